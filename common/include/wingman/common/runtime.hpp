@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: MIT
+// The process runtime every Wingman process uses: CLI, config, LCM in/out, typed subscriptions that
+// drop and count bad messages, status heartbeats, signals, and one-line fatal errors.
+#pragma once
+
+#include "wingman/common/config.hpp"
+#include "wingman/common/message_validation.hpp"
+#include "wingman/common/status_tracker.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace wingman::common {
+
+/// What a process is (fixed in its main).
+struct ProcessInfo {
+  std::string name;         ///< instance name default and config stem, e.g. "camera_driver"
+  std::string executable;   ///< e.g. "wingman-camera-driver"
+  std::string description;  ///< one line for --help
+};
+
+/// Options common to every process, from the command line (not the YAML file).
+struct RuntimeOptions {
+  std::string config_path;        ///< --config FILE; "" = built-in defaults
+  bool print_config = false;      ///< --print-config: print the effective config and exit 0
+  std::string lcm_url;            ///< --lcm-url; "" = LCM_DEFAULT_URL or LCM's default
+  std::string lcm_in;             ///< --lcm-in: URL to read from; "" = lcm_url
+  std::string lcm_out;            ///< --lcm-out: URL to publish to; "" = lcm_url
+  std::string instance;           ///< --name: instance name in status and its channel; "" = ProcessInfo::name
+  bool lockstep = false;          ///< --lockstep: publish status after every handled message (for `wingman replay`)
+  double status_period_s = 1.0;   ///< --status-period: heartbeat period, seconds (wall clock)
+  std::string log_level = "info"; ///< --log-level: trace, debug, info, warn, error
+
+  /// "" or one line naming the bad option.
+  std::string validate() const;
+};
+
+/// Channel on which process instance `instance` publishes its status_t: "STATUS_" + upper case.
+std::string status_channel(const std::string& instance);
+
+/// LCM I/O and bookkeeping for one process. Single-threaded: handlers run inside spin_once().
+class Runtime {
+ public:
+  /// Opens the LCM URLs and installs SIGINT/SIGTERM handlers. Throws std::runtime_error naming the
+  /// URL when LCM cannot be opened.
+  Runtime(const ProcessInfo& info, const RuntimeOptions& options);
+  ~Runtime();
+  Runtime(const Runtime&) = delete;
+  Runtime& operator=(const Runtime&) = delete;
+
+  const std::string& instance() const { return instance_; }
+  const RuntimeOptions& options() const { return options_; }
+  StatusTracker& status() { return status_; }
+  /// True when the input is an LCM log file (file:// URL): the process ends at its end.
+  bool input_is_file() const { return input_is_file_; }
+
+  /// Subscribes to `channel` with messages of type Msg. Each message is decoded and checked with
+  /// `validate` (default: validate_message); a message that fails either, or whose handler throws,
+  /// is dropped and counted (status drops, last_error) — the process keeps running.
+  template <class Msg>
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
+                 std::function<std::string(const Msg&)> validate = default_validator<Msg>());
+
+  /// Publishes on `channel` (to --lcm-out) and counts it. Throws std::runtime_error naming the
+  /// channel if LCM fails to publish.
+  template <class Msg>
+  void publish(const std::string& channel, const Msg& msg);
+
+  /// Handles incoming messages for up to `timeout_ms` and publishes the heartbeat when due.
+  /// Returns false when the process should end: SIGINT/SIGTERM, request_stop(), or end of a file input.
+  bool spin_once(int timeout_ms = 100);
+  /// spin_once() until it returns false; then publishes a final STOPPING heartbeat. Returns 0.
+  int spin();
+  /// Publishes the heartbeat now when it is due (sources call this from their own loop).
+  void heartbeat_if_due();
+  /// Publishes a heartbeat now.
+  void publish_heartbeat();
+
+  bool stop_requested() const;
+  void request_stop(const std::string& reason);
+
+ private:
+  class SubscriptionBase {
+   public:
+    virtual ~SubscriptionBase() = default;
+  };
+  template <class Msg>
+  class Subscription;
+
+  template <class Msg>
+  static std::function<std::string(const Msg&)> default_validator() {
+    return [](const Msg& m) { return validate_message(m); };
+  }
+  void after_message();
+  void publish_raw(const std::string& channel, const void* data, size_t size);
+
+  ProcessInfo info_;
+  RuntimeOptions options_;
+  std::string instance_;
+  std::string status_channel_;
+  std::unique_ptr<lcm::LCM> lcm_in_;
+  std::unique_ptr<lcm::LCM> lcm_out_owned_;
+  lcm::LCM* lcm_out_ = nullptr;
+  bool input_is_file_ = false;
+  bool end_of_input_ = false;
+  StatusTracker status_;
+  std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_heartbeat_;
+  std::string stop_reason_;
+  bool stop_requested_locally_ = false;
+};
+
+template <class Msg>
+class Runtime::Subscription : public Runtime::SubscriptionBase {
+ public:
+  Subscription(Runtime* rt, std::string channel, std::function<void(const Msg&)> handler,
+               std::function<std::string(const Msg&)> validate)
+      : rt_(rt), channel_(std::move(channel)), handler_(std::move(handler)), validate_(std::move(validate)) {}
+
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+    Msg msg;
+    if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0) {
+      rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + std::to_string(rbuf->data_size) +
+                                               " bytes do not decode as " + Msg::getTypeName() +
+                                               " (wrong type or truncated)");
+      rt_->after_message();
+      return;
+    }
+    const std::string problem = validate_ ? validate_(msg) : std::string();
+    if (!problem.empty()) {
+      rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + problem);
+      rt_->after_message();
+      return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      handler_(msg);
+      rt_->status_.input(channel_, msg.utime);
+    } catch (const std::exception& e) {
+      rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + e.what());
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    rt_->status_.record_latency_ms(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    rt_->after_message();
+  }
+
+ private:
+  Runtime* rt_;
+  std::string channel_;
+  std::function<void(const Msg&)> handler_;
+  std::function<std::string(const Msg&)> validate_;
+};
+
+template <class Msg>
+void Runtime::subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
+                        std::function<std::string(const Msg&)> validate) {
+  auto sub = std::make_unique<Subscription<Msg>>(this, channel, std::move(handler), std::move(validate));
+  // LCM treats the channel as a regular expression; anchor it so "IMAGE" does not match "IMAGE_2".
+  lcm_in_->subscribe("^" + channel + "$", &Subscription<Msg>::on_message, sub.get());
+  status_.declare_input(channel);
+  subscriptions_.push_back(std::move(sub));
+}
+
+template <class Msg>
+void Runtime::publish(const std::string& channel, const Msg& msg) {
+  const int size = msg.getEncodedSize();
+  std::vector<uint8_t> buf(static_cast<size_t>(size));
+  if (msg.encode(buf.data(), 0, size) < 0) {
+    throw std::runtime_error("channel " + channel + ": cannot encode " + Msg::getTypeName());
+  }
+  publish_raw(channel, buf.data(), buf.size());
+  status_.output(channel, msg.utime);
+}
+
+/// Sets up logging, parses the common options and `--config`, builds the Runtime and runs `body`.
+/// Turns every error into one line on stderr and an exit code: 0 on success, SIGINT/SIGTERM or end
+/// of a file input; 2 for a bad command line or config; 1 for any other fatal error.
+/// `Options` needs visit() and validate() (see ConfigLoader).
+int run_process_impl(const ProcessInfo& info, int argc, char** argv,
+                     const std::function<std::string(const std::string& path, bool print)>& load_config,
+                     const std::function<int(Runtime&)>& body);
+
+template <class Options>
+int run_process(const ProcessInfo& info, int argc, char** argv,
+                const std::function<int(Runtime&, const Options&)>& body) {
+  Options options;
+  auto load = [&](const std::string& path, bool print) -> std::string {
+    if (!path.empty()) options = load_options<Options>(path);
+    else {
+      const auto problems = options.validate();
+      if (!problems.empty()) throw ConfigError("built-in defaults invalid: " + problems.front());
+    }
+    if (!print) return "";
+    return print_options(options, info.executable + " effective configuration" +
+                                      (path.empty() ? " (built-in defaults)" : " (from " + path + ")"));
+  };
+  return run_process_impl(info, argc, argv, load, [&](Runtime& rt) { return body(rt, options); });
+}
+
+}  // namespace wingman::common

@@ -1,0 +1,275 @@
+// SPDX-License-Identifier: MIT
+// YAML configuration loader and printer.
+#include "wingman/common/config.hpp"
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace wingman::common {
+namespace {
+
+std::string scalar_text(const YAML::Node& node) {
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  if (node.IsSequence()) return "a sequence";
+  if (node.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+std::string quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+ConfigLoader ConfigLoader::from_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(fmt::format("{}: cannot open config file", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return from_string(ss.str(), path);
+}
+
+ConfigLoader ConfigLoader::from_string(const std::string& yaml_text, const std::string& source_name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(fmt::format("{}:{}:{}: not valid YAML: {}", source_name, e.mark.line + 1,
+                                  e.mark.column + 1, e.msg));
+  }
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // an empty file means all defaults
+  if (!root.IsMap()) {
+    throw ConfigError(fmt::format("{}: expected a mapping of sections at the top level, got {}",
+                                  source_name, scalar_text(root)));
+  }
+  return ConfigLoader(source_name, root);
+}
+
+ConfigLoader::ConfigLoader(std::string source_name, const YAML::Node& root)
+    : source_name_(std::move(source_name)) {
+  flatten(root, "");
+}
+
+void ConfigLoader::flatten(const YAML::Node& node, const std::string& prefix) {
+  for (const auto& kv : node) {
+    const std::string name = kv.first.as<std::string>();
+    const std::string key = prefix.empty() ? name : prefix + "." + name;
+    if (kv.second.IsMap()) {
+      flatten(kv.second, key);
+    } else {
+      leaves_[key] = kv.second;
+    }
+  }
+}
+
+std::string ConfigLoader::where(const std::string& key, const YAML::Node& node) const {
+  const auto mark = node.Mark();
+  if (mark.line >= 0) return fmt::format("{}:{}: {}", source_name_, mark.line + 1, key);
+  return fmt::format("{}: {}", source_name_, key);
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, bool& out) {
+  bool v;
+  if (node.IsScalar() && YAML::convert<bool>::decode(node, v)) {
+    out = v;
+  } else {
+    errors_.push_back(fmt::format("{}: expected true or false, got {}", where(key, node), scalar_text(node)));
+  }
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, int64_t& out) {
+  long long v;
+  if (node.IsScalar() && YAML::convert<long long>::decode(node, v)) {
+    out = v;
+  } else {
+    errors_.push_back(fmt::format("{}: expected an integer, got {}", where(key, node), scalar_text(node)));
+  }
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, int& out) {
+  int64_t v = 0;
+  const size_t before = errors_.size();
+  convert(key, node, v);
+  if (errors_.size() != before) return;
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
+    errors_.push_back(fmt::format("{}: integer {} out of range", where(key, node), v));
+    return;
+  }
+  out = static_cast<int>(v);
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, double& out) {
+  double v;
+  if (node.IsScalar() && YAML::convert<double>::decode(node, v)) {
+    out = v;
+  } else {
+    errors_.push_back(fmt::format("{}: expected a number, got {}", where(key, node), scalar_text(node)));
+  }
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::string& out) {
+  if (node.IsScalar()) {
+    out = node.Scalar();
+  } else if (node.IsNull()) {
+    out.clear();
+  } else {
+    errors_.push_back(fmt::format("{}: expected a string, got {}", where(key, node), scalar_text(node)));
+  }
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::vector<double>& out) {
+  if (!node.IsSequence()) {
+    errors_.push_back(fmt::format("{}: expected a sequence of numbers, got {}", where(key, node), scalar_text(node)));
+    return;
+  }
+  std::vector<double> v;
+  for (size_t i = 0; i < node.size(); ++i) {
+    double x;
+    if (!node[i].IsScalar() || !YAML::convert<double>::decode(node[i], x)) {
+      errors_.push_back(fmt::format("{}[{}]: expected a number, got {}", where(key, node), i, scalar_text(node[i])));
+      return;
+    }
+    v.push_back(x);
+  }
+  out = v;
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::vector<int>& out) {
+  if (!node.IsSequence()) {
+    errors_.push_back(fmt::format("{}: expected a sequence of integers, got {}", where(key, node), scalar_text(node)));
+    return;
+  }
+  std::vector<int> v;
+  for (size_t i = 0; i < node.size(); ++i) {
+    int x;
+    if (!node[i].IsScalar() || !YAML::convert<int>::decode(node[i], x)) {
+      errors_.push_back(fmt::format("{}[{}]: expected an integer, got {}", where(key, node), i, scalar_text(node[i])));
+      return;
+    }
+    v.push_back(x);
+  }
+  out = v;
+}
+
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::vector<std::string>& out) {
+  if (!node.IsSequence()) {
+    errors_.push_back(fmt::format("{}: expected a sequence of strings, got {}", where(key, node), scalar_text(node)));
+    return;
+  }
+  std::vector<std::string> v;
+  for (size_t i = 0; i < node.size(); ++i) {
+    if (!node[i].IsScalar()) {
+      errors_.push_back(fmt::format("{}[{}]: expected a string, got {}", where(key, node), i, scalar_text(node[i])));
+      return;
+    }
+    v.push_back(node[i].Scalar());
+  }
+  out = v;
+}
+
+void ConfigLoader::finish(const std::vector<std::string>& validation_errors) const {
+  std::vector<std::string> all = errors_;
+  for (const auto& [key, node] : leaves_) {
+    if (known_.count(key)) continue;
+    // Suggest a known key with the same last component, if any (typo in the section).
+    std::string hint;
+    const std::string last = key.substr(key.rfind('.') + 1);
+    for (const auto& k : known_) {
+      if (k.substr(k.rfind('.') + 1) == last) {
+        hint = fmt::format(" (did you mean '{}'?)", k);
+        break;
+      }
+    }
+    all.push_back(fmt::format("{}: unknown key{}", where(key, node), hint));
+  }
+  for (const auto& e : validation_errors) all.push_back(fmt::format("{}: {}", source_name_, e));
+  if (all.empty()) return;
+  std::string msg = fmt::format("{} problem{} in configuration: ", all.size(), all.size() == 1 ? "" : "s");
+  for (size_t i = 0; i < all.size(); ++i) msg += (i ? "; " : "") + all[i];
+  throw ConfigError(msg);
+}
+
+void ConfigPrinter::add(const std::string& key, const std::string& value, const char* doc) {
+  const auto dot = key.rfind('.');
+  Entry e;
+  e.section = dot == std::string::npos ? "" : key.substr(0, dot);
+  e.name = dot == std::string::npos ? key : key.substr(dot + 1);
+  e.value = value;
+  e.doc = doc ? doc : "";
+  entries_.push_back(std::move(e));
+}
+
+std::string ConfigPrinter::str(const std::string& header) const {
+  std::string out;
+  if (!header.empty()) {
+    std::istringstream hs(header);
+    for (std::string line; std::getline(hs, line);) out += "# " + line + "\n";
+  }
+  // Group by section in order of first appearance; nested sections ("a.b") are indented.
+  std::vector<std::string> order;
+  for (const auto& e : entries_) {
+    if (std::find(order.begin(), order.end(), e.section) == order.end()) order.push_back(e.section);
+  }
+  std::vector<std::string> open;  // currently open section path components
+  for (const auto& section : order) {
+    std::vector<std::string> parts;
+    if (!section.empty()) {
+      std::istringstream ss(section);
+      for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+    }
+    size_t common = 0;
+    while (common < open.size() && common < parts.size() && open[common] == parts[common]) ++common;
+    if (common == 0 && !out.empty()) out += "\n";
+    for (size_t i = common; i < parts.size(); ++i) out += std::string(2 * i, ' ') + parts[i] + ":\n";
+    open = parts;
+    const std::string indent(2 * parts.size(), ' ');
+    for (const auto& e : entries_) {
+      if (e.section != section) continue;
+      if (!e.doc.empty()) out += indent + "# " + e.doc + "\n";
+      out += indent + e.name + ": " + e.value + "\n";
+    }
+  }
+  return out;
+}
+
+std::string ConfigPrinter::format(bool v) { return v ? "true" : "false"; }
+std::string ConfigPrinter::format(int v) { return std::to_string(v); }
+std::string ConfigPrinter::format(int64_t v) { return std::to_string(v); }
+std::string ConfigPrinter::format(double v) {
+  std::string s = fmt::format("{}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // keep it a float for readers
+  return s;
+}
+std::string ConfigPrinter::format(const std::string& v) { return quote(v); }
+std::string ConfigPrinter::format(const std::vector<double>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + format(v[i]);
+  return s + "]";
+}
+std::string ConfigPrinter::format(const std::vector<int>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + format(v[i]);
+  return s + "]";
+}
+std::string ConfigPrinter::format(const std::vector<std::string>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + quote(v[i]);
+  return s + "]";
+}
+
+std::string problem(const std::string& key, const std::string& value, const std::string& rule) {
+  return fmt::format("{} = '{}': {}", key, value, rule);
+}
+std::string problem(const std::string& key, double value, const std::string& rule) {
+  return fmt::format("{} = {}: {}", key, value, rule);
+}
+
+}  // namespace wingman::common

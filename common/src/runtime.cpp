@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: MIT
+// Process runtime: command line, config, LCM endpoints, heartbeats, signals and error reporting.
+#include "wingman/common/runtime.hpp"
+
+#include "wingman/common/time.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
+
+namespace wingman::common {
+namespace {
+
+std::atomic<int> g_signal{0};
+
+extern "C" void on_signal(int sig) { g_signal.store(sig); }
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: blocking calls return EINTR so loops notice promptly
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+}
+
+bool is_file_url(const std::string& url) { return url.rfind("file://", 0) == 0; }
+
+std::unique_ptr<lcm::LCM> open_lcm(const std::string& url, const char* role) {
+  auto lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good()) {
+    const std::string shown = url.empty() ? "the default URL (LCM_DEFAULT_URL or udpm default)" : "'" + url + "'";
+    throw std::runtime_error(fmt::format("cannot open LCM {} {}", role, shown));
+  }
+  return lcm;
+}
+
+}  // namespace
+
+std::string RuntimeOptions::validate() const {
+  if (!(status_period_s > 0.0 && status_period_s <= 60.0))
+    return fmt::format("--status-period = {}: must be in (0, 60] seconds", status_period_s);
+  static const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
+  if (std::find(levels.begin(), levels.end(), log_level) == levels.end())
+    return fmt::format("--log-level = '{}': must be one of trace, debug, info, warn, error", log_level);
+  if (is_file_url(lcm_out) && lcm_out.find("mode=w") == std::string::npos && lcm_out.find("mode=a") == std::string::npos)
+    return fmt::format("--lcm-out = '{}': a file output needs '?mode=w' (or mode=a)", lcm_out);
+  return "";
+}
+
+std::string status_channel(const std::string& instance) {
+  std::string ch = "STATUS_";
+  for (char c : instance) ch += std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::toupper(c)) : '_';
+  return ch;
+}
+
+Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
+    : info_(info),
+      options_(options),
+      instance_(options.instance.empty() ? info.name : options.instance),
+      status_channel_(status_channel(instance_)),
+      status_(instance_, static_cast<int32_t>(getpid())) {
+  install_signal_handlers();
+  const std::string in_url = options_.lcm_in.empty() ? options_.lcm_url : options_.lcm_in;
+  const std::string out_url = options_.lcm_out.empty() ? options_.lcm_url : options_.lcm_out;
+  input_is_file_ = is_file_url(in_url);
+  lcm_in_ = open_lcm(in_url, input_is_file_ ? "input log" : "input");
+  if (out_url == in_url && !input_is_file_) {
+    lcm_out_ = lcm_in_.get();
+  } else {
+    lcm_out_owned_ = open_lcm(out_url, "output");
+    lcm_out_ = lcm_out_owned_.get();
+  }
+  start_ = std::chrono::steady_clock::now();
+  last_heartbeat_ = start_;
+  status_.declare_output(status_channel_);
+  spdlog::debug("lcm in '{}', out '{}', status on {}", in_url, out_url, status_channel_);
+}
+
+Runtime::~Runtime() = default;
+
+bool Runtime::stop_requested() const { return g_signal.load() != 0 || stop_requested_locally_; }
+
+void Runtime::request_stop(const std::string& reason) {
+  stop_requested_locally_ = true;
+  stop_reason_ = reason;
+}
+
+void Runtime::publish_raw(const std::string& channel, const void* data, size_t size) {
+  if (lcm_out_->publish(channel, data, static_cast<unsigned int>(size)) != 0) {
+    throw std::runtime_error(fmt::format("channel {}: LCM failed to publish {} bytes", channel, size));
+  }
+}
+
+void Runtime::publish_heartbeat() {
+  const auto now = std::chrono::steady_clock::now();
+  const double window_s = std::chrono::duration<double>(now - last_heartbeat_).count();
+  const int64_t uptime_us = std::chrono::duration_cast<std::chrono::microseconds>(now - start_).count();
+  last_heartbeat_ = now;
+  wingman::status_t s = status_.heartbeat(wall_utime(), uptime_us, window_s);
+  const int size = s.getEncodedSize();
+  std::vector<uint8_t> buf(static_cast<size_t>(size));
+  s.encode(buf.data(), 0, size);
+  if (lcm_out_->publish(status_channel_, buf.data(), static_cast<unsigned int>(buf.size())) != 0) {
+    spdlog::warn("channel {}: failed to publish the status heartbeat", status_channel_);
+  }
+}
+
+void Runtime::heartbeat_if_due() {
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_heartbeat_).count() >= options_.status_period_s) publish_heartbeat();
+}
+
+void Runtime::after_message() {
+  if (options_.lockstep) publish_heartbeat();
+}
+
+bool Runtime::spin_once(int timeout_ms) {
+  if (stop_requested() || end_of_input_) return false;
+  if (status_.state() == wingman::status_t::STATE_STARTING) status_.set_state(wingman::status_t::STATE_OK, "");
+  if (input_is_file_) {
+    // A log read with speed=0 delivers its next event on every handle(); -1 means the end of the file.
+    if (lcm_in_->handle() != 0) {
+      end_of_input_ = true;
+      stop_reason_ = "end of input log";
+    }
+  } else {
+    const int rc = lcm_in_->handleTimeout(timeout_ms);
+    if (rc < 0 && !stop_requested()) {
+      throw std::runtime_error("LCM input failed while waiting for messages");
+    }
+  }
+  heartbeat_if_due();
+  return !(stop_requested() || end_of_input_);
+}
+
+int Runtime::spin() {
+  while (spin_once(100)) {
+  }
+  if (stop_reason_.empty() && g_signal.load() != 0) stop_reason_ = fmt::format("signal {}", g_signal.load());
+  spdlog::info("stopping: {}", stop_reason_.empty() ? "requested" : stop_reason_);
+  status_.set_state(wingman::status_t::STATE_STOPPING, stop_reason_);
+  publish_heartbeat();
+  return 0;
+}
+
+int run_process_impl(const ProcessInfo& info, int argc, char** argv,
+                     const std::function<std::string(const std::string&, bool)>& load_config,
+                     const std::function<int(Runtime&)>& body) {
+  const std::string prog = info.executable;
+  RuntimeOptions ro;
+  CLI::App app{info.description, prog};
+  app.add_option("--config", ro.config_path, "YAML configuration file (default: built-in defaults; see config/" +
+                                                 info.name + ".yaml)");
+  app.add_flag("--print-config", ro.print_config, "Print the effective configuration as YAML and exit");
+  app.add_option("--lcm-url", ro.lcm_url, "LCM URL for input and output (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--lcm-in", ro.lcm_in, "LCM URL to read from, e.g. file:///tmp/in.lcmlog?speed=0 (default: --lcm-url)");
+  app.add_option("--lcm-out", ro.lcm_out, "LCM URL to publish to, e.g. file:///tmp/out.lcmlog?mode=w (default: --lcm-url)");
+  app.add_option("--name", ro.instance, "Instance name in status messages and the status channel (default: " + info.name + ")");
+  app.add_flag("--lockstep", ro.lockstep, "Publish status after every handled message (for `wingman replay --lockstep`)");
+  app.add_option("--status-period", ro.status_period_s, "Heartbeat period, seconds (default 1)");
+  app.add_option("--log-level", ro.log_level, "trace, debug, info, warn or error (default info)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << prog << ": error: " << e.what() << " (see --help)" << std::endl;
+    return 2;
+  }
+
+  auto logger = spdlog::stderr_color_st(info.name);
+  logger->set_pattern("%Y-%m-%dT%H:%M:%S.%e [%n] %^%l%$: %v");
+  spdlog::set_default_logger(logger);
+
+  if (const std::string bad = ro.validate(); !bad.empty()) {
+    std::cerr << prog << ": error: " << bad << std::endl;
+    return 2;
+  }
+  spdlog::set_level(spdlog::level::from_str(ro.log_level));
+
+  try {
+    const std::string printed = load_config(ro.config_path, ro.print_config);
+    if (ro.print_config) {
+      std::cout << printed << std::flush;
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << prog << ": error: " << e.what() << std::endl;
+    return 2;
+  }
+
+  try {
+    Runtime rt(info, ro);
+    spdlog::info("started (pid {}, instance '{}')", getpid(), rt.instance());
+    const int rc = body(rt);
+    return rc;
+  } catch (const std::exception& e) {
+    std::cerr << prog << ": error: " << e.what() << std::endl;
+    return 1;
+  }
+}
+
+}  // namespace wingman::common

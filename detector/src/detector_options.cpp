@@ -1,0 +1,19 @@
+// SPDX-License-Identifier: MIT
+// Validation of DetectorOptions.
+#include "wingman/detector/detector_options.hpp"
+
+#include <wingman/common/config.hpp>
+
+namespace wingman::detector {
+
+std::vector<std::string> DetectorOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (input_channel.empty()) p.push_back(problem("input.channel", input_channel, "must not be empty"));
+  if (output_channel.empty()) p.push_back(problem("output.channel", output_channel, "must not be empty"));
+  if (max_image_width < 1) p.push_back(problem("input.max_image_width", max_image_width, "must be >= 1"));
+  if (max_image_height < 1) p.push_back(problem("input.max_image_height", max_image_height, "must be >= 1"));
+  return p;
+}
+
+}  // namespace wingman::detector

@@ -1,0 +1,18 @@
+// SPDX-License-Identifier: MIT
+// Validation of LocalizerOptions.
+#include "wingman/localizer/localizer_options.hpp"
+
+#include <wingman/common/config.hpp>
+
+namespace wingman::localizer {
+
+std::vector<std::string> LocalizerOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (detections_channel.empty()) p.push_back(problem("input.detections_channel", detections_channel, "must not be empty"));
+  if (own_pose_channel.empty()) p.push_back(problem("input.own_pose_channel", own_pose_channel, "must not be empty"));
+  if (output_channel.empty()) p.push_back(problem("output.channel", output_channel, "must not be empty"));
+  return p;
+}
+
+}  // namespace wingman::localizer

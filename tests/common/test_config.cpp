@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: MIT
+// ConfigLoader / ConfigPrinter: defaults, every bad key reported at once, round trip.
+#include <gtest/gtest.h>
+#include <wingman/common/config.hpp>
+
+namespace {
+
+using wingman::common::ConfigError;
+using wingman::common::load_options_from_string;
+using wingman::common::print_options;
+
+struct Demo {
+  int width = 640;
+  double fps = 30.0;
+  std::string device = "/dev/video0";
+  bool loop = false;
+  std::vector<double> k = {1.0, 2.5};
+  int64_t start = 0;
+
+  template <class V>
+  void visit(V& v) {
+    v("camera.width", width, "pixels");
+    v("camera.fps", fps, "frames per second");
+    v("camera.device", device, "path");
+    v("file.loop", loop, "restart at the end");
+    v("file.k", k, "coefficients");
+    v("file.start", start, "utime");
+  }
+  std::vector<std::string> validate() const {
+    std::vector<std::string> p;
+    if (width <= 0) p.push_back(wingman::common::problem("camera.width", width, "must be > 0"));
+    return p;
+  }
+};
+
+TEST(ConfigLoader, EmptyFileGivesDefaults) {
+  const Demo d = load_options_from_string<Demo>("", "empty.yaml");
+  EXPECT_EQ(d.width, 640);
+  EXPECT_EQ(d.device, "/dev/video0");
+}
+
+TEST(ConfigLoader, ReadsNestedKeysOfEveryType) {
+  const Demo d = load_options_from_string<Demo>(
+      "camera: {width: 1280, fps: 15.5, device: /dev/video2}\nfile: {loop: true, k: [3, 4], start: 1700000000000000}\n",
+      "x.yaml");
+  EXPECT_EQ(d.width, 1280);
+  EXPECT_DOUBLE_EQ(d.fps, 15.5);
+  EXPECT_EQ(d.device, "/dev/video2");
+  EXPECT_TRUE(d.loop);
+  EXPECT_EQ(d.k, (std::vector<double>{3, 4}));
+  EXPECT_EQ(d.start, 1700000000000000);
+}
+
+TEST(ConfigLoader, ReportsEveryBadKeyAtOnceWithFileAndLine) {
+  try {
+    load_options_from_string<Demo>("camera:\n  width: -3\n  fps: fast\n  colour: red\nfile:\n  loop: maybe\n", "cam.yaml");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("4 problems"), std::string::npos) << m;
+    EXPECT_NE(m.find("cam.yaml:3: camera.fps: expected a number, got 'fast'"), std::string::npos) << m;
+    EXPECT_NE(m.find("cam.yaml:4: camera.colour: unknown key"), std::string::npos) << m;
+    EXPECT_NE(m.find("cam.yaml:6: file.loop: expected true or false, got 'maybe'"), std::string::npos) << m;
+    EXPECT_NE(m.find("camera.width = -3: must be > 0"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+  }
+}
+
+TEST(ConfigLoader, UnknownKeyInWrongSectionSuggestsTheKnownOne) {
+  try {
+    load_options_from_string<Demo>("file:\n  fps: 10\n", "s.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean 'camera.fps'?"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ConfigLoader, SyntaxErrorNamesFileAndLine) {
+  try {
+    load_options_from_string<Demo>("camera:\n  width: [1, 2\n", "bad.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not valid YAML"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ConfigLoader, MissingFileIsNamed) {
+  try {
+    wingman::common::load_options<Demo>("/nonexistent/wingman.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/wingman.yaml: cannot open"), std::string::npos);
+  }
+}
+
+TEST(ConfigPrinter, PrintedConfigReadsBackToTheSameValues) {
+  Demo d;
+  d.width = 999;
+  d.device = "we\"ird";
+  d.k = {0.1, 1e-9};
+  const std::string text = print_options(d, "header line");
+  EXPECT_EQ(text.rfind("# header line\n", 0), 0u) << text;
+  EXPECT_NE(text.find("  # pixels\n  width: 999\n"), std::string::npos) << text;
+  const Demo back = load_options_from_string<Demo>(text, "printed");
+  EXPECT_EQ(back.width, 999);
+  EXPECT_EQ(back.device, "we\"ird");
+  EXPECT_EQ(back.k, d.k);
+  EXPECT_EQ(print_options(back), print_options(d));
+}
+
+}  // namespace

@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: MIT
+// validate_message: good messages pass; each kind of bad field is named.
+#include <gtest/gtest.h>
+#include <wingman/common/message_validation.hpp>
+
+#include <limits>
+
+namespace {
+
+using wingman::common::validate_message;
+
+wingman::image_t gray_image(int w, int h, int stride) {
+  wingman::image_t m{};
+  m.utime = 1;
+  m.width = w;
+  m.height = h;
+  m.stride = stride;
+  m.pixel_format = wingman::image_t::GRAY8;
+  m.data.assign(static_cast<size_t>(stride) * h, 0);
+  m.size = static_cast<int32_t>(m.data.size());
+  return m;
+}
+
+TEST(ValidateImage, AcceptsPaddedStride) { EXPECT_EQ(validate_message(gray_image(10, 4, 16)), ""); }
+
+TEST(ValidateImage, RejectsZeroSizeAndNamesTheField) {
+  EXPECT_NE(validate_message(gray_image(0, 4, 16)).find("image_t.width = 0"), std::string::npos);
+}
+
+TEST(ValidateImage, RejectsStrideShorterThanARow) {
+  auto m = gray_image(10, 4, 16);
+  m.pixel_format = wingman::image_t::BGR8;
+  EXPECT_NE(validate_message(m).find("image_t.stride = 16: must be >= width * 3 = 30"), std::string::npos)
+      << validate_message(m);
+}
+
+TEST(ValidateImage, RejectsSizeMismatchAndTruncatedData) {
+  auto m = gray_image(10, 4, 16);
+  m.data.pop_back();
+  EXPECT_NE(validate_message(m).find("image_t.size"), std::string::npos);
+  m.size = static_cast<int32_t>(m.data.size());
+  EXPECT_NE(validate_message(m).find("must be stride * height"), std::string::npos);
+}
+
+TEST(ValidateImage, RejectsImagesAboveTheConfiguredLimit) {
+  wingman::common::ImageLimits limits;
+  limits.max_width = 8;
+  EXPECT_NE(validate_message(gray_image(10, 4, 16), limits).find("must be in 1..8"), std::string::npos);
+}
+
+TEST(ValidateImage, RejectsUnknownFormatAndNonJpegMjpeg) {
+  auto m = gray_image(10, 4, 16);
+  m.pixel_format = 9;
+  EXPECT_NE(validate_message(m).find("image_t.pixel_format = 9"), std::string::npos);
+  m.pixel_format = wingman::image_t::MJPEG;
+  EXPECT_NE(validate_message(m).find("SOI"), std::string::npos);
+  m.data[0] = 0xFF;
+  m.data[1] = 0xD8;
+  EXPECT_EQ(validate_message(m), "");
+}
+
+TEST(ValidateDetections, RejectsCountMismatchNonFiniteAndBadConfidence) {
+  wingman::detections_t d{};
+  d.utime = 1;
+  d.image_width = 640;
+  d.image_height = 480;
+  d.detections.resize(1);
+  d.detections[0] = {320, 240, 10, 10, 0.5f, 0, false};
+  d.num_detections = 2;
+  EXPECT_NE(validate_message(d).find("num_detections = 2"), std::string::npos);
+  d.num_detections = 1;
+  EXPECT_EQ(validate_message(d), "");
+  d.detections[0].cx = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(validate_message(d).find("detections[0]"), std::string::npos);
+  d.detections[0].cx = 1;
+  d.detections[0].confidence = 1.5f;
+  EXPECT_NE(validate_message(d).find("confidence = 1.5"), std::string::npos);
+}
+
+TEST(ValidateOwnPose, RejectsNonUnitQuaternionAndUnknownFrame) {
+  wingman::own_pose_t p{};
+  p.utime = 1;
+  p.q_body_to_world[0] = 1;
+  EXPECT_EQ(validate_message(p), "");
+  p.q_body_to_world[0] = 2;
+  EXPECT_NE(validate_message(p).find("q_body_to_world: norm 2"), std::string::npos);
+  p.q_body_to_world[0] = 1;
+  p.frame = 5;
+  EXPECT_NE(validate_message(p).find("own_pose_t.frame = 5"), std::string::npos);
+}
+
+TEST(ValidateSetpoint, RejectsUnknownMode) {
+  wingman::setpoint_t s{};
+  s.mode = 7;
+  EXPECT_NE(validate_message(s).find("setpoint_t.mode = 7"), std::string::npos);
+}
+
+}  // namespace

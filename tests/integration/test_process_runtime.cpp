@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: MIT
+// The common runtime as the real process binaries use it: configs, exit codes, signals, file I/O, bad messages.
+// No network: these tests use file:// and memq:// LCM URLs only.
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <wingman/common/runtime.hpp>
+#include <wingman/image_t.hpp>
+#include <wingman/status_t.hpp>
+
+#include <csignal>
+#include <fstream>
+#include <thread>
+
+namespace {
+
+using namespace std::chrono_literals;
+using wingman::testing::Child;
+using wingman::testing::TempDir;
+using wingman::testing::bin_path;
+using wingman::testing::run;
+using wingman::testing::source_path;
+
+struct ProcessCase {
+  std::string executable;
+  std::string config;    // config/<name>.yaml
+  std::string bad_key;   // a key that exists, to give a bad value
+};
+
+const std::vector<ProcessCase> kProcesses = {
+    {"wingman-camera-driver", "camera_driver", "output.camera_id"},
+    {"wingman-detector", "detector", "input.max_image_width"},
+    {"wingman-localizer", "localizer", "output.channel"},
+    {"wingman-follower-ctrl", "follower_ctrl", "output.channel"},
+};
+
+std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
+
+wingman::image_t gray_image(int64_t seq) {
+  wingman::image_t m{};
+  m.utime = 1700000000000000 + seq * 33333;
+  m.seq = seq;
+  m.width = 8;
+  m.height = 4;
+  m.stride = 8;
+  m.pixel_format = wingman::image_t::GRAY8;
+  m.data.assign(32, static_cast<uint8_t>(seq));
+  m.size = 32;
+  return m;
+}
+
+TEST(ProcessConfig, ShippedConfigFileEqualsTheBuiltInDefaults) {
+  for (const auto& p : kProcesses) {
+    SCOPED_TRACE(p.executable);
+    const auto defaults = run({bin_path(p.executable), "--print-config"});
+    ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+    const auto from_file = run({bin_path(p.executable), "--print-config", "--config", source_path("config/" + p.config + ".yaml")});
+    ASSERT_EQ(from_file.exit_code, 0) << from_file.err;
+    // Same keys and values; only the header line (which names the source) differs.
+    EXPECT_EQ(defaults.out.substr(defaults.out.find('\n')), from_file.out.substr(from_file.out.find('\n')));
+  }
+}
+
+TEST(ProcessConfig, EveryKeyInTheShippedConfigHasACommentAbove) {
+  for (const auto& p : kProcesses) {
+    SCOPED_TRACE(p.config);
+    std::ifstream in(source_path("config/" + p.config + ".yaml"));
+    ASSERT_TRUE(in.good());
+    std::string prev, line;
+    int keys = 0;
+    while (std::getline(in, line)) {
+      const auto colon = line.find(':');
+      const bool is_key = colon != std::string::npos && line.find('#') == std::string::npos && colon + 1 < line.size();
+      if (is_key) {
+        ++keys;
+        EXPECT_NE(prev.find('#'), std::string::npos) << "key without a comment: " << line;
+      }
+      prev = line;
+    }
+    EXPECT_GT(keys, 0);
+  }
+}
+
+TEST(ProcessConfig, BadConfigExitsNonZeroWithOneLineNamingFileAndEveryBadKey) {
+  TempDir dir;
+  for (const auto& p : kProcesses) {
+    SCOPED_TRACE(p.executable);
+    const std::string path = dir.file(p.config + ".yaml");
+    const auto dot = p.bad_key.find('.');
+    std::ofstream(path) << p.bad_key.substr(0, dot) << ":\n  " << p.bad_key.substr(dot + 1) << ": [not, a, scalar]\n"
+                        << "nonsense_section:\n  nonsense_key: 1\n";
+    const auto r = run({bin_path(p.executable), "--config", path}, 10s);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line expected: " << r.err;
+    EXPECT_NE(r.err.find(p.executable + ": error: 2 problems"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(path + ":2: " + p.bad_key), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("nonsense_section.nonsense_key: unknown key"), std::string::npos) << r.err;
+  }
+}
+
+TEST(ProcessConfig, MissingConfigFileAndBadOptionAreOneLineErrors) {
+  const auto r = run({bin_path("wingman-detector"), "--config", "/nonexistent.yaml"}, 10s);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(first_line(r.err), "wingman-detector: error: /nonexistent.yaml: cannot open config file");
+  const auto r2 = run({bin_path("wingman-localizer"), "--lcm-out", "file:///tmp/x.lcmlog"}, 10s);
+  EXPECT_EQ(r2.exit_code, 2);
+  EXPECT_NE(r2.err.find("--lcm-out"), std::string::npos) << r2.err;
+}
+
+TEST(ProcessSignals, SigtermAndSigintEndEveryProcessWithExitZeroWithinOneSecond) {
+  TempDir dir;
+  const std::string video = dir.file("v.avi");
+  wingman::testing::write_test_video(video, 10, 64, 48, 30.0);
+  const std::string cam_cfg = dir.file("cam.yaml");
+  std::ofstream(cam_cfg) << "source:\n  kind: file\nfile:\n  path: " << video << "\n  mode: realtime\n  loop: true\n";
+  for (int sig : {SIGTERM, SIGINT}) {
+    for (const auto& p : kProcesses) {
+      SCOPED_TRACE(p.executable + " signal " + std::to_string(sig));
+      std::vector<std::string> argv = {bin_path(p.executable), "--lcm-url", "memq://"};
+      if (p.config == "camera_driver") argv.insert(argv.end(), {"--config", cam_cfg});
+      Child c(argv);
+      // Running: it has logged that it started (bounded wait), and has not exited.
+      const auto deadline = std::chrono::steady_clock::now() + 10s;
+      while (c.err().find("started") == std::string::npos && std::chrono::steady_clock::now() < deadline && c.running()) {
+        std::this_thread::sleep_for(10ms);
+      }
+      ASSERT_TRUE(c.running()) << c.err();
+      const auto t0 = std::chrono::steady_clock::now();
+      c.signal(sig);
+      const int rc = c.wait(5s);
+      const auto elapsed = std::chrono::steady_clock::now() - t0;
+      EXPECT_EQ(rc, 0) << c.err();
+      EXPECT_LT(elapsed, 1s) << "took " << std::chrono::duration<double>(elapsed).count() << " s";
+    }
+  }
+}
+
+TEST(ProcessFileIo, FileInputIsProcessedToItsEndWithExitZeroAndBadMessagesAreCountedNotFatal) {
+  TempDir dir;
+  std::vector<wingman::testing::LogEvent> events;
+  for (int i = 0; i < 5; ++i) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
+  events.push_back({1100, "IMAGE_CAM0", {1, 2, 3}});  // garbage: does not decode
+  auto bad = gray_image(6);
+  bad.stride = 3;  // shorter than a row
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", bad, 1101));
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(7), 1102));
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+
+  const auto r = run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
+                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
+                     20s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = wingman::testing::read_log(dir.file("out.lcmlog"));
+  ASSERT_FALSE(out.empty());
+  wingman::status_t last;
+  ASSERT_EQ(out.back().channel, "STATUS_DETECTOR");
+  ASSERT_GE(last.decode(out.back().data.data(), 0, static_cast<int>(out.back().data.size())), 0);
+  EXPECT_EQ(last.state, int{wingman::status_t::STATE_STOPPING});
+  EXPECT_EQ(last.detail, "end of input log");
+  EXPECT_EQ(last.messages_handled, 8);
+  EXPECT_EQ(last.drops_total, 2);
+  EXPECT_EQ(last.last_processed_seq, 7);
+  EXPECT_NE(last.last_error.find("image_t.stride = 3"), std::string::npos) << last.last_error;
+  bool listed = false;
+  for (const auto& c : last.channels) {
+    if (c.channel == "IMAGE_CAM0") {
+      listed = true;
+      EXPECT_EQ(c.count, 8);
+      EXPECT_EQ(c.drops, 2);
+      EXPECT_EQ(c.last_utime, gray_image(7).utime);
+    }
+  }
+  EXPECT_TRUE(listed);
+}
+
+TEST(ProcessFileIo, UnreadableInputLogIsAOneLineError) {
+  const auto r = run({bin_path("wingman-localizer"), "--lcm-in", "file:///nonexistent/in.lcmlog?speed=0", "--lcm-out", "memq://"}, 10s);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("wingman-localizer: error: cannot open LCM input log 'file:///nonexistent/in.lcmlog?speed=0'"),
+            std::string::npos)
+      << r.err;
+}
+
+}  // namespace

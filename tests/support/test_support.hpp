@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: MIT
+// Helpers for tests that run the real processes: child processes with bounded waits, temp dirs, LCM logs.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace wingman::testing {
+
+/// Path of a built executable in build/bin ($WINGMAN_BIN_DIR), e.g. bin_path("wingman-detector").
+std::string bin_path(const std::string& name);
+/// Path in the source tree ($WINGMAN_SOURCE_DIR), e.g. source_path("config/detector.yaml").
+std::string source_path(const std::string& relative);
+
+/// A fresh directory under $TMPDIR, removed with its contents on destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+/// A child process with stdout and stderr captured to files.
+class Child {
+ public:
+  /// Starts argv[0] with arguments; throws std::runtime_error if it cannot be started.
+  explicit Child(const std::vector<std::string>& argv);
+  ~Child();  ///< kills (SIGKILL) and reaps the child if it is still running
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  int pid() const { return pid_; }
+  void signal(int sig) const;
+  /// Waits for exit up to `timeout`; returns the exit code (128+signal if killed by a signal) or -1 on timeout.
+  int wait(std::chrono::milliseconds timeout);
+  bool running();
+  std::string out() const;  ///< what it wrote to stdout so far
+  std::string err() const;  ///< what it wrote to stderr so far
+
+ private:
+  int pid_ = -1;
+  int exit_code_ = -1;
+  bool reaped_ = false;
+  TempDir dir_;
+};
+
+/// Runs a command to completion (bounded); returns {exit code, stdout, stderr}. Exit code -1 = timed out (killed).
+struct RunResult {
+  int exit_code;
+  std::string out;
+  std::string err;
+};
+RunResult run(const std::vector<std::string>& argv, std::chrono::milliseconds timeout = std::chrono::seconds(30));
+
+/// One event of an LCM log.
+struct LogEvent {
+  int64_t timestamp;
+  std::string channel;
+  std::vector<uint8_t> data;
+};
+/// All events of an LCM log; throws std::runtime_error naming the file if it cannot be read.
+std::vector<LogEvent> read_log(const std::string& path);
+/// Writes events to a new LCM log.
+void write_log(const std::string& path, const std::vector<LogEvent>& events);
+
+/// Encodes an LCM message into a log event.
+template <class Msg>
+LogEvent make_event(const std::string& channel, const Msg& msg, int64_t timestamp) {
+  LogEvent ev{timestamp, channel, std::vector<uint8_t>(static_cast<size_t>(msg.getEncodedSize()))};
+  msg.encode(ev.data.data(), 0, static_cast<int>(ev.data.size()));
+  return ev;
+}
+
+/// Writes an MJPG .avi of `frames` frames, `width` x `height`, with a bright square moving one
+/// step per frame over a textured background (OpenCV's built-in AVI writer, no ffmpeg needed).
+void write_test_video(const std::string& path, int frames, int width, int height, double fps);
+
+/// Payloads per channel, each channel in order, for comparing runs: LCM's event times differ
+/// between runs, and channels from different processes may interleave differently.
+std::map<std::string, std::vector<std::vector<uint8_t>>> payloads_by_channel(
+    const std::vector<LogEvent>& events, const std::string& channel_prefix_to_skip = "STATUS_");
+
+}  // namespace wingman::testing

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Installs Wingman's build and test dependencies from Debian 12's archive, only what is missing.
+# Called by the README's two commands; safe to run again (does nothing when all is present).
+set -euo pipefail
+
+# One list, grouped by what needs it. Later components append here.
+packages=(
+  # build
+  build-essential cmake pkg-config ninja-build
+  # LCM (C/C++ library, lcm-gen and tools, Java classes for lcm-spy and the tcpq hub)
+  liblcm-dev liblcm-bin liblcm-java libjchart2d-java libglib2.0-dev default-jdk-headless
+  # vision, maths, OpenCL (PoCL on the CPU), V4L2
+  libopencv-dev libeigen3-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
+  clinfo libv4l-dev
+  # configuration, CLI, logging
+  libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # private network namespaces for multi-process tests and the demo (unshare, ip)
+  util-linux iproute2
+  # lcm-spy screenshot check under a virtual X server
+  xvfb xauth x11-apps netpbm
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install_deps: installing ${#missing[@]} missing Debian packages: ${missing[*]}" >&2
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "install_deps: need root (or sudo) to install: ${missing[*]}" >&2; exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

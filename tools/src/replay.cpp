@@ -1,0 +1,222 @@
+// SPDX-License-Identifier: MIT
+// `wingman replay`: plays an LCM log, optionally in lockstep with the pipeline's processes.
+#include "wingman/tools/replay.hpp"
+
+#include <wingman/common/message_validation.hpp>
+#include <wingman/status_t.hpp>
+
+#include <fmt/format.h>
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <regex>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+namespace wingman::tools {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool is_status_channel(const std::string& channel) { return channel.rfind("STATUS_", 0) == 0; }
+
+/// Everything the player learns from the bus.
+class BusObserver {
+ public:
+  explicit BusObserver(lcm::LogFile* record) : record_(record) {}
+
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (is_status_channel(channel)) {
+      wingman::status_t s;
+      if (s.decode(rbuf->data, 0, rbuf->data_size) < 0 || !common::validate_message(s).empty()) {
+        ++bad_status_;
+        return;
+      }
+      statuses_[s.process] = s;
+      return;
+    }
+    ++bus_counts_[channel];
+    if (record_ != nullptr) {
+      lcm::LogEvent ev;
+      ev.eventnum = 0;
+      ev.timestamp = current_event_utime_;  // the played event's time: deterministic, unlike the receive clock
+      ev.channel = channel;
+      ev.datalen = static_cast<int32_t>(rbuf->data_size);
+      ev.data = rbuf->data;
+      if (record_->writeEvent(&ev) != 0) throw std::runtime_error("cannot write to the record log");
+      ++recorded_;
+    }
+  }
+
+  std::map<std::string, int64_t> bus_counts_;            ///< messages seen per channel since start
+  std::map<std::string, wingman::status_t> statuses_;    ///< newest status per process instance
+  int64_t current_event_utime_ = 0;
+  int64_t recorded_ = 0;
+  int64_t bad_status_ = 0;
+
+ private:
+  lcm::LogFile* record_;
+};
+
+/// Input counts of a stage at the start, so messages it handled before the replay do not count.
+using Baseline = std::map<std::string, std::map<std::string, int64_t>>;
+
+int64_t stage_input_count(const wingman::status_t& s, const std::string& channel) {
+  for (const auto& c : s.channels) {
+    if (c.direction == wingman::channel_stats_t::DIRECTION_IN && c.channel == channel) return c.count;
+  }
+  return 0;
+}
+
+/// "" when every stage has handled every message on its input channels, else what is missing.
+std::string unsettled(const BusObserver& bus, const std::vector<std::string>& stages, const Baseline& baseline) {
+  for (const auto& name : stages) {
+    const auto& s = bus.statuses_.at(name);
+    for (const auto& c : s.channels) {
+      if (c.direction != wingman::channel_stats_t::DIRECTION_IN) continue;
+      const auto it = bus.bus_counts_.find(c.channel);
+      const int64_t on_bus = it == bus.bus_counts_.end() ? 0 : it->second;
+      const int64_t handled = c.count - baseline.at(name).at(c.channel);
+      if (handled != on_bus) {
+        return fmt::format("stage '{}' handled {} of {} messages on {}", name, handled, on_bus, c.channel);
+      }
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string ReplayOptions::validate() const {
+  if (input_log.empty()) return "input log: must be given";
+  if (speed < 0) return fmt::format("--speed = {}: must be >= 0", speed);
+  if (start_timeout_s <= 0) return fmt::format("--start-timeout = {}: must be > 0 seconds", start_timeout_s);
+  if (step_timeout_s <= 0) return fmt::format("--step-timeout = {}: must be > 0 seconds", step_timeout_s);
+  if (max_events < 0) return fmt::format("--max-events = {}: must be >= 0", max_events);
+  return "";
+}
+
+std::string ReplaySummary::one_line() const {
+  std::string s = fmt::format("replay {}: {} events played, {} skipped, {} recorded, {:.2f} s", ok ? "done" : "FAILED",
+                              events_played, events_skipped, messages_recorded, wall_s);
+  if (!error.empty()) s += ": " + error;
+  return s;
+}
+
+ReplaySummary run_replay(const ReplayOptions& options) {
+  if (const std::string bad = options.validate(); !bad.empty()) throw std::runtime_error(bad);
+  const auto t_start = Clock::now();
+  ReplaySummary summary;
+
+  lcm::LogFile in(options.input_log, "r");
+  if (!in.good()) throw std::runtime_error(fmt::format("{}: cannot open LCM log for reading", options.input_log));
+  std::unique_ptr<lcm::LogFile> record;
+  if (!options.record_log.empty()) {
+    record = std::make_unique<lcm::LogFile>(options.record_log, "w");
+    if (!record->good()) throw std::runtime_error(fmt::format("{}: cannot open record log for writing", options.record_log));
+  }
+  lcm::LCM lcm(options.lcm_url);
+  if (!lcm.good()) throw std::runtime_error(fmt::format("cannot open LCM URL '{}'", options.lcm_url));
+
+  std::regex include_re, exclude_re;
+  try {
+    if (!options.channels.empty()) include_re = std::regex(options.channels);
+    if (!options.exclude.empty()) exclude_re = std::regex(options.exclude);
+  } catch (const std::regex_error& e) {
+    throw std::runtime_error(fmt::format("--channels/--exclude: not a valid regular expression: {}", e.what()));
+  }
+
+  BusObserver bus(record.get());
+  lcm.subscribe(".*", &BusObserver::on_message, &bus);
+  const bool lockstep = !options.stages.empty();
+
+  // Lockstep: wait until every stage reports, and remember where its counters start.
+  Baseline baseline;
+  std::set<std::string> stage_outputs;
+  if (lockstep) {
+    const auto deadline = t_start + std::chrono::duration<double>(options.start_timeout_s);
+    for (;;) {
+      std::string missing;
+      for (const auto& name : options.stages) {
+        if (!bus.statuses_.count(name)) missing += (missing.empty() ? "" : ", ") + name;
+      }
+      if (missing.empty()) break;
+      if (Clock::now() > deadline) {
+        summary.error = fmt::format("no status from {} within {} s (started with --lockstep on this LCM URL?)", missing,
+                                    options.start_timeout_s);
+        summary.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+        return summary;
+      }
+      lcm.handleTimeout(20);
+    }
+    for (const auto& name : options.stages) {
+      for (const auto& c : bus.statuses_.at(name).channels) {
+        if (c.direction == wingman::channel_stats_t::DIRECTION_IN) baseline[name][c.channel] = c.count;
+        else if (!is_status_channel(c.channel)) stage_outputs.insert(c.channel);
+      }
+    }
+    // Messages a stage saw before the replay (heartbeats excluded) are not ours to wait for.
+    bus.bus_counts_.clear();
+  }
+
+  int64_t first_timestamp = -1;
+  const auto play_start = Clock::now();
+  while (options.max_events == 0 || summary.events_played < options.max_events) {
+    const lcm::LogEvent* ev = in.readNextEvent();
+    if (ev == nullptr) break;
+    const bool play = !is_status_channel(ev->channel) && !stage_outputs.count(ev->channel) &&
+                      (options.channels.empty() || std::regex_match(ev->channel, include_re)) &&
+                      (options.exclude.empty() || !std::regex_match(ev->channel, exclude_re));
+    if (!play) {
+      ++summary.events_skipped;
+      continue;
+    }
+    if (!lockstep && options.speed > 0) {
+      if (first_timestamp < 0) first_timestamp = ev->timestamp;
+      const double due_s = static_cast<double>(ev->timestamp - first_timestamp) * 1e-6 / options.speed;
+      std::this_thread::sleep_until(play_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due_s)));
+    }
+    bus.current_event_utime_ = ev->timestamp;
+    const int64_t expected = bus.bus_counts_[ev->channel] + 1;
+    if (lcm.publish(ev->channel, ev->data, static_cast<unsigned int>(ev->datalen)) != 0) {
+      throw std::runtime_error(fmt::format("channel {}: LCM failed to publish {} bytes", ev->channel, ev->datalen));
+    }
+    ++summary.events_played;
+    if (!lockstep) {
+      while (lcm.handleTimeout(0) > 0) {
+      }
+      continue;
+    }
+    // Wait for our own message to come back, then for every stage to have handled everything.
+    const auto deadline = Clock::now() + std::chrono::duration<double>(options.step_timeout_s);
+    std::string why;
+    for (;;) {
+      why = bus.bus_counts_[ev->channel] < expected ? "own message not seen on the bus" : unsettled(bus, options.stages, baseline);
+      if (why.empty()) break;
+      if (Clock::now() > deadline) {
+        summary.error = fmt::format("event {} (channel {}): not settled within {} s: {}", summary.events_played,
+                                    ev->channel, options.step_timeout_s, why);
+        summary.messages_recorded = bus.recorded_;
+        summary.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+        return summary;
+      }
+      lcm.handleTimeout(20);
+    }
+  }
+  if (!lockstep) {
+    // Let the last messages arrive for the record (bounded).
+    const auto until = Clock::now() + std::chrono::milliseconds(300);
+    while (Clock::now() < until) lcm.handleTimeout(20);
+  }
+  if (bus.bad_status_ > 0) spdlog::warn("{} status messages could not be decoded and were ignored", bus.bad_status_);
+  summary.ok = true;
+  summary.messages_recorded = bus.recorded_;
+  summary.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+  return summary;
+}
+
+}  // namespace wingman::tools
