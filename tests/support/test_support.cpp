@@ -35,6 +35,22 @@ std::string slurp(const std::string& path) {
 
 }  // namespace
 
+std::string first_difference(const ChannelPayloads& expected, const ChannelPayloads& actual) {
+  for (const auto& [channel, msgs] : expected) {
+    const auto it = actual.find(channel);
+    if (it == actual.end()) return "channel " + channel + " missing";
+    if (it->second.size() != msgs.size())
+      return "channel " + channel + ": " + std::to_string(it->second.size()) + " messages, expected " + std::to_string(msgs.size());
+    for (size_t i = 0; i < msgs.size(); ++i) {
+      if (it->second[i] != msgs[i]) return "channel " + channel + ": message " + std::to_string(i) + " differs";
+    }
+  }
+  for (const auto& [channel, msgs] : actual) {
+    if (!expected.count(channel)) return "unexpected channel " + channel + " (" + std::to_string(msgs.size()) + " messages)";
+  }
+  return "";
+}
+
 std::string bin_path(const std::string& name) { return env_or("WINGMAN_BIN_DIR", "build/bin") + "/" + name; }
 std::string source_path(const std::string& relative) { return env_or("WINGMAN_SOURCE_DIR", ".") + "/" + relative; }
 
@@ -163,4 +179,17 @@ std::map<std::string, std::vector<std::vector<uint8_t>>> payloads_by_channel(
   return out;
 }
 
+}  // namespace wingman::testing
+
+namespace wingman::testing {
+std::string test_bin_path(const std::string& name) { return env_or("WINGMAN_TEST_BIN_DIR", "build/tests") + "/" + name; }
+
+std::string netns_lcm_url() {
+  const char* in = std::getenv("WINGMAN_IN_NETNS");
+  const char* url = std::getenv("WINGMAN_LCM_URL");
+  if (!in || std::string(in) != "1" || !url) {
+    throw std::runtime_error("this test multicasts: run it through tools/netns_run.sh (ctest does)");
+  }
+  return url;
+}
 }  // namespace wingman::testing

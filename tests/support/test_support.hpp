@@ -15,6 +15,10 @@ std::string bin_path(const std::string& name);
 /// Path in the source tree ($WINGMAN_SOURCE_DIR), e.g. source_path("config/detector.yaml").
 std::string source_path(const std::string& relative);
 
+using ChannelPayloads = std::map<std::string, std::vector<std::vector<uint8_t>>>;
+/// "" when equal, else the first difference (channel, index, sizes) in one line; for readable failures.
+std::string first_difference(const ChannelPayloads& expected, const ChannelPayloads& actual);
+
 /// A fresh directory under $TMPDIR, removed with its contents on destruction.
 class TempDir {
  public:
@@ -89,4 +93,12 @@ void write_test_video(const std::string& path, int frames, int width, int height
 std::map<std::string, std::vector<std::vector<uint8_t>>> payloads_by_channel(
     const std::vector<LogEvent>& events, const std::string& channel_prefix_to_skip = "STATUS_");
 
+}  // namespace wingman::testing
+
+namespace wingman::testing {
+/// Path of a test-support executable in build/tests ($WINGMAN_TEST_BIN_DIR).
+std::string test_bin_path(const std::string& name);
+/// The LCM URL of the private network namespace the test runs in ($WINGMAN_LCM_URL, set by
+/// tools/netns_run.sh); throws if the test is not running in one (so it never multicasts on the host).
+std::string netns_lcm_url();
 }  // namespace wingman::testing

@@ -23,6 +23,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 bool is_status_channel(const std::string& channel) { return channel.rfind("STATUS_", 0) == 0; }
+/// LCM's udpm provider publishes one LCM_SELF_TEST message when a process starts; it is not pipeline traffic.
+bool is_lcm_internal(const std::string& channel) { return channel == "LCM_SELF_TEST"; }
 
 /// Everything the player learns from the bus.
 class BusObserver {
@@ -39,6 +41,7 @@ class BusObserver {
       statuses_[s.process] = s;
       return;
     }
+    if (is_lcm_internal(channel)) return;
     ++bus_counts_[channel];
     if (record_ != nullptr) {
       lcm::LogEvent ev;
@@ -168,7 +171,7 @@ ReplaySummary run_replay(const ReplayOptions& options) {
   while (options.max_events == 0 || summary.events_played < options.max_events) {
     const lcm::LogEvent* ev = in.readNextEvent();
     if (ev == nullptr) break;
-    const bool play = !is_status_channel(ev->channel) && !stage_outputs.count(ev->channel) &&
+    const bool play = !is_status_channel(ev->channel) && !is_lcm_internal(ev->channel) && !stage_outputs.count(ev->channel) &&
                       (options.channels.empty() || std::regex_match(ev->channel, include_re)) &&
                       (options.exclude.empty() || !std::regex_match(ev->channel, exclude_re));
     if (!play) {

@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: MIT
+// Deterministic replay: the same input gives the same output payloads, run after run, both
+// file-to-file and through `wingman replay` in lockstep with live processes on LCM multicast.
+// Runs in a private network namespace (ctest wraps it in tools/netns_run.sh).
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <wingman/detections_t.hpp>
+#include <wingman/image_t.hpp>
+#include <wingman/status_t.hpp>
+
+#include <csignal>
+#include <fstream>
+#include <memory>
+
+namespace {
+
+using namespace std::chrono_literals;
+using wingman::testing::Child;
+using wingman::testing::TempDir;
+using wingman::testing::bin_path;
+using wingman::testing::payloads_by_channel;
+using wingman::testing::read_log;
+using wingman::testing::run;
+using wingman::testing::test_bin_path;
+
+constexpr int kFrames = 24;
+constexpr int kRuns = 10;
+
+/// Records `kFrames` frames of a generated video with the real camera driver, file to file.
+std::string record_camera_log(const TempDir& dir, const std::string& name) {
+  const std::string video = dir.file("clip.avi");
+  if (!std::ifstream(video).good()) wingman::testing::write_test_video(video, kFrames, 160, 120, 30.0);
+  const std::string cfg = dir.file("cam.yaml");
+  std::ofstream(cfg) << "source: {kind: file}\nfile: {path: " << video
+                     << ", mode: fast, start_utime: 1700000000000000}\n";
+  const std::string log = dir.file(name);
+  const auto r = run({bin_path("wingman-camera-driver"), "--config", cfg, "--lcm-url", "file://" + log + "?mode=w"}, 30s);
+  if (r.exit_code != 0) throw std::runtime_error("camera driver failed: " + r.err);
+  return log;
+}
+
+TEST(Replay, CameraDriverFileToFileGivesIdenticalPayloadsAcrossTenRuns) {
+  TempDir dir;
+  const auto reference = payloads_by_channel(read_log(record_camera_log(dir, "run0.lcmlog")));
+  ASSERT_EQ(reference.count("IMAGE_CAM0"), 1u);
+  ASSERT_EQ(reference.at("IMAGE_CAM0").size(), static_cast<size_t>(kFrames));
+  for (int i = 1; i < kRuns; ++i) {
+    const auto again = payloads_by_channel(read_log(record_camera_log(dir, "run" + std::to_string(i) + ".lcmlog")));
+    EXPECT_EQ(wingman::testing::first_difference(reference, again), "") << "run " << i;
+  }
+  // The frames are real: increasing seq and utime at 30 fps, and the moving square changes them.
+  wingman::image_t first, last;
+  const auto& frames = reference.at("IMAGE_CAM0");
+  first.decode(frames.front().data(), 0, static_cast<int>(frames.front().size()));
+  last.decode(frames.back().data(), 0, static_cast<int>(frames.back().size()));
+  EXPECT_EQ(first.utime, 1700000000000000);
+  EXPECT_EQ(last.seq - first.seq, kFrames - 1);
+  EXPECT_NEAR(static_cast<double>(last.utime - first.utime), (kFrames - 1) * 1e6 / 30.0, 1.0);
+  EXPECT_NE(first.data, last.data);
+}
+
+TEST(Replay, FileToFileChainThroughAStageIsDeterministic) {
+  TempDir dir;
+  const std::string images = record_camera_log(dir, "images.lcmlog");
+  std::map<std::string, std::vector<std::vector<uint8_t>>> reference;
+  for (int i = 0; i < kRuns; ++i) {
+    const std::string out = dir.file("det" + std::to_string(i) + ".lcmlog");
+    const auto r = run({test_bin_path("wingman-test-blob-stage"), "--lcm-in", "file://" + images + "?speed=0", "--lcm-out",
+                        "file://" + out + "?mode=w"},
+                       30s);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto p = payloads_by_channel(read_log(out));
+    if (i == 0) {
+      reference = p;
+      ASSERT_EQ(reference["DETECTIONS_CAM0"].size(), static_cast<size_t>(kFrames));
+    } else {
+      EXPECT_EQ(wingman::testing::first_difference(reference, p), "") << "run " << i;
+    }
+  }
+}
+
+/// Starts the stages with --lockstep, replays `log` in lockstep, and returns the recorded bus.
+std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const std::string& log, int run_index,
+                                                     std::string* replay_err) {
+  const std::string url = wingman::testing::netns_lcm_url();
+  std::vector<std::unique_ptr<Child>> stages;
+  stages.push_back(std::make_unique<Child>(
+      std::vector<std::string>{test_bin_path("wingman-test-blob-stage"), "--lcm-url", url, "--lockstep"}));
+  stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-detector"), "--lcm-url", url, "--lockstep"}));
+  stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url, "--lockstep"}));
+  const std::string record = dir.file("record" + std::to_string(run_index) + ".lcmlog");
+  const auto r = run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for", "blob_stage,detector,localizer",
+                      "--record", record, "--start-timeout", "20", "--step-timeout", "10"},
+                     120s);
+  *replay_err = r.err;
+  for (auto& s : stages) {
+    s->signal(SIGTERM);
+    EXPECT_EQ(s->wait(5s), 0) << s->err();
+  }
+  if (r.exit_code != 0) throw std::runtime_error("replay failed: " + r.err);
+  return read_log(record);
+}
+
+TEST(Replay, LockstepReplayThroughLiveProcessesGivesIdenticalPayloadsAcrossTenRuns) {
+  TempDir dir;
+  const std::string images = record_camera_log(dir, "images.lcmlog");
+  std::map<std::string, std::vector<std::vector<uint8_t>>> reference;
+  for (int i = 0; i < kRuns; ++i) {
+    std::string err;
+    const auto events = lockstep_run(dir, images, i, &err);
+    EXPECT_NE(err.find("replay done: " + std::to_string(kFrames) + " events played"), std::string::npos) << err;
+    const auto p = payloads_by_channel(events);
+    if (i == 0) {
+      reference = p;
+      // Every frame went out and came back as exactly one detection set, in order.
+      ASSERT_EQ(reference["IMAGE_CAM0"].size(), static_cast<size_t>(kFrames));
+      ASSERT_EQ(reference["DETECTIONS_CAM0"].size(), static_cast<size_t>(kFrames));
+      for (int k = 0; k < kFrames; ++k) {
+        wingman::detections_t d;
+        d.decode(reference["DETECTIONS_CAM0"][k].data(), 0, static_cast<int>(reference["DETECTIONS_CAM0"][k].size()));
+        EXPECT_EQ(d.seq, k);
+        EXPECT_EQ(d.num_detections, 1);
+      }
+    } else {
+      EXPECT_EQ(wingman::testing::first_difference(reference, p), "") << "run " << i;
+    }
+  }
+}
+
+TEST(Replay, LockstepReportsAStageThatNeverStarted) {
+  TempDir dir;
+  const std::string images = record_camera_log(dir, "images.lcmlog");
+  const auto r = run({bin_path("wingman"), "replay", images, "--lcm-url", wingman::testing::netns_lcm_url(), "--wait-for",
+                      "nobody", "--start-timeout", "0.5"},
+                     20s);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no status from nobody within 0.5 s"), std::string::npos) << r.err;
+}
+
+TEST(Replay, MissingLogIsAOneLineError) {
+  const auto r = run({bin_path("wingman"), "replay", "/nonexistent.lcmlog", "--lcm-url", "memq://"}, 20s);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "wingman: error: /nonexistent.lcmlog: cannot open LCM log for reading\n");
+}
+
+}  // namespace
