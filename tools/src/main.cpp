@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types).
+#include "wingman/tools/log_info.hpp"
+#include "wingman/tools/make_video.hpp"
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/spy.hpp"
 
@@ -11,7 +13,7 @@
 
 int main(int argc, char** argv) {
   using namespace wingman::tools;
-  CLI::App app{"Wingman tools: replay logs through the pipeline, monitor it", "wingman"};
+  CLI::App app{"Wingman tools: replay logs through the pipeline, monitor and inspect it", "wingman"};
   app.require_subcommand(1);
 
   ReplayOptions replay;
@@ -36,6 +38,19 @@ int main(int argc, char** argv) {
   s->add_option("--types-jar", spy.types_jar, "Jar with the wingman message classes (default: the built one)");
   s->add_flag("--dry-run", spy.dry_run, "Print the java command instead of running it");
 
+  MakeVideoOptions video;
+  auto* mv = app.add_subcommand("make-video", "Write a synthetic test clip (MJPG .avi) for the camera driver's file source");
+  mv->add_option("output", video.output, "Output .avi file")->required();
+  mv->add_option("--frames", video.frames, "Number of frames (default 90)");
+  mv->add_option("--width", video.width, "Width, pixels (default 640)");
+  mv->add_option("--height", video.height, "Height, pixels (default 480)");
+  mv->add_option("--fps", video.fps, "Frames per second (default 30)");
+
+  std::string info_log, info_snapshot;
+  auto* li = app.add_subcommand("loginfo", "Summarize an LCM log: channels, types, counts, time spans, process statuses");
+  li->add_option("log", info_log, "LCM log file")->required();
+  li->add_option("--snapshot", info_snapshot, "Save the last image_t as this PNG file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -56,6 +71,15 @@ int main(int argc, char** argv) {
       return summary.ok ? 0 : 1;
     }
     if (*s) return run_spy(spy);
+    if (*mv) {
+      make_video(video);
+      std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;
+    }
+    if (*li) {
+      const LogSummary summary = summarize_log(info_log, info_snapshot);
+      std::cout << summary.report() << std::flush;
+      if (!info_snapshot.empty() && summary.images_with_pixels > 0) std::cout << "last image saved to " << info_snapshot << std::endl;
+    }
   } catch (const std::exception& e) {
     std::cerr << "wingman: error: " << e.what() << std::endl;
     return 1;

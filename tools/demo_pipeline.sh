@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# The demo's pipeline run; call it through tools/netns_run.sh (it refuses to multicast on the host).
+# Usage: tools/demo_pipeline.sh VIDEO OUTDIR
+set -euo pipefail
+[ "${WINGMAN_IN_NETNS:-}" = "1" ] || { echo "demo_pipeline: run me through tools/netns_run.sh" >&2; exit 1; }
+video="$1"; out="$2"; bin=build/bin; url="$WINGMAN_LCM_URL"
+log="$out/demo.lcmlog"
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+trap cleanup EXIT
+
+echo "demo: LCM bus $url (private network namespace)"
+lcm-logger --lcm-url="$url" --force --quiet "$log" & pids+=($!)
+"$bin/wingman-detector" --lcm-url "$url" --log-level warn & pids+=($!)
+"$bin/wingman-localizer" --lcm-url "$url" --log-level warn & pids+=($!)
+"$bin/wingman-follower-ctrl" --lcm-url "$url" --log-level warn & pids+=($!)
+sleep 0.5   # let the subscribers join the group before the first frame
+
+cat > "$out/camera_driver.yaml" <<YAML
+# Demo: play the clip once at its own rate, stamped by the wall clock like a live camera.
+source: {kind: file}
+file: {path: "$video", mode: realtime, loop: false}
+YAML
+echo "demo: playing $video through wingman-camera-driver"
+"$bin/wingman-camera-driver" --config "$out/camera_driver.yaml" --lcm-url "$url" --status-period 0.5
+sleep 1.2   # one more heartbeat from every process
+cleanup
+pids=()
+trap - EXIT
+echo
+echo "demo: what arrived on the bus (recorded by lcm-logger in $log):"
+"$bin/wingman" loginfo "$log" --snapshot "$out/last_frame.png"

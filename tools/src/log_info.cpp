@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+// Summary of an LCM log: channels, types (by fingerprint), counts, utime spans, statuses, a snapshot.
+#include "wingman/tools/log_info.hpp"
+
+#include <wingman/common/message_validation.hpp>
+
+#include <fmt/format.h>
+#include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <functional>
+#include <stdexcept>
+
+namespace wingman::tools {
+namespace {
+
+uint64_t fingerprint(const void* data, int size) {
+  if (size < 8) return 0;
+  const auto* p = static_cast<const uint8_t*>(data);
+  uint64_t h = 0;
+  for (int i = 0; i < 8; ++i) h = (h << 8) | p[i];
+  return h;
+}
+
+/// Decodes and validates one message of a known type; returns its utime or -1.
+using Decoder = std::function<int64_t(const void*, int, std::string*)>;
+
+template <class Msg>
+std::pair<uint64_t, std::pair<std::string, Decoder>> entry() {
+  Decoder d = [](const void* data, int size, std::string* line) -> int64_t {
+    Msg m;
+    if (m.decode(data, 0, size) < 0) return -1;
+    if (!common::validate_message(m).empty()) return -1;
+    if constexpr (std::is_same_v<Msg, wingman::status_t>) {
+      static const char* kStates[] = {"STARTING", "OK", "DEGRADED", "ERROR", "STOPPING"};
+      *line = fmt::format("{} '{}', handled {}, drops {}, last seq {}, p50 {:.2f} ms{}",
+                          kStates[m.state], m.detail, m.messages_handled, m.drops_total, m.last_processed_seq, m.latency_p50_ms,
+                          m.last_error.empty() ? "" : ", last error: " + m.last_error);
+    }
+    return m.utime;
+  };
+  return {static_cast<uint64_t>(Msg::getHash()), {Msg::getTypeName(), d}};
+}
+
+cv::Mat to_bgr(const wingman::image_t& img) {
+  cv::Mat out;
+  switch (img.pixel_format) {
+    case wingman::image_t::MJPEG:
+      out = cv::imdecode(img.data, cv::IMREAD_COLOR);
+      break;
+    case wingman::image_t::GRAY8:
+      cv::cvtColor(cv::Mat(img.height, img.width, CV_8UC1, const_cast<uint8_t*>(img.data.data()), img.stride), out,
+                   cv::COLOR_GRAY2BGR);
+      break;
+    case wingman::image_t::BGR8:
+      out = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.stride).clone();
+      break;
+    case wingman::image_t::YUYV:
+      cv::cvtColor(cv::Mat(img.height, img.width, CV_8UC2, const_cast<uint8_t*>(img.data.data()), img.stride), out,
+                   cv::COLOR_YUV2BGR_YUYV);
+      break;
+    default:
+      break;
+  }
+  return out;
+}
+
+}  // namespace
+
+LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::runtime_error(fmt::format("{}: cannot open LCM log for reading", log_path));
+  const std::map<uint64_t, std::pair<std::string, Decoder>> types = {
+      entry<wingman::image_t>(),    entry<wingman::detections_t>(), entry<wingman::own_pose_t>(),
+      entry<wingman::targets_t>(),  entry<wingman::setpoint_t>(),   entry<wingman::status_t>(),
+      entry<wingman::ground_truth_t>()};
+  LogSummary summary;
+  std::map<std::string, size_t> index;
+  std::vector<uint8_t> last_image;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    auto [it, fresh] = index.emplace(ev->channel, summary.channels.size());
+    if (fresh) summary.channels.push_back(ChannelSummary{ev->channel, ev->channel == "LCM_SELF_TEST" ? "(LCM internal)" : "?"});
+    ChannelSummary& c = summary.channels[it->second];
+    ++c.count;
+    c.bytes += ev->datalen;
+    const uint64_t fp = fingerprint(ev->data, ev->datalen);
+    const auto t = types.find(fp);
+    if (t == types.end()) continue;
+    c.type = t->second.first;
+    std::string status_line;
+    const int64_t utime = t->second.second(ev->data, ev->datalen, &status_line);
+    if (utime < 0) {
+      ++c.undecodable;
+      continue;
+    }
+    if (c.first_utime == 0) c.first_utime = utime;
+    c.last_utime = utime;
+    if (!status_line.empty()) {
+      wingman::status_t s;
+      s.decode(ev->data, 0, ev->datalen);
+      summary.statuses[s.process] = status_line;
+    }
+    if (fp == static_cast<uint64_t>(wingman::image_t::getHash())) {
+      const auto* p = static_cast<const uint8_t*>(ev->data);
+      last_image.assign(p, p + ev->datalen);
+    }
+  }
+  if (!last_image.empty()) {
+    wingman::image_t img;
+    img.decode(last_image.data(), 0, static_cast<int>(last_image.size()));
+    const cv::Mat bgr = to_bgr(img);
+    if (!bgr.empty()) {
+      ++summary.images_with_pixels;
+      if (!snapshot_png.empty() && !cv::imwrite(snapshot_png, bgr))
+        throw std::runtime_error(fmt::format("{}: cannot write the snapshot", snapshot_png));
+    }
+  }
+  return summary;
+}
+
+std::string LogSummary::report() const {
+  std::string s = fmt::format("{:<20} {:<22} {:>7} {:>11} {:>9} {:>8}\n", "channel", "type", "count", "bytes",
+                              "span [s]", "bad");
+  for (const auto& c : channels) {
+    const double span = c.count > 1 && c.last_utime > c.first_utime ? (c.last_utime - c.first_utime) * 1e-6 : 0.0;
+    s += fmt::format("{:<20} {:<22} {:>7} {:>11} {:>9.2f} {:>8}\n", c.channel, c.type, c.count, c.bytes, span,
+                     c.undecodable);
+  }
+  if (!statuses.empty()) {
+    s += "last status of each process:\n";
+    for (const auto& [process, line] : statuses) s += fmt::format("  {:<16} {}\n", process, line);
+  }
+  return s;
+}
+
+}  // namespace wingman::tools
