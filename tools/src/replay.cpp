@@ -68,13 +68,6 @@ class BusObserver {
 /// Input counts of a stage at the start, so messages it handled before the replay do not count.
 using Baseline = std::map<std::string, std::map<std::string, int64_t>>;
 
-int64_t stage_input_count(const wingman::status_t& s, const std::string& channel) {
-  for (const auto& c : s.channels) {
-    if (c.direction == wingman::channel_stats_t::DIRECTION_IN && c.channel == channel) return c.count;
-  }
-  return 0;
-}
-
 /// "" when every stage has handled every message on its input channels, else what is missing.
 std::string unsettled(const BusObserver& bus, const std::vector<std::string>& stages, const Baseline& baseline) {
   for (const auto& name : stages) {
