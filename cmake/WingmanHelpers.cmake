@@ -6,11 +6,14 @@ function(wingman_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-unused-parameter)
 endfunction()
 
-# wingman_add_test(<name> SOURCES <files...> [LIBS <targets...>] [LABELS <labels...>] [TIMEOUT <s>] [NETNS])
+# wingman_add_test(<name> SOURCES <files...> [LIBS <targets...>] [LABEL <label>] [TIMEOUT <s>] [NETNS])
 # Builds one GoogleTest executable and registers each of its tests with CTest. NETNS runs each test
 # in its own private network namespace (tools/netns_run.sh), for tests that use LCM multicast.
 function(wingman_add_test name)
-  cmake_parse_arguments(ARG "NETNS" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "NETNS" "TIMEOUT;LABEL" "SOURCES;LIBS" ${ARGN})
+  if(NOT ARG_LABEL)
+    set(ARG_LABEL unit)
+  endif()
   add_executable(${name} ${ARG_SOURCES})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   if(ARG_NETNS)
@@ -23,7 +26,7 @@ function(wingman_add_test name)
   endif()
   gtest_discover_tests(${name}
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR}
-    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
+    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS ${ARG_LABEL}
                ENVIRONMENT "WINGMAN_BIN_DIR=${CMAKE_BINARY_DIR}/bin;WINGMAN_TEST_BIN_DIR=${CMAKE_BINARY_DIR}/tests;WINGMAN_SOURCE_DIR=${CMAKE_SOURCE_DIR};WINGMAN_BUILD_DIR=${CMAKE_BINARY_DIR};POCL_AFFINITY=1;OMP_WAIT_POLICY=PASSIVE"
     DISCOVERY_TIMEOUT 60)
 endfunction()

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// wingman-follower-ctrl: targets and own pose in, autopilot setpoints out (controllers arrive with the simulation issue).
+// wingman-follower-ctrl: targets and own pose in, autopilot setpoints out (controllers arrive with the simulation
+// issue).
 #include "wingman/follower_ctrl/follower_options.hpp"
 
 #include <wingman/common/runtime.hpp>

@@ -42,19 +42,18 @@ ConfigLoader ConfigLoader::from_string(const std::string& yaml_text, const std::
   try {
     root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}:{}:{}: not valid YAML: {}", source_name, e.mark.line + 1,
-                                  e.mark.column + 1, e.msg));
+    throw ConfigError(
+        fmt::format("{}:{}:{}: not valid YAML: {}", source_name, e.mark.line + 1, e.mark.column + 1, e.msg));
   }
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // an empty file means all defaults
   if (!root.IsMap()) {
-    throw ConfigError(fmt::format("{}: expected a mapping of sections at the top level, got {}",
-                                  source_name, scalar_text(root)));
+    throw ConfigError(
+        fmt::format("{}: expected a mapping of sections at the top level, got {}", source_name, scalar_text(root)));
   }
   return ConfigLoader(source_name, root);
 }
 
-ConfigLoader::ConfigLoader(std::string source_name, const YAML::Node& root)
-    : source_name_(std::move(source_name)) {
+ConfigLoader::ConfigLoader(std::string source_name, const YAML::Node& root) : source_name_(std::move(source_name)) {
   flatten(root, "");
 }
 

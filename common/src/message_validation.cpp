@@ -40,20 +40,29 @@ std::string check_quaternion(const char* type, const char* field, const double (
 
 int bytes_per_pixel(int8_t pixel_format) {
   switch (pixel_format) {
-    case wingman::image_t::GRAY8: return 1;
-    case wingman::image_t::BGR8: return 3;
-    case wingman::image_t::YUYV: return 2;
-    default: return 0;
+    case wingman::image_t::GRAY8:
+      return 1;
+    case wingman::image_t::BGR8:
+      return 3;
+    case wingman::image_t::YUYV:
+      return 2;
+    default:
+      return 0;
   }
 }
 
 std::string pixel_format_name(int8_t pixel_format) {
   switch (pixel_format) {
-    case wingman::image_t::GRAY8: return "GRAY8";
-    case wingman::image_t::BGR8: return "BGR8";
-    case wingman::image_t::YUYV: return "YUYV";
-    case wingman::image_t::MJPEG: return "MJPEG";
-    default: return fmt::format("unknown({})", pixel_format);
+    case wingman::image_t::GRAY8:
+      return "GRAY8";
+    case wingman::image_t::BGR8:
+      return "BGR8";
+    case wingman::image_t::YUYV:
+      return "YUYV";
+    case wingman::image_t::MJPEG:
+      return "MJPEG";
+    default:
+      return fmt::format("unknown({})", pixel_format);
   }
 }
 
@@ -67,7 +76,8 @@ std::string validate_message(const wingman::image_t& m, const ImageLimits& limit
     return fmt::format("image_t.size = {}: does not match {} data bytes", m.size, m.data.size());
   if (m.pixel_format == wingman::image_t::MJPEG) {
     if (m.size < 4) return fmt::format("image_t.size = {}: an MJPEG frame needs a JPEG stream", m.size);
-    if (m.data[0] != 0xFF || m.data[1] != 0xD8) return "image_t.data: MJPEG frame does not start with a JPEG SOI marker (FF D8)";
+    if (m.data[0] != 0xFF || m.data[1] != 0xD8)
+      return "image_t.data: MJPEG frame does not start with a JPEG SOI marker (FF D8)";
     return "";
   }
   const int bpp = bytes_per_pixel(m.pixel_format);
@@ -88,14 +98,17 @@ std::string validate_message(const wingman::image_t& m, const ImageLimits& limit
 std::string validate_message(const wingman::detections_t& m) {
   if (auto e = check_utime("detections_t", m.utime); !e.empty()) return e;
   if (m.image_width <= 0 || m.image_height <= 0)
-    return fmt::format("detections_t.image_width x image_height = {} x {}: must be positive", m.image_width, m.image_height);
+    return fmt::format("detections_t.image_width x image_height = {} x {}: must be positive", m.image_width,
+                       m.image_height);
   if (m.num_detections != static_cast<int32_t>(m.detections.size()) || m.num_detections < 0)
-    return fmt::format("detections_t.num_detections = {}: does not match {} detections", m.num_detections, m.detections.size());
+    return fmt::format("detections_t.num_detections = {}: does not match {} detections", m.num_detections,
+                       m.detections.size());
   for (size_t i = 0; i < m.detections.size(); ++i) {
     const auto& d = m.detections[i];
     if (!std::isfinite(d.cx) || !std::isfinite(d.cy) || !std::isfinite(d.w) || !std::isfinite(d.h))
       return fmt::format("detections_t.detections[{}]: cx, cy, w, h must be finite", i);
-    if (d.w <= 0 || d.h <= 0) return fmt::format("detections_t.detections[{}].w x h = {} x {}: must be positive", i, d.w, d.h);
+    if (d.w <= 0 || d.h <= 0)
+      return fmt::format("detections_t.detections[{}].w x h = {} x {}: must be positive", i, d.w, d.h);
     if (!(d.confidence >= 0 && d.confidence <= 1))
       return fmt::format("detections_t.detections[{}].confidence = {}: must be in [0, 1]", i, d.confidence);
   }
@@ -149,11 +162,13 @@ std::string validate_message(const wingman::ground_truth_t& m) {
   if (auto e = check_utime("ground_truth_t", m.utime); !e.empty()) return e;
   if (auto e = check_frame("ground_truth_t", m.frame); !e.empty()) return e;
   if (m.num_vehicles != static_cast<int32_t>(m.vehicles.size()) || m.num_vehicles < 0)
-    return fmt::format("ground_truth_t.num_vehicles = {}: does not match {} vehicles", m.num_vehicles, m.vehicles.size());
+    return fmt::format("ground_truth_t.num_vehicles = {}: does not match {} vehicles", m.num_vehicles,
+                       m.vehicles.size());
   if (m.num_boxes != static_cast<int32_t>(m.boxes.size()) || m.num_boxes < 0)
     return fmt::format("ground_truth_t.num_boxes = {}: does not match {} boxes", m.num_boxes, m.boxes.size());
   for (size_t i = 0; i < m.vehicles.size(); ++i) {
-    if (auto e = check_quaternion("ground_truth_t", "vehicles[].q_body_to_world", m.vehicles[i].q_body_to_world); !e.empty())
+    if (auto e = check_quaternion("ground_truth_t", "vehicles[].q_body_to_world", m.vehicles[i].q_body_to_world);
+        !e.empty())
       return e + fmt::format(" (vehicle index {})", i);
   }
   return "";

@@ -4,11 +4,11 @@
 
 #include "wingman/common/time.hpp"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -52,7 +52,8 @@ std::string RuntimeOptions::validate() const {
   static const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
   if (std::find(levels.begin(), levels.end(), log_level) == levels.end())
     return fmt::format("--log-level = '{}': must be one of trace, debug, info, warn, error", log_level);
-  if (is_file_url(lcm_out) && lcm_out.find("mode=w") == std::string::npos && lcm_out.find("mode=a") == std::string::npos)
+  if (is_file_url(lcm_out) && lcm_out.find("mode=w") == std::string::npos &&
+      lcm_out.find("mode=a") == std::string::npos)
     return fmt::format("--lcm-out = '{}': a file output needs '?mode=w' (or mode=a)", lcm_out);
   return "";
 }
@@ -159,14 +160,18 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
   const std::string prog = info.executable;
   RuntimeOptions ro;
   CLI::App app{info.description, prog};
-  app.add_option("--config", ro.config_path, "YAML configuration file (default: built-in defaults; see config/" +
-                                                 info.name + ".yaml)");
+  app.add_option("--config", ro.config_path,
+                 "YAML configuration file (default: built-in defaults; see config/" + info.name + ".yaml)");
   app.add_flag("--print-config", ro.print_config, "Print the effective configuration as YAML and exit");
   app.add_option("--lcm-url", ro.lcm_url, "LCM URL for input and output (default: LCM_DEFAULT_URL or LCM's default)");
-  app.add_option("--lcm-in", ro.lcm_in, "LCM URL to read from, e.g. file:///tmp/in.lcmlog?speed=0 (default: --lcm-url)");
-  app.add_option("--lcm-out", ro.lcm_out, "LCM URL to publish to, e.g. file:///tmp/out.lcmlog?mode=w (default: --lcm-url)");
-  app.add_option("--name", ro.instance, "Instance name in status messages and the status channel (default: " + info.name + ")");
-  app.add_flag("--lockstep", ro.lockstep, "Publish status after every handled message (for `wingman replay --lockstep`)");
+  app.add_option("--lcm-in", ro.lcm_in,
+                 "LCM URL to read from, e.g. file:///tmp/in.lcmlog?speed=0 (default: --lcm-url)");
+  app.add_option("--lcm-out", ro.lcm_out,
+                 "LCM URL to publish to, e.g. file:///tmp/out.lcmlog?mode=w (default: --lcm-url)");
+  app.add_option("--name", ro.instance,
+                 "Instance name in status messages and the status channel (default: " + info.name + ")");
+  app.add_flag("--lockstep", ro.lockstep,
+               "Publish status after every handled message (for `wingman replay --lockstep`)");
   app.add_option("--status-period", ro.status_period_s, "Heartbeat period, seconds (default 1)");
   app.add_option("--log-level", ro.log_level, "trace, debug, info, warn or error (default info)");
   try {

@@ -99,7 +99,7 @@ wingman::status_t StatusTracker::heartbeat(int64_t wall_utime, int64_t uptime_us
   std::sort(sorted.begin(), sorted.end());
   auto pct = [&](double p) -> float {
     if (sorted.empty()) return 0.0f;
-    const size_t i = static_cast<size_t>(std::ceil(p * static_cast<double>(sorted.size()))) ;
+    const size_t i = static_cast<size_t>(std::ceil(p * static_cast<double>(sorted.size())));
     return sorted[std::min(sorted.size() - 1, i == 0 ? 0 : i - 1)];
   };
   s.latency_p50_ms = pct(0.50);

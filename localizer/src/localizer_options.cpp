@@ -9,7 +9,8 @@ namespace wingman::localizer {
 std::vector<std::string> LocalizerOptions::validate() const {
   using common::problem;
   std::vector<std::string> p;
-  if (detections_channel.empty()) p.push_back(problem("input.detections_channel", detections_channel, "must not be empty"));
+  if (detections_channel.empty())
+    p.push_back(problem("input.detections_channel", detections_channel, "must not be empty"));
   if (own_pose_channel.empty()) p.push_back(problem("input.own_pose_channel", own_pose_channel, "must not be empty"));
   if (output_channel.empty()) p.push_back(problem("output.channel", output_channel, "must not be empty"));
   return p;

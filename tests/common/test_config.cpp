@@ -53,7 +53,8 @@ TEST(ConfigLoader, ReadsNestedKeysOfEveryType) {
 
 TEST(ConfigLoader, ReportsEveryBadKeyAtOnceWithFileAndLine) {
   try {
-    load_options_from_string<Demo>("camera:\n  width: -3\n  fps: fast\n  colour: red\nfile:\n  loop: maybe\n", "cam.yaml");
+    load_options_from_string<Demo>("camera:\n  width: -3\n  fps: fast\n  colour: red\nfile:\n  loop: maybe\n",
+                                   "cam.yaml");
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
     const std::string m = e.what();

@@ -15,16 +15,16 @@
 namespace {
 
 using namespace std::chrono_literals;
-using wingman::testing::Child;
-using wingman::testing::TempDir;
 using wingman::testing::bin_path;
+using wingman::testing::Child;
 using wingman::testing::run;
 using wingman::testing::source_path;
+using wingman::testing::TempDir;
 
 struct ProcessCase {
   std::string executable;
-  std::string config;    // config/<name>.yaml
-  std::string bad_key;   // a key that exists, to give a bad value
+  std::string config;   // config/<name>.yaml
+  std::string bad_key;  // a key that exists, to give a bad value
 };
 
 const std::vector<ProcessCase> kProcesses = {
@@ -54,7 +54,8 @@ TEST(ProcessConfig, ShippedConfigFileEqualsTheBuiltInDefaults) {
     SCOPED_TRACE(p.executable);
     const auto defaults = run({bin_path(p.executable), "--print-config"});
     ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
-    const auto from_file = run({bin_path(p.executable), "--print-config", "--config", source_path("config/" + p.config + ".yaml")});
+    const auto from_file =
+        run({bin_path(p.executable), "--print-config", "--config", source_path("config/" + p.config + ".yaml")});
     ASSERT_EQ(from_file.exit_code, 0) << from_file.err;
     // Same keys and values; only the header line (which names the source) differs.
     EXPECT_EQ(defaults.out.substr(defaults.out.find('\n')), from_file.out.substr(from_file.out.find('\n')));
@@ -121,7 +122,8 @@ TEST(ProcessSignals, SigtermAndSigintEndEveryProcessWithExitZeroWithinOneSecond)
       Child c(argv);
       // Running: it has logged that it started (bounded wait), and has not exited.
       const auto deadline = std::chrono::steady_clock::now() + 10s;
-      while (c.err().find("started") == std::string::npos && std::chrono::steady_clock::now() < deadline && c.running()) {
+      while (c.err().find("started") == std::string::npos && std::chrono::steady_clock::now() < deadline &&
+             c.running()) {
         std::this_thread::sleep_for(10ms);
       }
       ASSERT_TRUE(c.running()) << c.err();
@@ -174,7 +176,9 @@ TEST(ProcessFileIo, FileInputIsProcessedToItsEndWithExitZeroAndBadMessagesAreCou
 }
 
 TEST(ProcessFileIo, UnreadableInputLogIsAOneLineError) {
-  const auto r = run({bin_path("wingman-localizer"), "--lcm-in", "file:///nonexistent/in.lcmlog?speed=0", "--lcm-out", "memq://"}, 10s);
+  const auto r =
+      run({bin_path("wingman-localizer"), "--lcm-in", "file:///nonexistent/in.lcmlog?speed=0", "--lcm-out", "memq://"},
+          10s);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("wingman-localizer: error: cannot open LCM input log 'file:///nonexistent/in.lcmlog?speed=0'"),
             std::string::npos)

@@ -16,12 +16,12 @@
 namespace {
 
 using namespace std::chrono_literals;
-using wingman::testing::Child;
-using wingman::testing::TempDir;
 using wingman::testing::bin_path;
+using wingman::testing::Child;
 using wingman::testing::payloads_by_channel;
 using wingman::testing::read_log;
 using wingman::testing::run;
+using wingman::testing::TempDir;
 using wingman::testing::test_bin_path;
 
 constexpr int kFrames = 24;
@@ -35,7 +35,8 @@ std::string record_camera_log(const TempDir& dir, const std::string& name) {
   std::ofstream(cfg) << "source: {kind: file}\nfile: {path: " << video
                      << ", mode: fast, start_utime: 1700000000000000}\n";
   const std::string log = dir.file(name);
-  const auto r = run({bin_path("wingman-camera-driver"), "--config", cfg, "--lcm-url", "file://" + log + "?mode=w"}, 30s);
+  const auto r =
+      run({bin_path("wingman-camera-driver"), "--config", cfg, "--lcm-url", "file://" + log + "?mode=w"}, 30s);
   if (r.exit_code != 0) throw std::runtime_error("camera driver failed: " + r.err);
   return log;
 }
@@ -66,8 +67,8 @@ TEST(Replay, FileToFileChainThroughAStageIsDeterministic) {
   std::map<std::string, std::vector<std::vector<uint8_t>>> reference;
   for (int i = 0; i < kRuns; ++i) {
     const std::string out = dir.file("det" + std::to_string(i) + ".lcmlog");
-    const auto r = run({test_bin_path("wingman-test-blob-stage"), "--lcm-in", "file://" + images + "?speed=0", "--lcm-out",
-                        "file://" + out + "?mode=w"},
+    const auto r = run({test_bin_path("wingman-test-blob-stage"), "--lcm-in", "file://" + images + "?speed=0",
+                        "--lcm-out", "file://" + out + "?mode=w"},
                        30s);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto p = payloads_by_channel(read_log(out));
@@ -87,12 +88,15 @@ std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const s
   std::vector<std::unique_ptr<Child>> stages;
   stages.push_back(std::make_unique<Child>(
       std::vector<std::string>{test_bin_path("wingman-test-blob-stage"), "--lcm-url", url, "--lockstep"}));
-  stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-detector"), "--lcm-url", url, "--lockstep"}));
-  stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url, "--lockstep"}));
+  stages.push_back(
+      std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-detector"), "--lcm-url", url, "--lockstep"}));
+  stages.push_back(
+      std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url, "--lockstep"}));
   const std::string record = dir.file("record" + std::to_string(run_index) + ".lcmlog");
-  const auto r = run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for", "blob_stage,detector,localizer",
-                      "--record", record, "--start-timeout", "20", "--step-timeout", "10"},
-                     120s);
+  const auto r =
+      run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for", "blob_stage,detector,localizer",
+           "--record", record, "--start-timeout", "20", "--step-timeout", "10"},
+          120s);
   *replay_err = r.err;
   for (auto& s : stages) {
     s->signal(SIGTERM);
@@ -131,8 +135,8 @@ TEST(Replay, LockstepReplayThroughLiveProcessesGivesIdenticalPayloadsAcrossTenRu
 TEST(Replay, LockstepReportsAStageThatNeverStarted) {
   TempDir dir;
   const std::string images = record_camera_log(dir, "images.lcmlog");
-  const auto r = run({bin_path("wingman"), "replay", images, "--lcm-url", wingman::testing::netns_lcm_url(), "--wait-for",
-                      "nobody", "--start-timeout", "0.5"},
+  const auto r = run({bin_path("wingman"), "replay", images, "--lcm-url", wingman::testing::netns_lcm_url(),
+                      "--wait-for", "nobody", "--start-timeout", "0.5"},
                      20s);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no status from nobody within 0.5 s"), std::string::npos) << r.err;

@@ -21,7 +21,8 @@ struct BlobStageOptions {
   }
   std::vector<std::string> validate() const {
     std::vector<std::string> p;
-    if (threshold < 0 || threshold > 255) p.push_back(wingman::common::problem("blob.threshold", threshold, "must be in 0..255"));
+    if (threshold < 0 || threshold > 255)
+      p.push_back(wingman::common::problem("blob.threshold", threshold, "must be in 0..255"));
     return p;
   }
 };
@@ -39,10 +40,13 @@ int main(int argc, char** argv) {
                                  ": blob stage takes GRAY8 or BGR8");
       }
       const int type = img.pixel_format == image_t::GRAY8 ? CV_8UC1 : CV_8UC3;
-      const cv::Mat view(img.height, img.width, type, const_cast<uint8_t*>(img.data.data()), static_cast<size_t>(img.stride));
+      const cv::Mat view(img.height, img.width, type, const_cast<uint8_t*>(img.data.data()),
+                         static_cast<size_t>(img.stride));
       cv::Mat gray;
-      if (type == CV_8UC3) cv::cvtColor(view, gray, cv::COLOR_BGR2GRAY);
-      else gray = view;
+      if (type == CV_8UC3)
+        cv::cvtColor(view, gray, cv::COLOR_BGR2GRAY);
+      else
+        gray = view;
       cv::Mat mask;
       cv::threshold(gray, mask, o.threshold, 255, cv::THRESH_BINARY);
       detections_t out{};

@@ -3,8 +3,8 @@
 #include "wingman/common/message_validation.hpp"
 #include "wingman/common/time.hpp"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <wingman/channel_stats_t.hpp>
 #include <wingman/detections_t.hpp>
@@ -260,7 +260,8 @@ int run(const PublishSamplesOptions& options) {
 
   lcm::LCM lcm(options.lcm_url);
   if (!lcm.good()) {
-    throw std::runtime_error(fmt::format("cannot open LCM URL '{}'", options.lcm_url.empty() ? "(default)" : options.lcm_url));
+    throw std::runtime_error(
+        fmt::format("cannot open LCM URL '{}'", options.lcm_url.empty() ? "(default)" : options.lcm_url));
   }
   for (int round = 0; round < options.repeat; ++round) {
     if (round > 0 && options.period_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(options.period_ms));
@@ -278,7 +279,8 @@ int run(const PublishSamplesOptions& options) {
 
 int main(int argc, char** argv) {
   PublishSamplesOptions options;
-  CLI::App app{"Publish one valid sample of every Wingman message type on its pipeline channel", "wingman-publish-samples"};
+  CLI::App app{"Publish one valid sample of every Wingman message type on its pipeline channel",
+               "wingman-publish-samples"};
   app.add_option("--lcm-url", options.lcm_url, "LCM URL to publish on (default: LCM_DEFAULT_URL)");
   app.add_option("--log", options.log_path, "Write the samples to this LCM log instead of publishing");
   app.add_option("--repeat", options.repeat, "Rounds of samples (one message per channel each)");

@@ -40,13 +40,15 @@ std::string first_difference(const ChannelPayloads& expected, const ChannelPaylo
     const auto it = actual.find(channel);
     if (it == actual.end()) return "channel " + channel + " missing";
     if (it->second.size() != msgs.size())
-      return "channel " + channel + ": " + std::to_string(it->second.size()) + " messages, expected " + std::to_string(msgs.size());
+      return "channel " + channel + ": " + std::to_string(it->second.size()) + " messages, expected " +
+             std::to_string(msgs.size());
     for (size_t i = 0; i < msgs.size(); ++i) {
       if (it->second[i] != msgs[i]) return "channel " + channel + ": message " + std::to_string(i) + " differs";
     }
   }
   for (const auto& [channel, msgs] : actual) {
-    if (!expected.count(channel)) return "unexpected channel " + channel + " (" + std::to_string(msgs.size()) + " messages)";
+    if (!expected.count(channel))
+      return "unexpected channel " + channel + " (" + std::to_string(msgs.size()) + " messages)";
   }
   return "";
 }
@@ -182,7 +184,9 @@ std::map<std::string, std::vector<std::vector<uint8_t>>> payloads_by_channel(
 }  // namespace wingman::testing
 
 namespace wingman::testing {
-std::string test_bin_path(const std::string& name) { return env_or("WINGMAN_TEST_BIN_DIR", "build/tests") + "/" + name; }
+std::string test_bin_path(const std::string& name) {
+  return env_or("WINGMAN_TEST_BIN_DIR", "build/tests") + "/" + name;
+}
 
 std::string netns_lcm_url() {
   const char* in = std::getenv("WINGMAN_IN_NETNS");

@@ -25,8 +25,8 @@ using wingman::tools::spy_command;
 using wingman::tools::SpyOptions;
 
 /// The seven channels wingman-publish-samples writes, one per message type.
-const std::vector<std::string> kPipelineChannels = {
-    "IMAGE_CAM0", "DETECTIONS_CAM0", "OWN_POSE", "TARGETS", "SETPOINT", "STATUS_SAMPLE", "GROUND_TRUTH"};
+const std::vector<std::string> kPipelineChannels = {"IMAGE_CAM0", "DETECTIONS_CAM0", "OWN_POSE",    "TARGETS",
+                                                    "SETPOINT",   "STATUS_SAMPLE",   "GROUND_TRUTH"};
 
 /// Exit code and combined stdout+stderr of a shell command.
 struct CommandResult {
@@ -34,7 +34,8 @@ struct CommandResult {
   std::string output;
 };
 
-/// Runs one simple `command` (no pipes or lists) with /bin/sh, bounded by `timeout_s` seconds (coreutils timeout; 124 when it ran out).
+/// Runs one simple `command` (no pipes or lists) with /bin/sh, bounded by `timeout_s` seconds (coreutils timeout; 124
+/// when it ran out).
 CommandResult run_command(const std::string& command, int timeout_s = 60) {
   const std::string bounded = "timeout -k 5 " + std::to_string(timeout_s) + " " + command + " 2>&1";
   CommandResult result;
@@ -74,7 +75,8 @@ struct SpyJava {
 };
 
 SpyJava spy_java_from_dry_run() {
-  const CommandResult dry = run_command(bin_dir() + "/wingman spy --dry-run --lcm-url='udpm://239.255.76.67:7667?ttl=0'", 30);
+  const CommandResult dry =
+      run_command(bin_dir() + "/wingman spy --dry-run --lcm-url='udpm://239.255.76.67:7667?ttl=0'", 30);
   if (dry.exit_code != 0) throw std::runtime_error("wingman spy --dry-run failed: " + dry.output);
   const std::vector<std::string> words = split_words(dry.output);
   SpyJava spy;
@@ -172,9 +174,9 @@ TEST(SpyDecode, EveryPipelineChannelDecodesWithTheClasspathOfWingmanSpy) {
   const CommandResult check = run_decode_check(spy, log, kPipelineChannels);
   EXPECT_EQ(check.exit_code, 0) << "classpath " << spy.classpath << "\n" << check.output;
   const std::vector<std::pair<std::string, std::string>> expected_types = {
-      {"IMAGE_CAM0", "wingman.image_t"},       {"DETECTIONS_CAM0", "wingman.detections_t"},
-      {"OWN_POSE", "wingman.own_pose_t"},      {"TARGETS", "wingman.targets_t"},
-      {"SETPOINT", "wingman.setpoint_t"},      {"STATUS_SAMPLE", "wingman.status_t"},
+      {"IMAGE_CAM0", "wingman.image_t"},         {"DETECTIONS_CAM0", "wingman.detections_t"},
+      {"OWN_POSE", "wingman.own_pose_t"},        {"TARGETS", "wingman.targets_t"},
+      {"SETPOINT", "wingman.setpoint_t"},        {"STATUS_SAMPLE", "wingman.status_t"},
       {"GROUND_TRUTH", "wingman.ground_truth_t"}};
   for (const auto& [channel, type] : expected_types) {
     const std::vector<std::string> words = split_words(line_of(check.output, channel));

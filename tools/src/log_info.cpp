@@ -34,8 +34,8 @@ std::pair<uint64_t, std::pair<std::string, Decoder>> entry() {
     if (!common::validate_message(m).empty()) return -1;
     if constexpr (std::is_same_v<Msg, wingman::status_t>) {
       static const char* kStates[] = {"STARTING", "OK", "DEGRADED", "ERROR", "STOPPING"};
-      *line = fmt::format("{} '{}', handled {}, drops {}, last seq {}, p50 {:.2f} ms{}",
-                          kStates[m.state], m.detail, m.messages_handled, m.drops_total, m.last_processed_seq, m.latency_p50_ms,
+      *line = fmt::format("{} '{}', handled {}, drops {}, last seq {}, p50 {:.2f} ms{}", kStates[m.state], m.detail,
+                          m.messages_handled, m.drops_total, m.last_processed_seq, m.latency_p50_ms,
                           m.last_error.empty() ? "" : ", last error: " + m.last_error);
     }
     return m.utime;
@@ -72,15 +72,16 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error(fmt::format("{}: cannot open LCM log for reading", log_path));
   const std::map<uint64_t, std::pair<std::string, Decoder>> types = {
-      entry<wingman::image_t>(),    entry<wingman::detections_t>(), entry<wingman::own_pose_t>(),
-      entry<wingman::targets_t>(),  entry<wingman::setpoint_t>(),   entry<wingman::status_t>(),
+      entry<wingman::image_t>(),       entry<wingman::detections_t>(), entry<wingman::own_pose_t>(),
+      entry<wingman::targets_t>(),     entry<wingman::setpoint_t>(),   entry<wingman::status_t>(),
       entry<wingman::ground_truth_t>()};
   LogSummary summary;
   std::map<std::string, size_t> index;
   std::vector<uint8_t> last_image;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     auto [it, fresh] = index.emplace(ev->channel, summary.channels.size());
-    if (fresh) summary.channels.push_back(ChannelSummary{ev->channel, ev->channel == "LCM_SELF_TEST" ? "(LCM internal)" : "?"});
+    if (fresh)
+      summary.channels.push_back(ChannelSummary{ev->channel, ev->channel == "LCM_SELF_TEST" ? "(LCM internal)" : "?"});
     ChannelSummary& c = summary.channels[it->second];
     ++c.count;
     c.bytes += ev->datalen;
@@ -120,8 +121,8 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
 }
 
 std::string LogSummary::report() const {
-  std::string s = fmt::format("{:<20} {:<22} {:>7} {:>11} {:>9} {:>8}\n", "channel", "type", "count", "bytes",
-                              "span [s]", "bad");
+  std::string s =
+      fmt::format("{:<20} {:<22} {:>7} {:>11} {:>9} {:>8}\n", "channel", "type", "count", "bytes", "span [s]", "bad");
   for (const auto& c : channels) {
     const double span = c.count > 1 && c.last_utime > c.first_utime ? (c.last_utime - c.first_utime) * 1e-6 : 0.0;
     s += fmt::format("{:<20} {:<22} {:>7} {:>11} {:>9.2f} {:>8}\n", c.channel, c.type, c.count, c.bytes, span,

@@ -5,9 +5,9 @@
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/spy.hpp"
 
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include <iostream>
 
@@ -17,18 +17,21 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   ReplayOptions replay;
-  auto* r = app.add_subcommand("replay", "Play an LCM log into the pipeline; with --wait-for, in lockstep with the named processes");
+  auto* r = app.add_subcommand(
+      "replay", "Play an LCM log into the pipeline; with --wait-for, in lockstep with the named processes");
   r->add_option("log", replay.input_log, "Input LCM log file")->required();
   r->add_option("--lcm-url", replay.lcm_url, "LCM URL to publish on and listen to (default: LCM_DEFAULT_URL)");
   r->add_option("--wait-for", replay.stages,
                 "Process instance names (as in their status) to run in lockstep with; each must run with --lockstep")
       ->delimiter(',');
   r->add_option("--channels", replay.channels, "Regular expression of channels to play (default: all but STATUS_*)");
-  r->add_option("--exclude", replay.exclude, "Regular expression of channels not to play (e.g. the stages' own outputs)");
+  r->add_option("--exclude", replay.exclude,
+                "Regular expression of channels not to play (e.g. the stages' own outputs)");
   r->add_option("--record", replay.record_log, "Write every message seen on the bus (but status) to this LCM log");
   r->add_option("--speed", replay.speed, "Without --wait-for: playback speed (1 = real time, 0 = as fast as possible)");
   r->add_option("--start-timeout", replay.start_timeout_s, "Seconds to wait for every --wait-for process to report");
-  r->add_option("--step-timeout", replay.step_timeout_s, "Seconds to wait for the pipeline to settle after each message");
+  r->add_option("--step-timeout", replay.step_timeout_s,
+                "Seconds to wait for the pipeline to settle after each message");
   r->add_option("--max-events", replay.max_events, "Play at most this many events (0 = all)");
 
   SpyOptions spy;
@@ -39,7 +42,8 @@ int main(int argc, char** argv) {
   s->add_flag("--dry-run", spy.dry_run, "Print the java command instead of running it");
 
   MakeVideoOptions video;
-  auto* mv = app.add_subcommand("make-video", "Write a synthetic test clip (MJPG .avi) for the camera driver's file source");
+  auto* mv =
+      app.add_subcommand("make-video", "Write a synthetic test clip (MJPG .avi) for the camera driver's file source");
   mv->add_option("output", video.output, "Output .avi file")->required();
   mv->add_option("--frames", video.frames, "Number of frames (default 90)");
   mv->add_option("--width", video.width, "Width, pixels (default 640)");
@@ -47,7 +51,8 @@ int main(int argc, char** argv) {
   mv->add_option("--fps", video.fps, "Frames per second (default 30)");
 
   std::string info_log, info_snapshot;
-  auto* li = app.add_subcommand("loginfo", "Summarize an LCM log: channels, types, counts, time spans, process statuses");
+  auto* li =
+      app.add_subcommand("loginfo", "Summarize an LCM log: channels, types, counts, time spans, process statuses");
   li->add_option("log", info_log, "LCM log file")->required();
   li->add_option("--snapshot", info_snapshot, "Save the last image_t as this PNG file");
 
@@ -78,7 +83,8 @@ int main(int argc, char** argv) {
     if (*li) {
       const LogSummary summary = summarize_log(info_log, info_snapshot);
       std::cout << summary.report() << std::flush;
-      if (!info_snapshot.empty() && summary.images_with_pixels > 0) std::cout << "last image saved to " << info_snapshot << std::endl;
+      if (!info_snapshot.empty() && summary.images_with_pixels > 0)
+        std::cout << "last image saved to " << info_snapshot << std::endl;
     }
   } catch (const std::exception& e) {
     std::cerr << "wingman: error: " << e.what() << std::endl;

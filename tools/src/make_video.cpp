@@ -41,7 +41,8 @@ void make_video(const MakeVideoOptions& o) {
       const double a = M_PI / 4 + k * M_PI / 2;
       const cv::Point2d tip(c.x + arm * std::cos(a), c.y + 0.4 * arm * std::sin(a));
       cv::line(frame, c, tip, dark, std::max(1, o.width / 320), cv::LINE_AA);
-      cv::ellipse(frame, tip, cv::Size2d(0.5 * arm, 0.12 * arm), 0, 0, 360, cv::Scalar(90, 90, 90), cv::FILLED, cv::LINE_AA);
+      cv::ellipse(frame, tip, cv::Size2d(0.5 * arm, 0.12 * arm), 0, 0, 360, cv::Scalar(90, 90, 90), cv::FILLED,
+                  cv::LINE_AA);
     }
     cv::ellipse(frame, c, cv::Size2d(0.35 * arm, 0.2 * arm), 0, 0, 360, dark, cv::FILLED, cv::LINE_AA);
     cv::putText(frame, fmt::format("wingman synthetic clip  frame {}", i), cv::Point(8, o.height - 10),

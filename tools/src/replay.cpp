@@ -6,8 +6,8 @@
 #include <wingman/status_t.hpp>
 
 #include <fmt/format.h>
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
 #include <map>
@@ -55,8 +55,8 @@ class BusObserver {
     }
   }
 
-  std::map<std::string, int64_t> bus_counts_;            ///< messages seen per channel since start
-  std::map<std::string, wingman::status_t> statuses_;    ///< newest status per process instance
+  std::map<std::string, int64_t> bus_counts_;          ///< messages seen per channel since start
+  std::map<std::string, wingman::status_t> statuses_;  ///< newest status per process instance
   int64_t current_event_utime_ = 0;
   int64_t recorded_ = 0;
   int64_t bad_status_ = 0;
@@ -113,7 +113,8 @@ ReplaySummary run_replay(const ReplayOptions& options) {
   std::unique_ptr<lcm::LogFile> record;
   if (!options.record_log.empty()) {
     record = std::make_unique<lcm::LogFile>(options.record_log, "w");
-    if (!record->good()) throw std::runtime_error(fmt::format("{}: cannot open record log for writing", options.record_log));
+    if (!record->good())
+      throw std::runtime_error(fmt::format("{}: cannot open record log for writing", options.record_log));
   }
   lcm::LCM lcm(options.lcm_url);
   if (!lcm.good()) throw std::runtime_error(fmt::format("cannot open LCM URL '{}'", options.lcm_url));
@@ -151,8 +152,10 @@ ReplaySummary run_replay(const ReplayOptions& options) {
     }
     for (const auto& name : options.stages) {
       for (const auto& c : bus.statuses_.at(name).channels) {
-        if (c.direction == wingman::channel_stats_t::DIRECTION_IN) baseline[name][c.channel] = c.count;
-        else if (!is_status_channel(c.channel)) stage_outputs.insert(c.channel);
+        if (c.direction == wingman::channel_stats_t::DIRECTION_IN)
+          baseline[name][c.channel] = c.count;
+        else if (!is_status_channel(c.channel))
+          stage_outputs.insert(c.channel);
       }
     }
     // Messages a stage saw before the replay (heartbeats excluded) are not ours to wait for.
@@ -164,7 +167,8 @@ ReplaySummary run_replay(const ReplayOptions& options) {
   while (options.max_events == 0 || summary.events_played < options.max_events) {
     const lcm::LogEvent* ev = in.readNextEvent();
     if (ev == nullptr) break;
-    const bool play = !is_status_channel(ev->channel) && !is_lcm_internal(ev->channel) && !stage_outputs.count(ev->channel) &&
+    const bool play = !is_status_channel(ev->channel) && !is_lcm_internal(ev->channel) &&
+                      !stage_outputs.count(ev->channel) &&
                       (options.channels.empty() || std::regex_match(ev->channel, include_re)) &&
                       (options.exclude.empty() || !std::regex_match(ev->channel, exclude_re));
     if (!play) {
@@ -174,7 +178,8 @@ ReplaySummary run_replay(const ReplayOptions& options) {
     if (!lockstep && options.speed > 0) {
       if (first_timestamp < 0) first_timestamp = ev->timestamp;
       const double due_s = static_cast<double>(ev->timestamp - first_timestamp) * 1e-6 / options.speed;
-      std::this_thread::sleep_until(play_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due_s)));
+      std::this_thread::sleep_until(play_start +
+                                    std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due_s)));
     }
     bus.current_event_utime_ = ev->timestamp;
     const int64_t expected = bus.bus_counts_[ev->channel] + 1;
@@ -191,7 +196,8 @@ ReplaySummary run_replay(const ReplayOptions& options) {
     const auto deadline = Clock::now() + std::chrono::duration<double>(options.step_timeout_s);
     std::string why;
     for (;;) {
-      why = bus.bus_counts_[ev->channel] < expected ? "own message not seen on the bus" : unsettled(bus, options.stages, baseline);
+      why = bus.bus_counts_[ev->channel] < expected ? "own message not seen on the bus"
+                                                    : unsettled(bus, options.stages, baseline);
       if (why.empty()) break;
       if (Clock::now() > deadline) {
         summary.error = fmt::format("event {} (channel {}): not settled within {} s: {}", summary.events_played,

@@ -29,15 +29,15 @@ struct ProcessInfo {
 
 /// Options common to every process, from the command line (not the YAML file).
 struct RuntimeOptions {
-  std::string config_path;        ///< --config FILE; "" = built-in defaults
-  bool print_config = false;      ///< --print-config: print the effective config and exit 0
-  std::string lcm_url;            ///< --lcm-url; "" = LCM_DEFAULT_URL or LCM's default
-  std::string lcm_in;             ///< --lcm-in: URL to read from; "" = lcm_url
-  std::string lcm_out;            ///< --lcm-out: URL to publish to; "" = lcm_url
-  std::string instance;           ///< --name: instance name in status and its channel; "" = ProcessInfo::name
-  bool lockstep = false;          ///< --lockstep: publish status after every handled message (for `wingman replay`)
-  double status_period_s = 1.0;   ///< --status-period: heartbeat period, seconds (wall clock)
-  std::string log_level = "info"; ///< --log-level: trace, debug, info, warn, error
+  std::string config_path;         ///< --config FILE; "" = built-in defaults
+  bool print_config = false;       ///< --print-config: print the effective config and exit 0
+  std::string lcm_url;             ///< --lcm-url; "" = LCM_DEFAULT_URL or LCM's default
+  std::string lcm_in;              ///< --lcm-in: URL to read from; "" = lcm_url
+  std::string lcm_out;             ///< --lcm-out: URL to publish to; "" = lcm_url
+  std::string instance;            ///< --name: instance name in status and its channel; "" = ProcessInfo::name
+  bool lockstep = false;           ///< --lockstep: publish status after every handled message (for `wingman replay`)
+  double status_period_s = 1.0;    ///< --status-period: heartbeat period, seconds (wall clock)
+  std::string log_level = "info";  ///< --log-level: trace, debug, info, warn, error
 
   /// "" or one line naming the bad option.
   std::string validate() const;
@@ -194,7 +194,8 @@ int run_process(const ProcessInfo& info, int argc, char** argv,
                 const std::function<int(Runtime&, const Options&)>& body) {
   Options options;
   auto load = [&](const std::string& path, bool print) -> std::string {
-    if (!path.empty()) options = load_options<Options>(path);
+    if (!path.empty())
+      options = load_options<Options>(path);
     else {
       const auto problems = options.validate();
       if (!problems.empty()) throw ConfigError("built-in defaults invalid: " + problems.front());

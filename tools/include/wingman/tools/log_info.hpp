@@ -12,20 +12,20 @@ namespace wingman::tools {
 /// Per-channel summary of a log.
 struct ChannelSummary {
   std::string channel;
-  std::string type;          ///< wingman message type found by fingerprint, or "?" if unknown
-  int64_t count = 0;         ///< events
-  int64_t undecodable = 0;   ///< events of a known type that failed to decode or validate
-  int64_t bytes = 0;         ///< payload bytes
-  int64_t first_utime = 0;   ///< utime field of the first decoded message (0 if none)
-  int64_t last_utime = 0;    ///< utime field of the last decoded message
+  std::string type;         ///< wingman message type found by fingerprint, or "?" if unknown
+  int64_t count = 0;        ///< events
+  int64_t undecodable = 0;  ///< events of a known type that failed to decode or validate
+  int64_t bytes = 0;        ///< payload bytes
+  int64_t first_utime = 0;  ///< utime field of the first decoded message (0 if none)
+  int64_t last_utime = 0;   ///< utime field of the last decoded message
 };
 
 /// What `loginfo` found.
 struct LogSummary {
-  std::vector<ChannelSummary> channels;          ///< in order of first appearance
-  std::map<std::string, std::string> statuses;   ///< process -> one line from its last status_t
-  int64_t images_with_pixels = 0;                ///< image_t messages that could be turned into a picture
-  std::string report() const;                    ///< a table for people
+  std::vector<ChannelSummary> channels;         ///< in order of first appearance
+  std::map<std::string, std::string> statuses;  ///< process -> one line from its last status_t
+  int64_t images_with_pixels = 0;               ///< image_t messages that could be turned into a picture
+  std::string report() const;                   ///< a table for people
 };
 
 /// Reads `log_path` (throws std::runtime_error naming it when unreadable). When `snapshot_png` is

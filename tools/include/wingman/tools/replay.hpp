@@ -28,11 +28,11 @@ struct ReplayOptions {
 /// What a replay did.
 struct ReplaySummary {
   bool ok = false;
-  int64_t events_played = 0;     ///< messages published from the log
-  int64_t events_skipped = 0;    ///< log events not played (status, filtered, or stage outputs)
-  int64_t messages_recorded = 0; ///< messages written to the record log
-  double wall_s = 0.0;           ///< wall-clock duration
-  std::string error;             ///< why it failed, "" when ok
+  int64_t events_played = 0;      ///< messages published from the log
+  int64_t events_skipped = 0;     ///< log events not played (status, filtered, or stage outputs)
+  int64_t messages_recorded = 0;  ///< messages written to the record log
+  double wall_s = 0.0;            ///< wall-clock duration
+  std::string error;              ///< why it failed, "" when ok
 
   std::string one_line() const;
 };
