@@ -52,6 +52,9 @@ std::string RuntimeOptions::validate() const {
   static const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
   if (std::find(levels.begin(), levels.end(), log_level) == levels.end())
     return fmt::format("--log-level = '{}': must be one of trace, debug, info, warn, error", log_level);
+  if (is_file_url(lcm_url) && lcm_url.find("mode=") != std::string::npos && lcm_url.find("mode=r") == std::string::npos)
+    return fmt::format("--lcm-url = '{}': a log opened for writing cannot also be the input; use --lcm-out for it",
+                       lcm_url);
   if (is_file_url(lcm_out) && lcm_out.find("mode=w") == std::string::npos &&
       lcm_out.find("mode=a") == std::string::npos)
     return fmt::format("--lcm-out = '{}': a file output needs '?mode=w' (or mode=a)", lcm_out);
@@ -74,8 +77,11 @@ Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
   const std::string in_url = options_.lcm_in.empty() ? options_.lcm_url : options_.lcm_in;
   const std::string out_url = options_.lcm_out.empty() ? options_.lcm_url : options_.lcm_out;
   input_is_file_ = is_file_url(in_url);
-  lcm_in_ = open_lcm(in_url, input_is_file_ ? "input log" : "input");
+  in_url_ = in_url;
+  // The output opens now; the input only when the process subscribes or spins, so a pure source
+  // (the camera driver writing to a file) never opens a multicast socket it does not need.
   if (out_url == in_url && !input_is_file_) {
+    lcm_in_ = open_lcm(in_url, "bus");
     lcm_out_ = lcm_in_.get();
   } else {
     lcm_out_owned_ = open_lcm(out_url, "output");
@@ -125,17 +131,23 @@ void Runtime::after_message() {
   if (options_.lockstep) publish_heartbeat();
 }
 
+lcm::LCM& Runtime::input() {
+  if (!lcm_in_) lcm_in_ = open_lcm(in_url_, input_is_file_ ? "input log" : "input");
+  return *lcm_in_;
+}
+
 bool Runtime::spin_once(int timeout_ms) {
   if (stop_requested() || end_of_input_) return false;
+  lcm::LCM& in = input();
   if (status_.state() == wingman::status_t::STATE_STARTING) status_.set_state(wingman::status_t::STATE_OK, "");
   if (input_is_file_) {
     // A log read with speed=0 delivers its next event on every handle(); -1 means the end of the file.
-    if (lcm_in_->handle() != 0) {
+    if (in.handle() != 0) {
       end_of_input_ = true;
       stop_reason_ = "end of input log";
     }
   } else {
-    const int rc = lcm_in_->handleTimeout(timeout_ms);
+    const int rc = in.handleTimeout(timeout_ms);
     if (rc < 0 && !stop_requested()) {
       throw std::runtime_error("LCM input failed while waiting for messages");
     }
@@ -147,8 +159,14 @@ bool Runtime::spin_once(int timeout_ms) {
 int Runtime::spin() {
   while (spin_once(100)) {
   }
+  return shutdown();
+}
+
+int Runtime::shutdown(const std::string& reason) {
+  if (!reason.empty()) stop_reason_ = reason;
   if (stop_reason_.empty() && g_signal.load() != 0) stop_reason_ = fmt::format("signal {}", g_signal.load());
-  spdlog::info("stopping: {}", stop_reason_.empty() ? "requested" : stop_reason_);
+  if (stop_reason_.empty()) stop_reason_ = "requested";
+  spdlog::info("stopping: {}", stop_reason_);
   status_.set_state(wingman::status_t::STATE_STOPPING, stop_reason_);
   publish_heartbeat();
   return 0;

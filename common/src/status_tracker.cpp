@@ -6,6 +6,12 @@
 #include <cmath>
 
 namespace wingman::common {
+namespace {
+// Copies of lcm-gen's in-class constants, which have no out-of-class definition: binding those to a
+// reference (std::pair, std::map::find) fails to link in unoptimised builds.
+constexpr int8_t kIn = wingman::channel_stats_t::DIRECTION_IN;
+constexpr int8_t kOut = wingman::channel_stats_t::DIRECTION_OUT;
+}  // namespace
 
 StatusTracker::StatusTracker(std::string process, int32_t pid, size_t latency_window)
     : process_(std::move(process)),
@@ -24,11 +30,11 @@ StatusTracker::Channel& StatusTracker::channel(const std::string& name, int8_t d
   return it->second;
 }
 
-void StatusTracker::declare_input(const std::string& ch) { channel(ch, wingman::channel_stats_t::DIRECTION_IN); }
-void StatusTracker::declare_output(const std::string& ch) { channel(ch, wingman::channel_stats_t::DIRECTION_OUT); }
+void StatusTracker::declare_input(const std::string& ch) { channel(ch, kIn); }
+void StatusTracker::declare_output(const std::string& ch) { channel(ch, kOut); }
 
 void StatusTracker::input(const std::string& ch, int64_t utime) {
-  Channel& c = channel(ch, wingman::channel_stats_t::DIRECTION_IN);
+  Channel& c = channel(ch, kIn);
   ++c.count;
   ++c.window_count;
   c.last_utime = utime;
@@ -37,7 +43,7 @@ void StatusTracker::input(const std::string& ch, int64_t utime) {
 }
 
 void StatusTracker::input_dropped(const std::string& ch, const std::string& reason) {
-  Channel& c = channel(ch, wingman::channel_stats_t::DIRECTION_IN);
+  Channel& c = channel(ch, kIn);
   ++c.count;
   ++c.window_count;
   ++c.drops;
@@ -47,14 +53,14 @@ void StatusTracker::input_dropped(const std::string& ch, const std::string& reas
 }
 
 void StatusTracker::output(const std::string& ch, int64_t utime) {
-  Channel& c = channel(ch, wingman::channel_stats_t::DIRECTION_OUT);
+  Channel& c = channel(ch, kOut);
   ++c.count;
   ++c.window_count;
   c.last_utime = utime;
 }
 
 void StatusTracker::source_dropped(const std::string& ch, int64_t count, const std::string& reason) {
-  Channel& c = channel(ch, wingman::channel_stats_t::DIRECTION_OUT);
+  Channel& c = channel(ch, kOut);
   c.drops += count;
   drops_total_ += count;
   last_error_ = reason;
@@ -71,15 +77,15 @@ void StatusTracker::set_state(int8_t state, const std::string& detail) {
 }
 
 int64_t StatusTracker::input_count(const std::string& ch) const {
-  auto it = channels_.find({ch, wingman::channel_stats_t::DIRECTION_IN});
+  auto it = channels_.find({ch, kIn});
   return it == channels_.end() ? 0 : it->second.count;
 }
 int64_t StatusTracker::input_drops(const std::string& ch) const {
-  auto it = channels_.find({ch, wingman::channel_stats_t::DIRECTION_IN});
+  auto it = channels_.find({ch, kIn});
   return it == channels_.end() ? 0 : it->second.drops;
 }
 int64_t StatusTracker::output_count(const std::string& ch) const {
-  auto it = channels_.find({ch, wingman::channel_stats_t::DIRECTION_OUT});
+  auto it = channels_.find({ch, kOut});
   return it == channels_.end() ? 0 : it->second.count;
 }
 

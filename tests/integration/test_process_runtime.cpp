@@ -106,6 +106,9 @@ TEST(ProcessConfig, MissingConfigFileAndBadOptionAreOneLineErrors) {
   const auto r2 = run({bin_path("wingman-localizer"), "--lcm-out", "file:///tmp/x.lcmlog"}, 10s);
   EXPECT_EQ(r2.exit_code, 2);
   EXPECT_NE(r2.err.find("--lcm-out"), std::string::npos) << r2.err;
+  const auto r3 = run({bin_path("wingman-detector"), "--lcm-url", "file:///tmp/x.lcmlog?mode=w"}, 10s);
+  EXPECT_EQ(r3.exit_code, 2);
+  EXPECT_NE(r3.err.find("use --lcm-out"), std::string::npos) << r3.err;
 }
 
 TEST(ProcessSignals, SigtermAndSigintEndEveryProcessWithExitZeroWithinOneSecond) {

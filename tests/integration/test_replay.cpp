@@ -36,7 +36,7 @@ std::string record_camera_log(const TempDir& dir, const std::string& name) {
                      << ", mode: fast, start_utime: 1700000000000000}\n";
   const std::string log = dir.file(name);
   const auto r =
-      run({bin_path("wingman-camera-driver"), "--config", cfg, "--lcm-url", "file://" + log + "?mode=w"}, 30s);
+      run({bin_path("wingman-camera-driver"), "--config", cfg, "--lcm-out", "file://" + log + "?mode=w"}, 30s);
   if (r.exit_code != 0) throw std::runtime_error("camera driver failed: " + r.err);
   return log;
 }

@@ -77,8 +77,11 @@ class Runtime {
   /// Handles incoming messages for up to `timeout_ms` and publishes the heartbeat when due.
   /// Returns false when the process should end: SIGINT/SIGTERM, request_stop(), or end of a file input.
   bool spin_once(int timeout_ms = 100);
-  /// spin_once() until it returns false; then publishes a final STOPPING heartbeat. Returns 0.
+  /// spin_once() until it returns false, then shutdown(). Returns 0.
   int spin();
+  /// Sets the state to STOPPING with `reason` (default: the signal or end of input) and publishes a
+  /// final heartbeat. Processes with their own loop (sources) call it before returning. Returns 0.
+  int shutdown(const std::string& reason = "");
   /// Publishes the heartbeat now when it is due (sources call this from their own loop).
   void heartbeat_if_due();
   /// Publishes a heartbeat now.
@@ -100,12 +103,15 @@ class Runtime {
     return [](const Msg& m) { return validate_message(m); };
   }
   void after_message();
+  /// The input LCM instance, opened on first use (throws naming the URL if it cannot be opened).
+  lcm::LCM& input();
   void publish_raw(const std::string& channel, const void* data, size_t size);
 
   ProcessInfo info_;
   RuntimeOptions options_;
   std::string instance_;
   std::string status_channel_;
+  std::string in_url_;
   std::unique_ptr<lcm::LCM> lcm_in_;
   std::unique_ptr<lcm::LCM> lcm_out_owned_;
   lcm::LCM* lcm_out_ = nullptr;
@@ -128,7 +134,13 @@ class Runtime::Subscription : public Runtime::SubscriptionBase {
 
   void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
     Msg msg;
-    if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0) {
+    int decoded = -1;
+    try {
+      decoded = msg.decode(rbuf->data, 0, rbuf->data_size);
+    } catch (const std::exception&) {  // e.g. a negative array length makes the generated code throw
+      decoded = -1;
+    }
+    if (decoded < 0) {
       rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + std::to_string(rbuf->data_size) +
                                                " bytes do not decode as " + Msg::getTypeName() +
                                                " (wrong type or truncated)");
@@ -165,7 +177,7 @@ void Runtime::subscribe(const std::string& channel, std::function<void(const Msg
                         std::function<std::string(const Msg&)> validate) {
   auto sub = std::make_unique<Subscription<Msg>>(this, channel, std::move(handler), std::move(validate));
   // LCM treats the channel as a regular expression; anchor it so "IMAGE" does not match "IMAGE_2".
-  lcm_in_->subscribe("^" + channel + "$", &Subscription<Msg>::on_message, sub.get());
+  input().subscribe("^" + channel + "$", &Subscription<Msg>::on_message, sub.get());
   status_.declare_input(channel);
   subscriptions_.push_back(std::move(sub));
 }

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+// Configuration of wingman-camera-driver: which source, how to capture or play it, where to publish.
+#pragma once
+
+#include "wingman/camera_driver/file_source.hpp"
+#include "wingman/camera_driver/v4l2_source.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace wingman::camera_driver {
+
+/// What CameraDriver publishes.
+struct OutputOptions {
+  /// LCM channel of the image_t messages.
+  std::string channel = "IMAGE_CAM0";
+  /// image_t.camera_id: which camera on the vehicle (0..n-1).
+  int camera_id = 0;
+  /// true: decode MJPEG frames and publish BGR8; false: publish the JPEG stream undecoded (MJPEG).
+  bool decode_mjpeg = false;
+  /// Stop after publishing this many frames (exit 0); 0 = no limit.
+  int64_t max_frames = 0;
+
+  /// One line per problem naming the key; empty when valid.
+  std::vector<std::string> validate() const;
+};
+
+/// Everything config/camera_driver.yaml holds (one key per field; see visit()).
+struct CameraDriverOptions {
+  /// Frame source: v4l2 (a camera) or file (a video file or an image folder).
+  std::string source_kind = "v4l2";
+  /// V4L2 capture settings (section v4l2), used when source_kind is v4l2.
+  V4l2SourceOptions v4l2;
+  /// File playback settings (section file), used when source_kind is file.
+  FileSourceOptions file;
+  /// Publishing settings (section output).
+  OutputOptions output;
+
+  template <class V>
+  void visit(V& v) {
+    v("source.kind", source_kind, "frame source: v4l2 (a camera) or file (a video file or an image folder)");
+    v("v4l2.device", v4l2.device, "device node, e.g. /dev/video0 or a stable /dev/v4l/by-id/... link");
+    v("v4l2.pixel_format", v4l2.pixel_format, "pixel format to request: YUYV or MJPEG");
+    v("v4l2.width", v4l2.width, "requested width, pixels (the driver may round it; the rounded size is used)");
+    v("v4l2.height", v4l2.height, "requested height, pixels (the driver may round it; the rounded size is used)");
+    v("v4l2.fps", v4l2.fps, "requested frame rate, frames per second; 0 = keep the driver's rate");
+    v("v4l2.buffers", v4l2.buffers, "number of mmap capture buffers to request, 2..32");
+    v("v4l2.reconnect_initial_s", v4l2.reconnect_initial_s,
+      "first wait before reopening an unplugged camera, seconds; doubles after each failed attempt");
+    v("v4l2.reconnect_max_s", v4l2.reconnect_max_s, "longest wait between reopening attempts, seconds");
+    v("v4l2.stall_timeout_s", v4l2.stall_timeout_s,
+      "no frame for this long while streaming counts as an unplug (reopen), seconds; 0 = never");
+    v("file.path", file.path, "video file, image folder (played in name order) or single image; required for file");
+    v("file.mode", file.mode,
+      "realtime (paced at fps, utime = wall clock) or fast (no waiting, utime = start_utime + i / fps)");
+    v("file.fps", file.fps, "playback rate, frames per second; 0 = the video's own rate (30 for images)");
+    v("file.loop", file.loop, "start again at the end (seq and utime keep increasing); false = exit at the end");
+    v("file.start_utime", file.start_utime,
+      "fast mode: utime of the first frame, microseconds since the epoch; 0 = wall clock at start");
+    v("file.pixel_format", file.pixel_format, "published layout for files: BGR8 or GRAY8");
+    v("output.channel", output.channel, "LCM channel of the image_t messages");
+    v("output.camera_id", output.camera_id, "image_t.camera_id: which camera on the vehicle (0..n-1)");
+    v("output.decode_mjpeg", output.decode_mjpeg,
+      "decode MJPEG frames and publish BGR8 (true) or publish them undecoded (false)");
+    v("output.max_frames", output.max_frames, "exit 0 after publishing this many frames; 0 = no limit");
+  }
+
+  /// Every problem, each naming its key; empty when valid. Both source sections are checked (so a
+  /// typo shows before the source is switched), but file.path is required only for source.kind file.
+  std::vector<std::string> validate() const;
+};
+
+}  // namespace wingman::camera_driver

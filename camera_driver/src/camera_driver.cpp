@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: MIT
+// CameraDriver: frame checks, MJPEG decoding, image_t conversion and the source factory.
+#include "wingman/camera_driver/camera_driver.hpp"
+
+#include "wingman/camera_driver/file_source.hpp"
+#include "wingman/camera_driver/v4l2_source.hpp"
+
+#include <fmt/format.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+
+namespace wingman::camera_driver {
+
+namespace {
+wingman::image_t header_of(const Frame& frame, int32_t camera_id) {
+  wingman::image_t msg;
+  msg.utime = frame.utime;
+  msg.seq = frame.seq;
+  msg.camera_id = camera_id;
+  msg.width = frame.width;
+  msg.height = frame.height;
+  msg.stride = frame.format == PixelFormat::kMjpeg ? 0 : frame.stride;
+  msg.pixel_format = static_cast<int8_t>(frame.format);
+  msg.size = static_cast<int32_t>(frame.data.size());
+  return msg;
+}
+}  // namespace
+
+wingman::image_t to_image_message(const Frame& frame, int32_t camera_id) {
+  wingman::image_t msg = header_of(frame, camera_id);
+  msg.data = frame.data;
+  return msg;
+}
+
+wingman::image_t to_image_message(Frame&& frame, int32_t camera_id) {
+  wingman::image_t msg = header_of(frame, camera_id);
+  msg.data = std::move(frame.data);
+  frame.data.clear();
+  return msg;
+}
+
+std::string decode_mjpeg(const Frame& jpeg, Frame& bgr) {
+  const cv::Mat buf(1, static_cast<int>(jpeg.data.size()), CV_8UC1, const_cast<uint8_t*>(jpeg.data.data()));
+  cv::Mat img;
+  try {
+    img = cv::imdecode(buf, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {
+    img.release();
+  }
+  if (img.empty())
+    return fmt::format("frame seq {}: MJPEG stream ({} bytes) does not decode", jpeg.seq, jpeg.data.size());
+  if (img.cols != jpeg.width || img.rows != jpeg.height) {
+    return fmt::format("frame seq {}: MJPEG decodes to {}x{}, the device said {}x{}", jpeg.seq, img.cols, img.rows,
+                       jpeg.width, jpeg.height);
+  }
+  bgr.utime = jpeg.utime;
+  bgr.seq = jpeg.seq;
+  bgr.width = img.cols;
+  bgr.height = img.rows;
+  bgr.format = PixelFormat::kBgr8;
+  bgr.stride = img.cols * 3;
+  bgr.data.resize(static_cast<size_t>(bgr.stride) * static_cast<size_t>(bgr.height));
+  for (int r = 0; r < img.rows; ++r) {
+    std::memcpy(bgr.data.data() + static_cast<size_t>(r) * bgr.stride, img.ptr(r), static_cast<size_t>(bgr.stride));
+  }
+  return "";
+}
+
+std::unique_ptr<FrameSource> make_source(const CameraDriverOptions& options, std::shared_ptr<V4l2Io> io,
+                                         std::shared_ptr<Clock> clock) {
+  const auto problems = options.validate();
+  if (!problems.empty()) throw std::invalid_argument(problems.front());
+  if (options.source_kind == "file") return std::make_unique<FileSource>(options.file, std::move(clock));
+  return std::make_unique<V4l2Source>(options.v4l2, std::move(io), std::move(clock));
+}
+
+CameraDriver::CameraDriver(OutputOptions options, std::unique_ptr<FrameSource> source)
+    : options_(std::move(options)), source_(std::move(source)) {
+  if (!source_) throw std::invalid_argument("CameraDriver: source must not be null");
+}
+
+void CameraDriver::open() { source_->open(); }
+
+bool CameraDriver::done() const { return ended_ || (options_.max_frames > 0 && frames_out_ >= options_.max_frames); }
+
+DriverStep CameraDriver::step(int timeout_ms) {
+  DriverStep step;
+  const ReadResult r = source_->read(frame_, timeout_ms);
+  step.status = r.status;
+  step.lost = r.lost;
+  step.reason = r.reason;
+  step.reconnected = r.reconnected;
+  if (r.status == ReadStatus::kEnd) ended_ = true;
+  if (r.status != ReadStatus::kFrame) return step;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  auto drop = [&](const std::string& why) {
+    ++driver_drops_;
+    step.status = ReadStatus::kDropped;
+    step.lost += 1;
+    step.reason = step.reason.empty() ? why : step.reason + "; " + why;
+    return step;
+  };
+  if (std::string bad = check_frame(frame_); !bad.empty()) return drop(source_->describe() + ": " + bad);
+  Frame* out = &frame_;
+  if (options_.decode_mjpeg && frame_.format == PixelFormat::kMjpeg) {
+    if (std::string bad = decode_mjpeg(frame_, decoded_); !bad.empty()) return drop(source_->describe() + ": " + bad);
+    out = &decoded_;
+  }
+  step.image = to_image_message(std::move(*out), options_.camera_id);  // the next read refills the frame
+  ++frames_out_;
+  step.convert_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return step;
+}
+
+}  // namespace wingman::camera_driver

@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: MIT
+// Validation of the camera driver's options.
+#include "wingman/camera_driver/camera_driver_options.hpp"
+
+#include <wingman/common/config.hpp>
+
+#include <cctype>
+
+namespace wingman::camera_driver {
+
+std::vector<std::string> OutputOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  bool channel_ok = !channel.empty();
+  for (unsigned char c : channel) channel_ok = channel_ok && std::isgraph(c);
+  if (!channel_ok) p.push_back(problem("output.channel", channel, "must be a non-empty name without spaces"));
+  if (camera_id < 0 || camera_id > 255) p.push_back(problem("output.camera_id", camera_id, "must be in [0, 255]"));
+  if (max_frames < 0) {
+    p.push_back(problem("output.max_frames", static_cast<double>(max_frames), "must be >= 0 (0 = no limit)"));
+  }
+  return p;
+}
+
+std::vector<std::string> CameraDriverOptions::validate() const {
+  std::vector<std::string> p;
+  if (source_kind != "v4l2" && source_kind != "file") {
+    p.push_back(common::problem("source.kind", source_kind, "must be v4l2 or file"));
+  }
+  for (auto& s : v4l2.validate()) p.push_back(std::move(s));
+  for (auto& s : file.validate(source_kind == "file")) p.push_back(std::move(s));
+  for (auto& s : output.validate()) p.push_back(std::move(s));
+  return p;
+}
+
+}  // namespace wingman::camera_driver
