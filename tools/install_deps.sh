@@ -7,7 +7,7 @@ set -euo pipefail
 # One list, grouped by what needs it. Later components append here.
 packages=(
   # build
-  build-essential cmake pkg-config ninja-build
+  build-essential cmake pkg-config ninja-build clang-format
   # LCM (C/C++ library, lcm-gen and tools, Java classes for lcm-spy and the tcpq hub)
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java libglib2.0-dev default-jdk-headless
   # vision, maths, OpenCL (PoCL on the CPU), V4L2
