@@ -153,7 +153,9 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   diag3(t.position_covariance, 0.25);
   diag3(t.velocity_covariance, 0.04);
   t.range = std::sqrt(1.5 * 1.5 + 0.5 * 0.5 + 12.0 * 12.0);
+  t.world_valid = true;
   t.confidence = 0.9f;
+  t.age_s = 4.5f;
   t.source_utime = utime;
   t.predicted_utime = utime + 20000;
   targets.targets.push_back(t);

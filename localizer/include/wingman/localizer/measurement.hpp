@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// The data that flows inside the localizer: a box, its camera-frame localization, and its world-frame form.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace wingman::localizer {
+
+/// A detected box in pixels of the source (distorted) image; (0, 0) is the top-left corner of the
+/// top-left pixel, as in detections_t.
+struct PixelBox {
+  double cx = 0;  ///< centre x, pixels
+  double cy = 0;  ///< centre y, pixels
+  double w = 0;   ///< width, pixels
+  double h = 0;   ///< height, pixels
+};
+
+/// One detection localized in the camera optical frame (x right, y down, z forward).
+struct CameraMeasurement {
+  Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();     ///< target centre, metres
+  Eigen::Matrix3d cov_p_in_cam = Eigen::Matrix3d::Identity();    ///< covariance of p_target_in_cam, m^2
+  Eigen::Vector3d bearing_in_cam = Eigen::Vector3d::UnitZ();     ///< unit vector to the target centre
+  double range = 0;                                              ///< camera centre to target centre, metres
+  bool range_valid = true;  ///< false: the box was cut by the border on both axes (bearing only)
+  double confidence = 1;    ///< detector confidence, 0..1
+};
+
+/// One detection in the world frame, as the tracker consumes it.
+struct WorldMeasurement {
+  int64_t utime = 0;     ///< exposure utime of the source image, microseconds since epoch
+  int32_t camera_id = 0;
+  Eigen::Vector3d p_target_in_world = Eigen::Vector3d::Zero();  ///< metres
+  Eigen::Matrix3d cov_p_in_world = Eigen::Matrix3d::Identity();  ///< m^2
+  Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();    ///< kept for the output message, metres
+  double range = 0;                                             ///< metres
+  double confidence = 1;                                        ///< 0..1
+};
+
+}  // namespace wingman::localizer
