@@ -1,19 +1,44 @@
 // SPDX-License-Identifier: MIT
-// wingman-localizer: detections and own pose in, tracked 3D targets out (tracking arrives with the localizer issue).
-#include "wingman/localizer/localizer_options.hpp"
+// wingman-localizer: detections and own pose in, tracked 3D targets out.
+#include "wingman/localizer/calibration.hpp"
+#include "wingman/localizer/localizer.hpp"
 
 #include <wingman/common/runtime.hpp>
 
+namespace {
+
+using namespace wingman;
+
+localizer::CameraModel make_camera(const localizer::CameraOptions& o) {
+  if (o.calibration.empty()) {
+    // Principal point at the image centre, in the calibration convention (pixel centres at integers).
+    return localizer::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
+                                           0.5 * o.height - 0.5);
+  }
+  return localizer::load_calibration(o.calibration, o.kalibr_camera);
+}
+
+int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
+  localizer::Localizer loc(o, make_camera(o.camera));
+  rt.status().declare_output(o.output_channel);
+  rt.subscribe<own_pose_t>(o.own_pose_channel, [&](const own_pose_t& p) { loc.on_own_pose(p); });
+  rt.subscribe<detections_t>(o.detections_channel, [&](const detections_t& d) {
+    const localizer::LocalizerOutput out = loc.on_detections(d);
+    rt.status().set_last_processed_seq(d.seq);
+    for (const auto& why : out.rejections) rt.status().item_dropped(o.detections_channel, why);
+    if (out.camera_frame_only) {
+      rt.status().set_state(status_t::STATE_DEGRADED, "camera frame only: no fresh own pose");
+    } else {
+      rt.status().set_state(status_t::STATE_OK, "");
+    }
+    if (out.targets) rt.publish(o.output_channel, *out.targets);
+  });
+  return rt.spin();
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace wingman;
   const common::ProcessInfo info{"localizer", "wingman-localizer", "Localizes and tracks detected drones in 3D"};
-  return common::run_process<localizer::LocalizerOptions>(
-      info, argc, argv, [](common::Runtime& rt, const localizer::LocalizerOptions& o) {
-        rt.status().declare_output(o.output_channel);
-        rt.status().set_state(status_t::STATE_DEGRADED, "no localization yet: inputs are checked and counted only");
-        rt.subscribe<detections_t>(o.detections_channel,
-                                   [&rt](const detections_t& d) { rt.status().set_last_processed_seq(d.seq); });
-        rt.subscribe<own_pose_t>(o.own_pose_channel, [](const own_pose_t&) {});
-        return rt.spin();
-      });
+  return common::run_process<localizer::LocalizerOptions>(info, argc, argv, run);
 }

@@ -14,6 +14,7 @@ TEST(StatusTracker, HeartbeatListsDeclaredChannelsWithCountsDropsAndRates) {
   t.input("IMAGE_CAM0", 2000);
   t.input_dropped("IMAGE_CAM0", "bad image");
   t.output("DETECTIONS_CAM0", 2000);
+  t.item_dropped("IMAGE_CAM0", "one box");
   t.source_dropped("DETECTIONS_CAM0", 3, "gap");
   t.set_last_processed_seq(7);
   const wingman::status_t s = t.heartbeat(5, 6, 2.0);
@@ -23,10 +24,10 @@ TEST(StatusTracker, HeartbeatListsDeclaredChannelsWithCountsDropsAndRates) {
   ASSERT_EQ(s.channels.size(), 2u);
   EXPECT_EQ(s.channels[0].channel, "IMAGE_CAM0");
   EXPECT_EQ(s.channels[0].count, 3);
-  EXPECT_EQ(s.channels[0].drops, 1);
+  EXPECT_EQ(s.channels[0].drops, 2);
   EXPECT_FLOAT_EQ(s.channels[0].rate_hz, 1.5f);
   EXPECT_EQ(s.channels[1].drops, 3);
-  EXPECT_EQ(s.drops_total, 4);
+  EXPECT_EQ(s.drops_total, 5);
   EXPECT_EQ(s.messages_handled, 3);
   EXPECT_EQ(s.last_input_utime, 2000);
   EXPECT_EQ(s.last_processed_seq, 7);

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
-// `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types).
+// `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types), localize (one box
+// to 3D).
+#include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
 #include "wingman/tools/replay.hpp"
@@ -56,6 +58,31 @@ int main(int argc, char** argv) {
   li->add_option("log", info_log, "LCM log file")->required();
   li->add_option("--snapshot", info_snapshot, "Save the last image_t as this PNG file");
 
+  LocalizeToolOptions localize;
+  auto* lo = app.add_subcommand(
+      "localize",
+      "Localize one box: calibration file + target radius + box -> direction, range, camera-frame position");
+  lo->add_option("calibration", localize.calibration, "Calibration file: ROS camera_info, OpenCV FileStorage or Kalibr")
+      ->required();
+  lo->add_option("--box", localize.box, "Box cx,cy,w,h in pixels (origin at the top-left pixel's corner)")
+      ->required()
+      ->expected(4)
+      ->delimiter(',');
+  lo->add_option("--radius", localize.localizer.radius_m,
+                 "Target bounding-sphere radius, metres (default 0.348, F450)");
+  lo->add_option("--method", localize.localizer.range_method, "exact (default), thesis (eq. 32) or thesis_eq33");
+  lo->add_option("--min-range", localize.localizer.min_range_m, "Reject ranges below this, metres (default 0.5)");
+  lo->add_option("--max-range", localize.localizer.max_range_m, "Reject ranges above this, metres (default 100)");
+  lo->add_option("--edge-noise", localize.localizer.edge_noise_px, "Box edge noise, pixels (default 1)");
+  lo->add_option("--centre-noise", localize.localizer.centre_noise_px, "Box centre noise, pixels (default 0.5)");
+  lo->add_option("--border-margin", localize.localizer.border_margin_px,
+                 "An edge this close to the image edge is cut, pixels (default 1)");
+  lo->add_option("--kalibr-camera", localize.kalibr_camera, "Camera entry of a Kalibr camchain (default cam0)");
+  lo->add_option("--image-size", localize.image_size, "WxH of the images the box comes from; a mismatch is an error");
+  lo->add_flag("--scale-calibration", localize.scale_calibration,
+               "With --image-size: scale the calibration to that size (a uniform resize) instead of failing");
+  lo->add_flag("--json", localize.json, "Print one JSON object");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -76,6 +103,7 @@ int main(int argc, char** argv) {
       return summary.ok ? 0 : 1;
     }
     if (*s) return run_spy(spy);
+    if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*mv) {
       make_video(video);
       std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;

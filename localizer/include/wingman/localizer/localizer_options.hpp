@@ -2,23 +2,70 @@
 // Options of wingman-localizer (config/localizer.yaml).
 #pragma once
 
+#include "wingman/localizer/extrinsics.hpp"
+#include "wingman/localizer/pose_buffer.hpp"
+#include "wingman/localizer/sphere_localizer.hpp"
+#include "wingman/localizer/tracker.hpp"
+
 #include <string>
 #include <vector>
 
 namespace wingman::localizer {
 
-/// Options of the localizer process. Box-to-3D localization and tracking arrive with the localizer
-/// issue; until then the process checks and counts its inputs and publishes no targets.
+/// The camera the detections come from.
+struct CameraOptions {
+  /// Calibration file (ROS camera_info, OpenCV FileStorage or Kalibr camchain YAML); "" = an ideal
+  /// pinhole camera from the width, height and focal length below.
+  std::string calibration;
+  std::string kalibr_camera = "cam0";  ///< camera of a Kalibr camchain file
+  int camera_id = 0;                   ///< detections_t.camera_id this localizer accepts
+  int width = 1280;                    ///< built-in pinhole: image width, pixels
+  int height = 720;                    ///< built-in pinhole: image height, pixels
+  double focal_px = 640.0;             ///< built-in pinhole: fx = fy, pixels (principal point at the centre)
+  /// Rescale the calibration to the detections' image size when they differ (intrinsics scaled
+  /// by the width and height ratios). Off: a size mismatch drops the message, naming both sizes.
+  bool scale_to_image = false;
+
+  template <class V>
+  void visit(V& v) {
+    v("camera.calibration", calibration,
+      "calibration YAML (ROS camera_info, OpenCV, Kalibr); \"\" = ideal pinhole below");
+    v("camera.kalibr_camera", kalibr_camera, "which camera of a Kalibr camchain file");
+    v("camera.camera_id", camera_id, "detections_t.camera_id accepted; others are dropped and counted");
+    v("camera.width", width, "ideal pinhole only: image width, pixels");
+    v("camera.height", height, "ideal pinhole only: image height, pixels");
+    v("camera.focal_px", focal_px, "ideal pinhole only: focal length fx = fy, pixels");
+    v("camera.scale_to_image", scale_to_image,
+      "rescale intrinsics to the detections' image size (false: a size mismatch is an error)");
+  }
+  std::vector<std::string> validate() const;
+};
+
+/// Options of the localizer process.
 struct LocalizerOptions {
   std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t input channel
   std::string own_pose_channel = "OWN_POSE";           ///< own_pose_t input channel
   std::string output_channel = "TARGETS";              ///< targets_t output channel
+  /// Publish camera-frame-only targets (world_valid = false) when no own pose is fresh enough.
+  bool publish_camera_frame_only = true;
+  CameraOptions camera;
+  SphereLocalizerOptions sphere;
+  ExtrinsicsOptions extrinsics;
+  PoseBufferOptions pose;
+  TrackerOptions tracker;
 
   template <class V>
   void visit(V& v) {
     v("input.detections_channel", detections_channel, "detections_t channel from wingman-detector");
     v("input.own_pose_channel", own_pose_channel, "own_pose_t channel with the camera vehicle's pose");
     v("output.channel", output_channel, "targets_t channel to publish tracked targets on");
+    v("output.publish_camera_frame_only", publish_camera_frame_only,
+      "without a fresh own pose, publish camera-frame targets (world_valid false) instead of nothing");
+    camera.visit(v);
+    sphere.visit(v);
+    extrinsics.visit(v);
+    pose.visit(v);
+    tracker.visit(v);
   }
   std::vector<std::string> validate() const;
 };

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: MIT
+// The localizer's logic without LCM: detections and own poses in, targets out.
+#pragma once
+
+#include "wingman/localizer/camera_model.hpp"
+#include "wingman/localizer/extrinsics.hpp"
+#include "wingman/localizer/localizer_options.hpp"
+#include "wingman/localizer/pose_buffer.hpp"
+#include "wingman/localizer/tracker.hpp"
+
+#include <wingman/detections_t.hpp>
+#include <wingman/own_pose_t.hpp>
+#include <wingman/targets_t.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace wingman::localizer {
+
+/// What one detections message gave.
+struct LocalizerOutput {
+  /// Targets to publish; nullopt when there is nothing to publish (no confirmed track, or no fresh
+  /// own pose and output.publish_camera_frame_only is off).
+  std::optional<wingman::targets_t> targets;
+  /// One line per box that could not be used and per missing own pose, naming the field and why;
+  /// the process counts each as a drop.
+  std::vector<std::string> rejections;
+  bool camera_frame_only = false;  ///< no own pose fresh enough at the image's exposure time
+};
+
+/// Turns detections into tracked targets (Algorithm: eq. 24 / tangent planes per box, then the
+/// frames, then the tracker). Uses message utimes only: the same inputs give the same outputs.
+class Localizer {
+ public:
+  /// `camera` must match the detections' image size (checked per message).
+  Localizer(const LocalizerOptions& options, CameraModel camera);
+
+  /// Adds an own pose. Throws std::invalid_argument naming the field when it cannot be used
+  /// (out of order, duplicate); the caller drops and counts it.
+  void on_own_pose(const wingman::own_pose_t& pose);
+
+  /// Localizes and tracks one detections message. Throws std::invalid_argument naming the field for
+  /// a message that cannot be used at all (other camera, other image size, out of order); the caller
+  /// drops and counts it.
+  LocalizerOutput on_detections(const wingman::detections_t& detections);
+
+ private:
+  wingman::targets_t camera_frame_targets(const wingman::detections_t& d,
+                                          const std::vector<CameraMeasurement>& measurements) const;
+
+  LocalizerOptions options_;
+  CameraModel camera_;
+  Extrinsics extrinsics_;
+  PoseBuffer poses_;
+  Tracker tracker_;
+  int64_t last_detections_utime_ = -1;
+  int64_t newest_pose_utime_ = -1;
+};
+
+}  // namespace wingman::localizer

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: MIT
+// Multi-target tracking in the world frame: gating, association, track birth and death, output modes.
+#pragma once
+
+#include "wingman/localizer/kalman_cv3d.hpp"
+#include "wingman/localizer/measurement.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+namespace wingman::localizer {
+
+/// What the tracker publishes for a confirmed track.
+enum class TrackerMode {
+  kKalman,         ///< the constant-velocity Kalman estimate, predicted to the requested time (default)
+  kSlidingWindow,  ///< the thesis's mean of the last n_f associated measurements, not predicted
+  kMostConfident,  ///< the thesis's single-target mode: only each frame's most confident detection, one output
+};
+
+/// How detections are assigned to tracks.
+enum class AssociationMethod {
+  kHungarian,  ///< optimal global nearest neighbour (least total Mahalanobis^2), default
+  kGreedy,     ///< cheapest pair first
+};
+
+/// Options of the tracker (keys `tracker.*` of config/localizer.yaml).
+struct TrackerOptions {
+  /// Output mode: "kalman", "sliding_window" or "most_confident" (see TrackerMode).
+  std::string mode = "kalman";
+  /// Assignment method: "hungarian" or "greedy".
+  std::string association = "hungarian";
+  /// Acceleration noise density of the constant-velocity model, m s^-1.5 (kalman_cv3d.hpp). >= 0.
+  double accel_noise = 1.0;
+  /// Gate on the squared Mahalanobis distance of a detection to a track's predicted position
+  /// (chi-square, 3 dof: 16.27 keeps 99.9 %, 11.34 keeps 99 %). 99.9 %: a manoeuvring target
+  /// (2.5 m/s^2) outruns the constant-velocity model and a 99 % gate then splits it in two. > 0.
+  double gate_chi2 = 16.27;
+  /// M of the M-of-N birth rule: hits a tentative track needs within its first N frames. >= 1.
+  int birth_hits = 3;
+  /// N of the M-of-N birth rule, frames (calls of update()); a tentative track that can no longer
+  /// reach M hits within N frames is dropped. >= birth_hits.
+  int birth_window = 5;
+  /// A track without a hit for longer than this (image time) is deleted. Seconds, > 0.
+  double death_timeout_s = 1.0;
+  /// n_f of the sliding-window mode: measurements averaged (thesis: 5). >= 1.
+  int window_size = 5;
+  /// Standard deviation of a new track's velocity on each axis, m/s. > 0.
+  double initial_velocity_std = 5.0;
+  /// Lag compensation horizon: confirmed() predicts at most this far past a track's state time. Seconds, >= 0.
+  double max_prediction_s = 1.0;
+  /// Tracks (tentative + confirmed) kept at most; detections beyond start no track. >= 1.
+  int max_tracks = 64;
+  /// Two tracks whose full states (position and velocity) differ by a squared Mahalanobis distance
+  /// below this (chi-square, 6 dof: 16.81 = 99 %) are one target followed twice (after a manoeuvre
+  /// the gate missed, or duplicate detections): a tentative one is not confirmed, and two confirmed
+  /// ones are merged into the older id. 0 disables. Crossing targets differ in velocity and are not
+  /// merged. >= 0.
+  double merge_chi2 = 16.81;
+
+  template <class V>
+  void visit(V& v) {
+    v("tracker.mode", mode, "kalman | sliding_window (thesis, n_f mean) | most_confident (thesis, single target)");
+    v("tracker.association", association, "hungarian | greedy");
+    v("tracker.accel_noise", accel_noise, "acceleration noise density of the constant-velocity model, m s^-1.5");
+    v("tracker.gate_chi2", gate_chi2, "gate on squared Mahalanobis distance (3 dof: 16.27 = 99.9 %, 11.34 = 99 %)");
+    v("tracker.birth_hits", birth_hits, "M: hits a tentative track needs within its first N frames");
+    v("tracker.birth_window", birth_window, "N: frames a tentative track has to collect M hits");
+    v("tracker.death_timeout_s", death_timeout_s, "a track without a hit for this long is deleted, s");
+    v("tracker.window_size", window_size, "n_f: measurements averaged in sliding_window mode");
+    v("tracker.initial_velocity_std", initial_velocity_std, "velocity standard deviation of a new track, m/s");
+    v("tracker.max_prediction_s", max_prediction_s, "lag compensation: longest prediction past a track's state, s");
+    v("tracker.max_tracks", max_tracks, "tracks (tentative + confirmed) kept at most");
+    v("tracker.merge_chi2", merge_chi2,
+      "merge confirmed tracks closer than this in state (6 dof: 16.81 = 99 %); 0 = off");
+  }
+  /// One "key = value: rule" line per problem; empty when valid.
+  std::vector<std::string> validate() const;
+
+  /// `mode` as an enum. Precondition: validate() is empty.
+  TrackerMode mode_enum() const;
+  /// `association` as an enum. Precondition: validate() is empty.
+  AssociationMethod association_enum() const;
+};
+
+/// One confirmed track as published.
+struct TrackOutput {
+  int32_t track_id = 0;                                         ///< 1, 2, ... in order of confirmation; never reused
+  int32_t camera_id = 0;                                        ///< camera of the last detection used
+  Eigen::Vector3d p_target_in_world = Eigen::Vector3d::Zero();  ///< at predicted_utime, m
+  Eigen::Vector3d v_target_in_world = Eigen::Vector3d::Zero();  ///< m/s
+  Eigen::Matrix3d cov_p = Eigen::Matrix3d::Identity();          ///< covariance of p_target_in_world, m^2
+  Eigen::Matrix3d cov_v = Eigen::Matrix3d::Identity();          ///< covariance of v_target_in_world, (m/s)^2
+  Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();    ///< the last detection's, camera frame, m
+  double range = 0;                                             ///< the last detection's range, m
+  double confidence = 0;        ///< fraction of the last N frames with a hit x last detection confidence, 0..1
+  int64_t source_utime = 0;     ///< exposure utime of the newest image that updated the track
+  int64_t predicted_utime = 0;  ///< time the state refers to (lag compensation), microseconds
+  double age_s = 0;             ///< time since the track's first detection, at the requested time, s
+};
+
+/// Counters for the status message and the log.
+struct TrackerStats {
+  int64_t frames = 0;                 ///< update() calls accepted
+  int64_t frames_rejected = 0;        ///< update() calls refused (time not increasing)
+  int64_t measurements = 0;           ///< measurements accepted
+  int64_t measurements_rejected = 0;  ///< non-finite or ignored (most_confident keeps one per frame)
+  int64_t associated = 0;             ///< measurements that updated a track
+  int64_t births = 0;                 ///< tentative tracks started
+  int64_t confirmations = 0;          ///< tentative tracks confirmed
+  int64_t tentative_dropped = 0;      ///< tentative tracks that failed the M-of-N rule or timed out
+  int64_t deaths = 0;                 ///< confirmed tracks deleted after death_timeout_s
+  int64_t merges = 0;                 ///< duplicates merged into an older confirmed track (or not confirmed)
+};
+
+/// Tracks targets from world-frame detections, one frame (image) at a time.
+///
+/// Per frame: every track is predicted to the frame's exposure time; confirmed tracks take their
+/// detections first, then tentative ones take what is left (each by hungarian() or greedy_assign()
+/// on the squared Mahalanobis distances, pairs outside tracker.gate_chi2 forbidden); matched tracks
+/// are updated, detections left over start tentative tracks. A tentative track is confirmed once it
+/// has M hits within its first N frames, so an isolated false positive or a burst of scattered ones
+/// never becomes a target. A track is deleted when it has had no hit for death_timeout_s. Two
+/// confirmed tracks that agree in position and velocity (merge_chi2) are merged into the older id,
+/// with the state of whichever was updated last.
+/// Every mode runs this Kalman tracker for association; the mode decides what is published.
+class Tracker {
+ public:
+  /// Throws std::invalid_argument listing options.validate() problems.
+  explicit Tracker(TrackerOptions options = {});
+
+  /// Processes one frame's detections (possibly none); `utime` is the image's exposure utime and
+  /// must be later than the previous frame's. Returns false (and sets `why` when not null) for a
+  /// frame that is not later; such a frame changes nothing. Non-finite measurements are skipped;
+  /// each measurement's own utime is ignored (the frame's `utime` is used).
+  bool update(int64_t utime, const std::vector<WorldMeasurement>& measurements, std::string* why = nullptr);
+
+  /// The confirmed tracks, ordered by track_id, with their state predicted to `predict_to_utime`
+  /// (the publish time; lag compensation). The prediction is limited to [state time, state time +
+  /// max_prediction_s]; predicted_utime says where it ended. sliding_window mode does not predict
+  /// (predicted_utime = source_utime); most_confident mode returns at most the one track with the
+  /// newest hit.
+  std::vector<TrackOutput> confirmed(int64_t predict_to_utime) const;
+
+  /// Tentative (not yet confirmed) tracks held.
+  size_t num_tentative() const;
+  /// Confirmed tracks held.
+  size_t num_confirmed() const;
+  const TrackerStats& stats() const { return stats_; }
+  const TrackerOptions& options() const { return options_; }
+
+ private:
+  struct WindowEntry {
+    int64_t utime;
+    Eigen::Vector3d p;
+    Eigen::Matrix3d R;
+  };
+  struct Track {
+    int32_t id = 0;  // 0 while tentative, -1 once merged away
+    StateCov sc;
+    int64_t state_utime = 0;         // time sc refers to
+    int64_t birth_utime = 0;         // first detection
+    int64_t last_hit_utime = 0;      // newest detection
+    int frames = 0;                  // frames since birth, the birth frame included
+    int hits = 0;                    // hits since birth
+    std::deque<bool> recent;         // hit or miss of the last birth_window frames
+    std::deque<WindowEntry> window;  // last window_size detections
+    WorldMeasurement last;           // newest detection
+  };
+
+  void associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
+                 std::vector<int>& track_to_z) const;
+  void hit(Track& t, const WorldMeasurement& z);
+  TrackOutput output(const Track& t, int64_t predict_to_utime) const;
+  bool same_target(const Track& a, const Track& b) const;
+  bool duplicates_a_confirmed_track(const Track& t) const;
+  void merge_duplicates();  // also removes tracks marked id = -1
+
+  TrackerOptions options_;
+  TrackerMode mode_;
+  AssociationMethod association_;
+  std::vector<Track> tracks_;
+  int32_t next_id_ = 1;
+  bool have_frame_ = false;
+  int64_t last_frame_utime_ = 0;
+  TrackerStats stats_;
+};
+
+}  // namespace wingman::localizer

@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: MIT
+// The localizer's logic: boxes -> camera-frame measurements -> world frame -> tracks -> targets_t.
+#include "wingman/localizer/localizer.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace wingman::localizer {
+namespace {
+
+template <class M>
+void copy3(const M& v, double (&out)[3]) {
+  for (int i = 0; i < 3; ++i) out[i] = v(i);
+}
+
+void copy33(const Eigen::Matrix3d& m, double (&out)[9]) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[3 * r + c] = m(r, c);
+}
+
+}  // namespace
+
+Localizer::Localizer(const LocalizerOptions& options, CameraModel camera)
+    : options_(options),
+      camera_(std::move(camera)),
+      extrinsics_(Extrinsics::from_options(options.extrinsics)),
+      poses_(options.pose),
+      tracker_(options.tracker) {}
+
+void Localizer::on_own_pose(const wingman::own_pose_t& m) {
+  PoseSample s;
+  s.utime = m.utime;
+  s.p_body_in_world = Eigen::Vector3d(m.p_body_in_world[0], m.p_body_in_world[1], m.p_body_in_world[2]);
+  s.q_body_to_world =
+      Eigen::Quaterniond(m.q_body_to_world[0], m.q_body_to_world[1], m.q_body_to_world[2], m.q_body_to_world[3])
+          .normalized();
+  s.v_body_in_world = Eigen::Vector3d(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
+  if (m.frame == wingman::own_pose_t::FRAME_NED) s = pose_ned_frd_to_enu_flu(s);  // world ENU, body FLU inside
+  std::string why;
+  if (!poses_.add(s, &why)) throw std::invalid_argument("own_pose_t.utime = " + std::to_string(m.utime) + ": " + why);
+  newest_pose_utime_ = std::max(newest_pose_utime_, m.utime);
+}
+
+LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
+  if (d.camera_id != options_.camera.camera_id) {
+    throw std::invalid_argument(fmt::format("detections_t.camera_id = {}: this localizer takes camera {}", d.camera_id,
+                                            options_.camera.camera_id));
+  }
+  if (d.image_width != camera_.width() || d.image_height != camera_.height()) {
+    if (!options_.camera.scale_to_image) {
+      throw std::invalid_argument("detections_t.image_width x image_height: " +
+                                  camera_.check_image_size(d.image_width, d.image_height));
+    }
+    camera_ = camera_.scaled_to(d.image_width, d.image_height);
+  }
+  if (d.utime <= last_detections_utime_) {
+    throw std::invalid_argument(fmt::format("detections_t.utime = {}: not after the previous one ({}): out of order",
+                                            d.utime, last_detections_utime_));
+  }
+  last_detections_utime_ = d.utime;
+
+  LocalizerOutput result;
+  std::vector<CameraMeasurement> measurements;
+  for (size_t i = 0; i < d.detections.size(); ++i) {
+    const auto& det = d.detections[i];
+    const PixelBox box{det.cx, det.cy, det.w, det.h};
+    LocalizeResult r = localize_box(box, camera_, options_.sphere);
+    if (!r.ok) {
+      result.rejections.push_back(fmt::format("detections_t.detections[{}]: {}", i, r.reason));
+      continue;
+    }
+    r.measurement.confidence = det.confidence;
+    measurements.push_back(r.measurement);
+  }
+
+  std::string why;
+  const std::optional<PoseSample> pose = poses_.at(d.utime, &why);
+  if (!pose) {
+    result.camera_frame_only = true;
+    result.rejections.push_back("no own pose at detections_t.utime = " + std::to_string(d.utime) + ": " + why);
+    if (options_.publish_camera_frame_only) result.targets = camera_frame_targets(d, measurements);
+    return result;
+  }
+
+  std::vector<WorldMeasurement> world;
+  world.reserve(measurements.size());
+  for (const auto& m : measurements) {
+    if (!m.range_valid) continue;  // bearing-only: not a position; the tracker takes positions
+    world.push_back(to_world(m, extrinsics_, *pose, d.utime, d.camera_id));
+  }
+  if (!tracker_.update(d.utime, world, &why)) {
+    throw std::invalid_argument("detections_t.utime = " + std::to_string(d.utime) + ": " + why);
+  }
+
+  // Lag compensation: predict to the newest time we know of (own poses arrive with little delay).
+  const int64_t predict_to = std::max(d.utime, newest_pose_utime_);
+  wingman::targets_t out{};
+  out.utime = predict_to;
+  out.frame = wingman::own_pose_t::FRAME_ENU;
+  for (const TrackOutput& t : tracker_.confirmed(predict_to)) {
+    wingman::target_t m{};
+    m.track_id = t.track_id;
+    m.camera_id = t.camera_id;
+    copy3(t.p_target_in_cam, m.p_target_in_cam);
+    copy3(t.p_target_in_world, m.p_target_in_world);
+    copy3(t.v_target_in_world, m.v_target_in_world);
+    copy33(t.cov_p, m.position_covariance);
+    copy33(t.cov_v, m.velocity_covariance);
+    m.world_valid = true;
+    m.range = t.range;
+    m.confidence = static_cast<float>(t.confidence);
+    m.age_s = static_cast<float>(t.age_s);
+    m.source_utime = t.source_utime;
+    m.predicted_utime = t.predicted_utime;
+    out.targets.push_back(m);
+  }
+  out.num_targets = static_cast<int32_t>(out.targets.size());
+  if (out.num_targets > 0) result.targets = std::move(out);
+  return result;
+}
+
+wingman::targets_t Localizer::camera_frame_targets(const wingman::detections_t& d,
+                                                   const std::vector<CameraMeasurement>& measurements) const {
+  wingman::targets_t out{};
+  out.utime = d.utime;
+  out.frame = wingman::own_pose_t::FRAME_ENU;
+  for (const auto& m : measurements) {
+    wingman::target_t t{};
+    t.track_id = 0;  // untracked: tracks live in the world frame
+    t.camera_id = d.camera_id;
+    copy3(m.p_target_in_cam, t.p_target_in_cam);
+    copy33(m.cov_p_in_cam, t.position_covariance);
+    t.world_valid = false;
+    t.range = m.range_valid ? m.range : 0.0;
+    t.confidence = static_cast<float>(m.confidence);
+    t.source_utime = d.utime;
+    t.predicted_utime = d.utime;
+    out.targets.push_back(t);
+  }
+  out.num_targets = static_cast<int32_t>(out.targets.size());
+  return out;
+}
+
+}  // namespace wingman::localizer

@@ -1,0 +1,325 @@
+// SPDX-License-Identifier: MIT
+// Tracker: predict, gate, associate, update, M-of-N birth, timeout death, output modes.
+#include "wingman/localizer/tracker.hpp"
+
+#include "wingman/localizer/association.hpp"
+
+#include <fmt/format.h>
+#include <Eigen/Cholesky>
+#include <wingman/common/config.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace wingman::localizer {
+namespace {
+
+double us_to_s(int64_t us) { return static_cast<double>(us) * 1e-6; }
+
+bool finite(const WorldMeasurement& m) {
+  return m.p_target_in_world.allFinite() && m.cov_p_in_world.allFinite() && std::isfinite(m.confidence);
+}
+
+}  // namespace
+
+std::vector<std::string> TrackerOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (mode != "kalman" && mode != "sliding_window" && mode != "most_confident")
+    p.push_back(problem("tracker.mode", mode, "must be kalman, sliding_window or most_confident"));
+  if (association != "hungarian" && association != "greedy")
+    p.push_back(problem("tracker.association", association, "must be hungarian or greedy"));
+  if (!(accel_noise >= 0) || !std::isfinite(accel_noise))
+    p.push_back(problem("tracker.accel_noise", accel_noise, "must be finite and >= 0"));
+  if (!(gate_chi2 > 0) || !std::isfinite(gate_chi2))
+    p.push_back(problem("tracker.gate_chi2", gate_chi2, "must be finite and > 0"));
+  if (birth_hits < 1) p.push_back(problem("tracker.birth_hits", birth_hits, "must be >= 1"));
+  if (birth_window < birth_hits)
+    p.push_back(
+        problem("tracker.birth_window", birth_window, fmt::format("must be >= tracker.birth_hits ({})", birth_hits)));
+  if (!(death_timeout_s > 0)) p.push_back(problem("tracker.death_timeout_s", death_timeout_s, "must be > 0"));
+  if (window_size < 1) p.push_back(problem("tracker.window_size", window_size, "must be >= 1"));
+  if (!(initial_velocity_std > 0) || !std::isfinite(initial_velocity_std))
+    p.push_back(problem("tracker.initial_velocity_std", initial_velocity_std, "must be finite and > 0"));
+  if (!(max_prediction_s >= 0) || !std::isfinite(max_prediction_s))
+    p.push_back(problem("tracker.max_prediction_s", max_prediction_s, "must be finite and >= 0"));
+  if (max_tracks < 1) p.push_back(problem("tracker.max_tracks", max_tracks, "must be >= 1"));
+  if (!(merge_chi2 >= 0) || !std::isfinite(merge_chi2))
+    p.push_back(problem("tracker.merge_chi2", merge_chi2, "must be finite and >= 0"));
+  return p;
+}
+
+TrackerMode TrackerOptions::mode_enum() const {
+  if (mode == "sliding_window") return TrackerMode::kSlidingWindow;
+  if (mode == "most_confident") return TrackerMode::kMostConfident;
+  return TrackerMode::kKalman;
+}
+
+AssociationMethod TrackerOptions::association_enum() const {
+  return association == "greedy" ? AssociationMethod::kGreedy : AssociationMethod::kHungarian;
+}
+
+Tracker::Tracker(TrackerOptions options) : options_(std::move(options)) {
+  const auto problems = options_.validate();
+  if (!problems.empty()) {
+    std::string all = "invalid TrackerOptions:";
+    for (const auto& q : problems) all += " " + q + ";";
+    throw std::invalid_argument(all);
+  }
+  mode_ = options_.mode_enum();
+  association_ = options_.association_enum();
+}
+
+size_t Tracker::num_tentative() const {
+  return static_cast<size_t>(std::count_if(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.id == 0; }));
+}
+
+size_t Tracker::num_confirmed() const { return tracks_.size() - num_tentative(); }
+
+void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
+                        std::vector<int>& track_to_z) const {
+  track_to_z.assign(tracks.size(), -1);
+  if (tracks.empty() || z.empty()) return;
+  Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(tracks.size()),
+                                                   static_cast<Eigen::Index>(z.size()), kForbiddenCost);
+  for (size_t i = 0; i < tracks.size(); ++i)
+    for (size_t j = 0; j < z.size(); ++j) {
+      if (z_used[j]) continue;
+      const double d2 = mahalanobis2(tracks[i]->sc, z[j].p_target_in_world, z[j].cov_p_in_world);
+      if (d2 <= options_.gate_chi2) cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = d2;
+    }
+  track_to_z = association_ == AssociationMethod::kGreedy ? greedy_assign(cost) : hungarian(cost);
+  for (int j : track_to_z)
+    if (j >= 0) z_used[static_cast<size_t>(j)] = true;
+}
+
+void Tracker::hit(Track& t, const WorldMeasurement& z) {
+  t.sc = localizer::update(t.sc, z.p_target_in_world, z.cov_p_in_world);  // the filter, not Tracker::update
+  t.last_hit_utime = z.utime;
+  t.last = z;
+  t.window.push_back({z.utime, z.p_target_in_world, z.cov_p_in_world});
+  while (static_cast<int>(t.window.size()) > options_.window_size) t.window.pop_front();
+}
+
+bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measurements, std::string* why) {
+  if (have_frame_ && utime <= last_frame_utime_) {
+    ++stats_.frames_rejected;
+    if (why)
+      *why =
+          fmt::format("frame utime {} is not after the previous frame's ({}, {} s {})", utime, last_frame_utime_,
+                      us_to_s(std::abs(last_frame_utime_ - utime)), utime == last_frame_utime_ ? "apart" : "earlier");
+    return false;
+  }
+  ++stats_.frames;
+
+  // The detections this frame uses; each carries the frame's utime.
+  std::vector<WorldMeasurement> z;
+  z.reserve(measurements.size());
+  for (const WorldMeasurement& m : measurements) {
+    if (!finite(m)) {
+      ++stats_.measurements_rejected;
+      continue;
+    }
+    z.push_back(m);
+    z.back().utime = utime;
+  }
+  if (mode_ == TrackerMode::kMostConfident && z.size() > 1) {
+    const auto best = std::max_element(z.begin(), z.end(), [](const WorldMeasurement& a, const WorldMeasurement& b) {
+      return a.confidence < b.confidence;
+    });
+    const WorldMeasurement keep = *best;
+    stats_.measurements_rejected += static_cast<int64_t>(z.size() - 1);
+    z.assign(1, keep);
+  }
+  stats_.measurements += static_cast<int64_t>(z.size());
+
+  // Predict every track to the exposure time.
+  for (Track& t : tracks_) {
+    t.sc = predict(t.sc, options_.accel_noise, us_to_s(utime - t.state_utime));
+    t.state_utime = utime;
+  }
+
+  // Confirmed tracks choose first, tentative ones take the rest.
+  std::vector<bool> z_used(z.size(), false);
+  std::vector<bool> track_hit(tracks_.size(), false);
+  for (const bool confirmed_pass : {true, false}) {
+    std::vector<Track*> group;
+    std::vector<size_t> index;
+    for (size_t i = 0; i < tracks_.size(); ++i)
+      if ((tracks_[i].id != 0) == confirmed_pass) {
+        group.push_back(&tracks_[i]);
+        index.push_back(i);
+      }
+    std::vector<int> track_to_z;
+    associate(group, z, z_used, track_to_z);
+    for (size_t k = 0; k < group.size(); ++k)
+      if (track_to_z[k] >= 0) {
+        hit(*group[k], z[static_cast<size_t>(track_to_z[k])]);
+        track_hit[index[k]] = true;
+        ++stats_.associated;
+      }
+  }
+
+  // Book-keeping and deletion of the existing tracks.
+  const int64_t death_timeout_us = static_cast<int64_t>(std::llround(options_.death_timeout_s * 1e6));
+  std::vector<Track> kept;
+  kept.reserve(tracks_.size() + z.size());
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    Track& t = tracks_[i];
+    ++t.frames;
+    if (track_hit[i]) ++t.hits;
+    t.recent.push_back(track_hit[i]);
+    while (static_cast<int>(t.recent.size()) > options_.birth_window) t.recent.pop_front();
+    const bool timed_out = utime - t.last_hit_utime > death_timeout_us;
+    if (t.id == 0 && (timed_out || t.hits + (options_.birth_window - t.frames) < options_.birth_hits)) {
+      ++stats_.tentative_dropped;
+      continue;
+    }
+    if (t.id != 0 && timed_out) {
+      ++stats_.deaths;
+      continue;
+    }
+    kept.push_back(std::move(t));
+  }
+  tracks_ = std::move(kept);
+
+  // Confirmation (M of N), unless the track only duplicates a confirmed one; then merges.
+  for (Track& t : tracks_) {
+    if (t.id != 0 || t.hits < options_.birth_hits) continue;
+    if (duplicates_a_confirmed_track(t)) {
+      t.id = -1;  // removed by merge_duplicates()
+      ++stats_.merges;
+      continue;
+    }
+    t.id = next_id_++;
+    ++stats_.confirmations;
+  }
+  merge_duplicates();
+
+  // Detections no track took start tentative tracks.
+  for (size_t j = 0; j < z.size(); ++j) {
+    if (z_used[j] || static_cast<int>(tracks_.size()) >= options_.max_tracks) continue;
+    Track t;
+    t.sc = cv_initialize(z[j].p_target_in_world, z[j].cov_p_in_world, options_.initial_velocity_std);
+    t.state_utime = utime;
+    t.birth_utime = utime;
+    t.last_hit_utime = utime;
+    t.frames = 1;
+    t.hits = 1;
+    t.recent.push_back(true);
+    t.last = z[j];
+    t.window.push_back({utime, z[j].p_target_in_world, z[j].cov_p_in_world});
+    ++stats_.births;
+    if (t.hits >= options_.birth_hits) {
+      t.id = next_id_++;
+      ++stats_.confirmations;
+    }
+    tracks_.push_back(std::move(t));
+  }
+
+  have_frame_ = true;
+  last_frame_utime_ = utime;
+  return true;
+}
+
+bool Tracker::same_target(const Track& a, const Track& b) const {
+  if (options_.merge_chi2 <= 0) return false;
+  const Vector6d d = a.sc.x - b.sc.x;
+  return d.dot((a.sc.P + b.sc.P).ldlt().solve(d)) < options_.merge_chi2;
+}
+
+bool Tracker::duplicates_a_confirmed_track(const Track& t) const {
+  for (const Track& c : tracks_)
+    if (c.id > 0 && &c != &t && same_target(c, t)) return true;
+  return false;
+}
+
+void Tracker::merge_duplicates() {
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    for (size_t j = i + 1; j < tracks_.size(); ++j) {
+      Track& a = tracks_[i];
+      Track& b = tracks_[j];
+      if (a.id <= 0 || b.id <= 0 || !same_target(a, b)) continue;  // tentative, already merged, or distinct
+      Track& older = a.id < b.id ? a : b;
+      Track& younger = a.id < b.id ? b : a;
+      const int32_t id = older.id;
+      const int64_t birth = older.birth_utime;
+      if (younger.last_hit_utime > older.last_hit_utime) older = younger;  // the fresher estimate
+      older.id = id;
+      older.birth_utime = birth;
+      younger.id = -1;  // marked for removal
+      ++stats_.merges;
+    }
+  }
+  tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.id < 0; }), tracks_.end());
+}
+
+TrackOutput Tracker::output(const Track& t, int64_t predict_to_utime) const {
+  TrackOutput o;
+  o.track_id = t.id;
+  o.camera_id = t.last.camera_id;
+  o.p_target_in_cam = t.last.p_target_in_cam;
+  o.range = t.last.range;
+  const double hit_fraction =
+      static_cast<double>(std::count(t.recent.begin(), t.recent.end(), true)) / options_.birth_window;
+  o.confidence = std::clamp(hit_fraction * t.last.confidence, 0.0, 1.0);
+  o.source_utime = t.last_hit_utime;
+  o.age_s = std::max(0.0, us_to_s(predict_to_utime - t.birth_utime));
+
+  if (mode_ == TrackerMode::kSlidingWindow) {
+    // Thesis: the mean of the last n_f measurements, published as current (it lags by about
+    // (n_f - 1) / 2 frames times the speed). Velocity by finite difference across the window.
+    const double n = static_cast<double>(t.window.size());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
+    for (const WindowEntry& e : t.window) {
+      mean += e.p;
+      sum_R += e.R;
+    }
+    o.p_target_in_world = mean / n;
+    o.cov_p = sum_R / (n * n);
+    const WindowEntry& first = t.window.front();
+    const WindowEntry& last = t.window.back();
+    if (t.window.size() >= 2 && last.utime > first.utime) {
+      const double dt = us_to_s(last.utime - first.utime);
+      o.v_target_in_world = (last.p - first.p) / dt;
+      o.cov_v = (first.R + last.R) / (dt * dt);
+    } else {
+      o.v_target_in_world.setZero();
+      o.cov_v = options_.initial_velocity_std * options_.initial_velocity_std * Eigen::Matrix3d::Identity();
+    }
+    o.predicted_utime = t.last_hit_utime;
+    return o;
+  }
+
+  const int64_t max_us = static_cast<int64_t>(std::llround(options_.max_prediction_s * 1e6));
+  const int64_t dt_us = std::clamp<int64_t>(predict_to_utime - t.state_utime, 0, max_us);
+  const StateCov p = predict(t.sc, options_.accel_noise, us_to_s(dt_us));
+  o.p_target_in_world = p.x.head<3>();
+  o.v_target_in_world = p.x.tail<3>();
+  o.cov_p = p.P.topLeftCorner<3, 3>();
+  o.cov_v = p.P.bottomRightCorner<3, 3>();
+  o.predicted_utime = t.state_utime + dt_us;
+  return o;
+}
+
+std::vector<TrackOutput> Tracker::confirmed(int64_t predict_to_utime) const {
+  std::vector<TrackOutput> out;
+  const Track* newest = nullptr;
+  for (const Track& t : tracks_) {
+    if (t.id == 0) continue;
+    if (mode_ == TrackerMode::kMostConfident) {
+      if (!newest || t.last_hit_utime > newest->last_hit_utime ||
+          (t.last_hit_utime == newest->last_hit_utime && t.last.confidence > newest->last.confidence))
+        newest = &t;
+      continue;
+    }
+    out.push_back(output(t, predict_to_utime));
+  }
+  if (newest) out.push_back(output(*newest, predict_to_utime));
+  std::sort(out.begin(), out.end(), [](const TrackOutput& a, const TrackOutput& b) { return a.track_id < b.track_id; });
+  return out;
+}
+
+}  // namespace wingman::localizer

@@ -1,0 +1,175 @@
+// SPDX-License-Identifier: MIT
+// wingman-localizer as a process, file to file: a scripted flight gives tracked world positions;
+// bad and out-of-order inputs are dropped and counted; without own poses it publishes camera-frame targets.
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <wingman/detections_t.hpp>
+#include <wingman/own_pose_t.hpp>
+#include <wingman/status_t.hpp>
+#include <wingman/targets_t.hpp>
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <limits>
+
+namespace {
+
+using namespace std::chrono_literals;
+using wingman::testing::bin_path;
+using wingman::testing::LogEvent;
+using wingman::testing::make_event;
+using wingman::testing::read_log;
+using wingman::testing::run;
+using wingman::testing::TempDir;
+
+constexpr int64_t kT0 = 1700000000000000;
+constexpr double kF = 640, kCx = 640, kCy = 360, kRadius = 0.348;  // built-in pinhole, default radius
+
+/// Target truth: 10 m east, 1 m north, 0.5 m up of the observer, flying north at 1 m/s.
+Eigen::Vector3d target_in_world(int64_t utime) {
+  const double t = (utime - kT0) * 1e-6;
+  return {10.0, 1.0 + 1.0 * t, 0.5};
+}
+
+/// The exact box of a sphere seen by the built-in pinhole camera, which looks east (the default
+/// extrinsics with an identity body pose): camera x = -north, y = -up, z = east.
+wingman::detection_t sphere_box(const Eigen::Vector3d& p_world) {
+  const double X = -p_world.y(), Y = -p_world.z(), Z = p_world.x();
+  auto edges = [](double a, double z) {  // tangent lines from the origin to a circle (a, z) of radius r
+    const double centre = std::atan2(a, z), half = std::asin(kRadius / std::hypot(a, z));
+    return std::make_pair(std::tan(centre - half), std::tan(centre + half));
+  };
+  const auto [xl, xr] = edges(X, Z);
+  const auto [yt, yb] = edges(Y, Z);
+  wingman::detection_t d{};
+  d.cx = static_cast<float>(kCx + kF * 0.5 * (xl + xr));
+  d.cy = static_cast<float>(kCy + kF * 0.5 * (yt + yb));
+  d.w = static_cast<float>(kF * (xr - xl));
+  d.h = static_cast<float>(kF * (yb - yt));
+  d.confidence = 0.9f;
+  return d;
+}
+
+wingman::detections_t detections(int64_t utime, int64_t seq, std::vector<wingman::detection_t> boxes, int camera = 0) {
+  wingman::detections_t m{};
+  m.utime = utime;
+  m.seq = seq;
+  m.camera_id = camera;
+  m.image_width = 1280;
+  m.image_height = 720;
+  m.detections = std::move(boxes);
+  m.num_detections = static_cast<int32_t>(m.detections.size());
+  return m;
+}
+
+wingman::own_pose_t own_pose(int64_t utime) {
+  wingman::own_pose_t p{};
+  p.utime = utime;
+  p.frame = wingman::own_pose_t::FRAME_ENU;
+  p.q_body_to_world[0] = 1.0;
+  return p;
+}
+
+struct LocalizerRun {
+  std::vector<wingman::targets_t> targets;
+  wingman::status_t last_status;
+  std::string err;
+};
+
+LocalizerRun run_localizer(const TempDir& dir, const std::vector<LogEvent>& events) {
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+  const auto r = run({bin_path("wingman-localizer"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
+                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
+                     30s);
+  LocalizerRun out;
+  out.err = r.err;
+  if (r.exit_code != 0) throw std::runtime_error("localizer failed: " + r.err);
+  for (const auto& e : read_log(dir.file("out.lcmlog"))) {
+    if (e.channel == "TARGETS") {
+      wingman::targets_t t;
+      t.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+      out.targets.push_back(t);
+    } else if (e.channel == "STATUS_LOCALIZER") {
+      out.last_status.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+    }
+  }
+  return out;
+}
+
+/// 2 s of flight: own poses at 100 Hz, detections at 30 Hz (each after the poses that bracket it).
+std::vector<LogEvent> scripted_flight() {
+  std::vector<LogEvent> events;
+  int64_t seq = 0;
+  for (int64_t t = 0; t <= 2000000; t += 10000) {
+    events.push_back(make_event("OWN_POSE", own_pose(kT0 + t), t));
+    if (t % 33333 < 10000 && t >= 20000) {
+      const int64_t exposure = kT0 + t - 15000;  // the detector reports 15 ms after exposure
+      events.push_back(
+          make_event("DETECTIONS_CAM0", detections(exposure, seq++, {sphere_box(target_in_world(exposure))}), t));
+    }
+  }
+  return events;
+}
+
+TEST(LocalizerProcess, ScriptedFlightGivesOneConfirmedTrackAtTheTruePositionPredictedToTheNewestPose) {
+  TempDir dir;
+  const LocalizerRun r = run_localizer(dir, scripted_flight());
+  ASSERT_FALSE(r.targets.empty()) << r.err;
+  const wingman::targets_t& last = r.targets.back();
+  ASSERT_EQ(last.num_targets, 1);
+  const wingman::target_t& t = last.targets[0];
+  EXPECT_EQ(t.track_id, 1);
+  EXPECT_TRUE(t.world_valid);
+  // Lag compensation: predicted past the image's exposure to the newest own pose.
+  EXPECT_GT(t.predicted_utime, t.source_utime);
+  EXPECT_EQ(last.utime, t.predicted_utime);
+  const Eigen::Vector3d truth = target_in_world(t.predicted_utime);
+  const Eigen::Vector3d est(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);
+  EXPECT_LT((est - truth).norm(), 0.10) << "estimate " << est.transpose() << " truth " << truth.transpose();
+  EXPECT_NEAR(t.v_target_in_world[1], 1.0, 0.15);
+  EXPECT_NEAR(t.range, target_in_world(t.source_utime).norm(), 0.05);
+  EXPECT_EQ(r.last_status.drops_total, 0) << r.last_status.last_error;
+}
+
+TEST(LocalizerProcess, BadBoxesAndMessagesAreDroppedAndCountedNeverFatal) {
+  TempDir dir;
+  std::vector<LogEvent> events = scripted_flight();
+  const int64_t t = kT0 + 500000;
+  auto nan_box = sphere_box(target_in_world(t));
+  nan_box.cx = std::numeric_limits<float>::quiet_NaN();
+  auto outside = sphere_box(target_in_world(t));
+  outside.cx = 5000;
+  events.push_back(
+      make_event("DETECTIONS_CAM0", detections(kT0 + 1994000, 900, {nan_box}), 2100000));  // invalid message
+  events.push_back(make_event("DETECTIONS_CAM0", detections(kT0 + 1995000, 901, {outside}), 2110000));  // box outside
+  events.push_back(
+      make_event("DETECTIONS_CAM0", detections(kT0 + 1996000, 902, {outside}, 3), 2120000));  // unknown camera
+  events.push_back(make_event("DETECTIONS_CAM0", detections(kT0 + 1000000, 903, {outside}), 2130000));  // out of order
+  events.push_back({2140000, "OWN_POSE", {0, 1, 2, 3}});                                                // garbage
+  const LocalizerRun r = run_localizer(dir, events);
+  EXPECT_EQ(r.last_status.state, int{wingman::status_t::STATE_STOPPING});
+  EXPECT_EQ(r.last_status.drops_total, 5) << r.last_status.last_error;
+}
+
+TEST(LocalizerProcess, WithoutOwnPosesItPublishesCameraFrameTargetsFlaggedAsSuch) {
+  TempDir dir;
+  std::vector<LogEvent> events;
+  const Eigen::Vector3d p(10.0, 1.0, 0.5);
+  events.push_back(make_event("DETECTIONS_CAM0", detections(kT0, 0, {sphere_box(p)}), 0));
+  const LocalizerRun r = run_localizer(dir, events);
+  ASSERT_EQ(r.targets.size(), 1u);
+  ASSERT_EQ(r.targets[0].num_targets, 1);
+  const auto& t = r.targets[0].targets[0];
+  EXPECT_FALSE(t.world_valid);
+  EXPECT_EQ(t.track_id, 0);
+  EXPECT_NEAR(t.p_target_in_cam[0], -1.0, 0.01);
+  EXPECT_NEAR(t.p_target_in_cam[1], -0.5, 0.01);
+  EXPECT_NEAR(t.p_target_in_cam[2], 10.0, 0.05);
+  EXPECT_EQ(r.last_status.drops_total, 1);
+  EXPECT_NE(r.last_status.last_error.find("no own pose at detections_t.utime"), std::string::npos)
+      << r.last_status.last_error;
+}
+
+}  // namespace

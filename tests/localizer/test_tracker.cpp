@@ -1,0 +1,404 @@
+// SPDX-License-Identifier: MIT
+// Tracker: options, frame order, M-of-N birth, death, ids, false-positive burst, crossing targets,
+// accuracy (raw vs sliding window vs Kalman) and lag compensation on simulated detections.
+#include <gtest/gtest.h>
+#include <wingman/common/config.hpp>
+#include <wingman/localizer/tracker.hpp>
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+namespace {
+
+using wingman::localizer::Tracker;
+using wingman::localizer::TrackerOptions;
+using wingman::localizer::TrackOutput;
+using wingman::localizer::WorldMeasurement;
+
+constexpr int64_t kT0 = 1'700'000'000'000'000;
+constexpr int64_t kFrameUs = 100'000;  // 10 Hz detections
+constexpr double kPi = 3.14159265358979323846;
+
+int64_t frame_utime(int k) { return kT0 + kFrameUs * k; }
+double seconds(int64_t utime) { return static_cast<double>(utime - kT0) * 1e-6; }
+
+WorldMeasurement meas(const Eigen::Vector3d& p, double sigma = 0.2, double confidence = 0.9) {
+  WorldMeasurement m;
+  m.p_target_in_world = p;
+  m.cov_p_in_world = sigma * sigma * Eigen::Matrix3d::Identity();
+  m.p_target_in_cam = p;
+  m.range = p.norm();
+  m.confidence = confidence;
+  return m;
+}
+
+// Noisy world-frame detections as the sphere model gives them, seen from a camera at the origin:
+// range error 5 % of range along the line of sight, 1 % across it.
+class Detections {
+ public:
+  explicit Detections(unsigned seed) : rng_(seed) {}
+  WorldMeasurement operator()(const Eigen::Vector3d& truth, double confidence = 0.9) {
+    const double range = truth.norm();
+    const Eigen::Vector3d u = truth / range;
+    const double s_r = 0.05 * range, s_l = 0.01 * range;
+    const Eigen::Matrix3d R =
+        s_r * s_r * u * u.transpose() + s_l * s_l * (Eigen::Matrix3d::Identity() - u * u.transpose());
+    const Eigen::Vector3d w(g_(rng_), g_(rng_), g_(rng_));
+    WorldMeasurement m;
+    m.p_target_in_world = truth + Eigen::LLT<Eigen::Matrix3d>(R).matrixL() * w;
+    m.cov_p_in_world = R;
+    m.range = m.p_target_in_world.norm();
+    m.confidence = confidence;
+    return m;
+  }
+  std::mt19937& rng() { return rng_; }
+
+ private:
+  std::mt19937 rng_;
+  std::normal_distribution<double> g_{0, 1};
+};
+
+// A target on a horizontal circle of radius 10 m around (20, 0, 5) at constant speed (m/s).
+Eigen::Vector3d circle(double t, double speed) {
+  const double r = 10, a = speed * t / r;
+  return Eigen::Vector3d(20 + r * std::cos(a), r * std::sin(a), 5);
+}
+
+TEST(TrackerOptions, DefaultsAreValidAndBadValuesAreNamed) {
+  EXPECT_TRUE(TrackerOptions{}.validate().empty());
+  TrackerOptions o;
+  o.mode = "best";
+  o.birth_hits = 4;
+  o.birth_window = 3;
+  o.gate_chi2 = 0;
+  const auto p = o.validate();
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_NE(p[0].find("tracker.mode = 'best'"), std::string::npos) << p[0];
+  EXPECT_NE(p[1].find("tracker.gate_chi2"), std::string::npos) << p[1];
+  EXPECT_NE(p[2].find("tracker.birth_window = 3"), std::string::npos) << p[2];
+  EXPECT_THROW(Tracker{o}, std::invalid_argument);
+  const auto y = wingman::common::load_options_from_string<TrackerOptions>(
+      "tracker: {mode: sliding_window, window_size: 7}\n", "localizer.yaml");
+  EXPECT_EQ(y.mode, "sliding_window");
+  EXPECT_EQ(y.window_size, 7);
+}
+
+TEST(Tracker, RefusesFramesThatAreNotLaterWithAReason) {
+  Tracker t;
+  std::string why;
+  ASSERT_TRUE(t.update(frame_utime(5), {meas({10, 0, 0})}, &why));
+  EXPECT_FALSE(t.update(frame_utime(5), {meas({10, 0, 0})}, &why));
+  EXPECT_NE(why.find("not after the previous frame"), std::string::npos) << why;
+  EXPECT_FALSE(t.update(frame_utime(4), {meas({10, 0, 0})}, &why));
+  EXPECT_EQ(t.stats().frames, 1);
+  EXPECT_EQ(t.stats().frames_rejected, 2);
+  EXPECT_EQ(t.num_tentative(), 1u);  // the refused frames changed nothing
+}
+
+TEST(Tracker, ConfirmsAfterMHitsInNFramesAndIdsStartAtOne) {
+  Tracker t;  // M = 3, N = 5
+  const Eigen::Vector3d p(15, 2, 3);
+  t.update(frame_utime(0), {meas(p)});
+  t.update(frame_utime(1), {});
+  t.update(frame_utime(2), {meas(p)});
+  EXPECT_EQ(t.num_tentative(), 1u);
+  EXPECT_TRUE(t.confirmed(frame_utime(2)).empty());
+  t.update(frame_utime(3), {});
+  t.update(frame_utime(4), {meas(p)});  // third hit in the fifth frame
+  const auto out = t.confirmed(frame_utime(4));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 1);
+  EXPECT_EQ(t.num_tentative(), 0u);
+  EXPECT_EQ(out[0].source_utime, frame_utime(4));
+  EXPECT_NEAR(out[0].age_s, 0.4, 1e-12);
+}
+
+TEST(Tracker, DropsATentativeTrackThatCannotReachMHits) {
+  Tracker t;
+  const Eigen::Vector3d p(15, 2, 3);
+  t.update(frame_utime(0), {meas(p)});
+  t.update(frame_utime(1), {});
+  t.update(frame_utime(2), {});
+  t.update(frame_utime(3), {meas(p)});  // 2 hits in 4 frames: 3 still possible
+  EXPECT_EQ(t.num_tentative(), 1u);
+  t.update(frame_utime(4), {});  // 2 hits in 5 frames: dropped
+  EXPECT_EQ(t.num_tentative(), 0u);
+  EXPECT_EQ(t.stats().tentative_dropped, 1);
+  EXPECT_TRUE(t.confirmed(frame_utime(4)).empty());
+}
+
+TEST(Tracker, DeletesAfterTheTimeoutAndNeverReusesIds) {
+  TrackerOptions o;
+  o.death_timeout_s = 0.5;
+  Tracker t(o);
+  for (int k = 0; k < 5; ++k) t.update(frame_utime(k), {meas({15, 0, 3})});
+  ASSERT_EQ(t.confirmed(frame_utime(4)).size(), 1u);
+  for (int k = 5; k <= 9; ++k) t.update(frame_utime(k), {});  // 0.5 s without a hit: kept
+  EXPECT_EQ(t.num_confirmed(), 1u);
+  t.update(frame_utime(10), {});  // 0.6 s: deleted
+  EXPECT_EQ(t.num_confirmed(), 0u);
+  EXPECT_EQ(t.stats().deaths, 1);
+  for (int k = 11; k < 14; ++k) t.update(frame_utime(k), {meas({15, 0, 3})});
+  const auto out = t.confirmed(frame_utime(13));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 2);
+}
+
+TEST(Tracker, GatesOutADetectionFarFromTheTrack) {
+  Tracker t;
+  for (int k = 0; k < 5; ++k) t.update(frame_utime(k), {meas({15, 0, 3}, 0.1)});
+  // 3 m away with sigma 0.1 m: far outside the 99 % gate; it starts a tentative track instead.
+  t.update(frame_utime(5), {meas({15, 3, 3}, 0.1)});
+  const auto out = t.confirmed(frame_utime(5));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_LT((out[0].p_target_in_world - Eigen::Vector3d(15, 0, 3)).norm(), 0.1);
+  EXPECT_EQ(out[0].source_utime, frame_utime(4));
+  EXPECT_EQ(t.num_tentative(), 1u);
+}
+
+TEST(Tracker, ABurstOfFalsePositivesCreatesNoConfirmedTrack) {
+  // One real target plus, for 6 frames, 8 false positives per frame uniform in a 60 m cube (seed 11).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-30, 30);
+  Detections det(12);
+  Tracker t;
+  int max_confirmed = 0;
+  for (int k = 0; k < 40; ++k) {
+    std::vector<WorldMeasurement> z{det(circle(k * 0.1, 2.0))};
+    if (k >= 10 && k < 16)
+      for (int i = 0; i < 8; ++i) z.push_back(meas({u(rng) + 30, u(rng), u(rng) + 30}, 0.5, 0.6));
+    ASSERT_TRUE(t.update(frame_utime(k), z));
+    max_confirmed = std::max(max_confirmed, static_cast<int>(t.confirmed(frame_utime(k)).size()));
+  }
+  EXPECT_EQ(max_confirmed, 1);
+  EXPECT_EQ(t.stats().confirmations, 1);
+  EXPECT_GE(t.stats().births, 1 + 6 * 8 - 2);  // (nearly) every false positive started a tentative track
+  EXPECT_EQ(t.num_tentative(), 0u);
+  const auto out = t.confirmed(frame_utime(39));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 1);
+}
+
+TEST(Tracker, TwoCrossingTargetsKeepTheirIds) {
+  // A flies east, B north; both pass (20, 0, 5) at t = 4 s at 3 m/s, 90 degrees apart. Noise seed 5
+  // (range sigma 1 m along the line of sight, i.e. along A's path). Which output is which target: by
+  // position while they are over 3 m apart (|t - 4| > 0.7 s), by velocity at the crossing itself,
+  // where the detections of both lie within each other's noise.
+  Detections det(5);
+  Tracker t;
+  const Eigen::Vector3d v_a(3, 0, 0), v_b(0, 3, 0);
+  auto a = [&](double s) -> Eigen::Vector3d { return Eigen::Vector3d(20, 0, 5) + v_a * (s - 4); };
+  auto b = [&](double s) -> Eigen::Vector3d { return Eigen::Vector3d(20, 0, 5) + v_b * (s - 4); };
+  int id_a = 0, id_b = 0;
+  for (int k = 0; k <= 80; ++k) {
+    const double s = k * 0.1;
+    std::vector<WorldMeasurement> z{det(b(s)), det(a(s))};
+    ASSERT_TRUE(t.update(frame_utime(k), z));
+    const auto out = t.confirmed(frame_utime(k));
+    if (k < 2) continue;
+    ASSERT_EQ(out.size(), 2u) << "frame " << k;
+    const bool by_position = std::abs(s - 4) > 0.7;
+    const bool first_is_a = by_position
+                                ? (out[0].p_target_in_world - a(s)).norm() < (out[1].p_target_in_world - a(s)).norm()
+                                : (out[0].v_target_in_world - v_a).norm() < (out[1].v_target_in_world - v_a).norm();
+    const int now_a = first_is_a ? out[0].track_id : out[1].track_id;
+    const int now_b = first_is_a ? out[1].track_id : out[0].track_id;
+    if (id_a == 0) {
+      id_a = now_a;
+      id_b = now_b;
+    }
+    EXPECT_EQ(now_a, id_a) << "frame " << k << " t " << s << (by_position ? " by position" : " by velocity") << "\n"
+                           << out[0].track_id << ": p " << out[0].p_target_in_world.transpose() << " v "
+                           << out[0].v_target_in_world.transpose() << "\n"
+                           << out[1].track_id << ": p " << out[1].p_target_in_world.transpose() << " v "
+                           << out[1].v_target_in_world.transpose();
+    EXPECT_EQ(now_b, id_b) << "frame " << k;
+  }
+  EXPECT_EQ(t.stats().confirmations, 2);
+  EXPECT_EQ(t.stats().merges, 0);
+}
+
+TEST(Tracker, DuplicateDetectionsOfOneTargetGiveOneTrack) {
+  // Every frame the same target is detected twice, 5 cm apart (two overlapping boxes): the spare
+  // detection keeps starting tentative tracks, which are never confirmed as a second target.
+  Tracker t;
+  for (int k = 0; k < 30; ++k) {
+    const Eigen::Vector3d p(15 + 0.2 * k, 0, 3);
+    ASSERT_TRUE(t.update(frame_utime(k), {meas(p, 0.2), meas(p + Eigen::Vector3d(0, 0.05, 0), 0.2)}));
+    const auto out = t.confirmed(frame_utime(k));
+    if (k < 2) continue;
+    ASSERT_EQ(out.size(), 1u) << "frame " << k;
+    EXPECT_EQ(out[0].track_id, 1);
+  }
+  EXPECT_EQ(t.stats().confirmations, 1);
+  EXPECT_GE(t.stats().merges, 1);
+}
+
+TEST(Tracker, TwoConfirmedTracksOfOneTargetMergeIntoTheOlderId) {
+  // Merging off: two targets 0.3 m apart with the same velocity become tracks 1 and 2. When merging
+  // is turned on (a fresh tracker with the same input), they are one target and keep id 1.
+  TrackerOptions off;
+  off.merge_chi2 = 0;
+  Tracker separate(off), merged;
+  for (int k = 0; k < 10; ++k) {
+    const Eigen::Vector3d p(15 + 0.2 * k, 0, 3);
+    const std::vector<WorldMeasurement> z{meas(p, 0.2), meas(p + Eigen::Vector3d(0, 0.3, 0), 0.2)};
+    separate.update(frame_utime(k), z);
+    merged.update(frame_utime(k), z);
+  }
+  EXPECT_EQ(separate.confirmed(frame_utime(9)).size(), 2u);
+  const auto out = merged.confirmed(frame_utime(9));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 1);
+}
+
+struct Rms {
+  double raw = 0, window = 0, kalman = 0;
+};
+
+// Runs the three estimators on the same detections of a target on the circle; RMS position error at
+// each frame's exposure time, after 3 s of settling, over 60 s.
+Rms rms_on_circle(double speed, unsigned seed) {
+  Detections det(seed);
+  TrackerOptions ko;
+  TrackerOptions wo;
+  wo.mode = "sliding_window";
+  Tracker kalman(ko), window(wo);
+  double se_raw = 0, se_window = 0, se_kalman = 0;
+  int n = 0;
+  for (int k = 0; k < 600; ++k) {
+    const double s = k * 0.1;
+    const Eigen::Vector3d truth = circle(s, speed);
+    const WorldMeasurement z = det(truth);
+    kalman.update(frame_utime(k), {z});
+    window.update(frame_utime(k), {z});
+    if (s < 3.0) continue;
+    const auto ok = kalman.confirmed(frame_utime(k));
+    const auto ow = window.confirmed(frame_utime(k));
+    EXPECT_EQ(ok.size(), 1u);
+    EXPECT_EQ(ow.size(), 1u);
+    if (ok.size() != 1 || ow.size() != 1) return {};
+    se_raw += (z.p_target_in_world - truth).squaredNorm();
+    se_window += (ow[0].p_target_in_world - truth).squaredNorm();
+    se_kalman += (ok[0].p_target_in_world - truth).squaredNorm();
+    ++n;
+  }
+  return {std::sqrt(se_raw / n), std::sqrt(se_window / n), std::sqrt(se_kalman / n)};
+}
+
+TEST(TrackerAccuracy, KalmanBeatsRawAndSlidingWindowAt0p5To5MetresPerSecond) {
+  for (const double speed : {0.5, 1.0, 2.0, 3.5, 5.0}) {
+    const Rms r = rms_on_circle(speed, 100 + static_cast<unsigned>(speed * 10));
+    std::printf("[ measured ] speed %.1f m/s: RMS raw %.3f m, sliding window (n_f=5) %.3f m, Kalman %.3f m\n", speed,
+                r.raw, r.window, r.kalman);
+    EXPECT_LT(r.kalman, r.raw) << "speed " << speed;
+    EXPECT_LT(r.kalman, r.window) << "speed " << speed;
+  }
+}
+
+// Detections arrive 0.3 s after exposure. At each "now", the newest processed image is 0.3 s old:
+// compare the track predicted to now (lag compensation) with the track at its source time, both
+// against the truth now. A straight 20 s pass at constant speed through (20, 0, 5) diagonally
+// across the line of sight; error along the direction of motion (bias) and RMS.
+TEST(TrackerAccuracy, LagCompensationRemovesTheVelocityTimesLatencyBias) {
+  const int64_t latency_us = 300'000;
+  for (const double speed : {0.5, 2.0, 5.0}) {
+    Detections det(77);
+    Tracker t;
+    const Eigen::Vector3d dir = Eigen::Vector3d(1, 1, 0).normalized();
+    auto truth = [&](int64_t utime) -> Eigen::Vector3d {
+      return Eigen::Vector3d(20, 0, 5) + dir * speed * (seconds(utime) - 10);
+    };
+    double bias_pred = 0, bias_raw = 0, se_pred = 0, se_raw = 0;
+    int n = 0, fresh = 0;
+    for (int k = 0; k < 200; ++k) {
+      const int64_t exposure = frame_utime(k);
+      t.update(exposure, {det(truth(exposure))});
+      const int64_t now = exposure + latency_us;
+      if (k < 30) continue;
+      const auto pred = t.confirmed(now);
+      const auto raw = t.confirmed(exposure);
+      ASSERT_EQ(pred.size(), 1u) << "frame " << k;
+      ASSERT_EQ(raw.size(), 1u) << "frame " << k;
+      EXPECT_EQ(pred[0].predicted_utime, now);
+      EXPECT_EQ(raw[0].predicted_utime, exposure);
+      fresh += pred[0].source_utime == exposure;
+      const Eigen::Vector3d e_pred = pred[0].p_target_in_world - truth(now);
+      const Eigen::Vector3d e_raw = raw[0].p_target_in_world - truth(now);
+      bias_pred += e_pred.dot(dir);
+      bias_raw += e_raw.dot(dir);
+      se_pred += e_pred.squaredNorm();
+      se_raw += e_raw.squaredNorm();
+      ++n;
+    }
+    bias_pred /= n;
+    bias_raw /= n;
+    const double rms_pred = std::sqrt(se_pred / n), rms_raw = std::sqrt(se_raw / n);
+    std::printf(
+        "[ measured ] lag 0.3 s, speed %.1f m/s: bias along track unpredicted %.3f m (-v*lag = %.3f), predicted "
+        "%.3f m; RMS unpredicted %.3f m, predicted %.3f m\n",
+        speed, bias_raw, -speed * 0.3, bias_pred, rms_raw, rms_pred);
+    EXPECT_GE(fresh, n * 95 / 100) << "detections should update the track (gate 99.9 %)";
+    EXPECT_NEAR(bias_raw, -speed * 0.3, 0.1 + 0.05 * speed);  // the lag bias is there without prediction
+    EXPECT_LT(std::abs(bias_pred), 0.1);                      // and gone with it
+    // Predicting 0.3 s ahead multiplies the velocity noise; it pays in RMS once v * lag dominates.
+    if (speed >= 2.0) {
+      EXPECT_LT(rms_pred, rms_raw);
+    }
+  }
+}
+
+TEST(Tracker, PredictionIsLimitedToTheHorizonAndNeverGoesBack) {
+  TrackerOptions o;
+  o.max_prediction_s = 0.5;
+  Tracker t(o);
+  for (int k = 0; k < 10; ++k) t.update(frame_utime(k), {meas({10 + 0.2 * k, 0, 0}, 0.01)});
+  const auto far = t.confirmed(frame_utime(9) + 2'000'000);
+  ASSERT_EQ(far.size(), 1u);
+  EXPECT_EQ(far[0].predicted_utime, frame_utime(9) + 500'000);
+  EXPECT_NEAR(far[0].p_target_in_world.x(), 11.8 + 0.5 * 2, 0.05);
+  const auto back = t.confirmed(frame_utime(5));
+  EXPECT_EQ(back[0].predicted_utime, frame_utime(9));
+}
+
+TEST(Tracker, SlidingWindowPublishesTheMeanOfTheLastNfMeasurements) {
+  TrackerOptions o;
+  o.mode = "sliding_window";
+  Tracker t(o);
+  for (int k = 0; k < 8; ++k) t.update(frame_utime(k), {meas({10 + 0.01 * k * k, 1, 2}, 0.1)});
+  const auto out = t.confirmed(frame_utime(7) + 300'000);
+  ASSERT_EQ(out.size(), 1u);
+  const double mean_x = 10 + 0.01 * (9 + 16 + 25 + 36 + 49) / 5.0;  // frames 3..7
+  EXPECT_NEAR(out[0].p_target_in_world.x(), mean_x, 1e-12);
+  EXPECT_NEAR(out[0].p_target_in_world.y(), 1, 1e-12);
+  EXPECT_NEAR(out[0].cov_p(0, 0), 0.01 / 5, 1e-15);
+  EXPECT_NEAR(out[0].v_target_in_world.x(), 0.01 * (49 - 9) / 0.4, 1e-9);
+  EXPECT_EQ(out[0].predicted_utime, frame_utime(7));  // not predicted: the thesis's behaviour
+}
+
+TEST(Tracker, MostConfidentModeFollowsTheBestDetectionAndPublishesOneTarget) {
+  // Each frame: the target (confidence 0.9) and a random false positive (0.5); twice a false
+  // positive with confidence 0.95 far away. Seed 9.
+  TrackerOptions o;
+  o.mode = "most_confident";
+  Tracker t(o);
+  Detections det(9);
+  std::uniform_real_distribution<double> u(-20, 20);
+  for (int k = 0; k < 50; ++k) {
+    const Eigen::Vector3d truth = circle(k * 0.1, 2.0);
+    std::vector<WorldMeasurement> z{det(truth, 0.9), meas({u(det.rng()) + 40, u(det.rng()), 5}, 0.5, 0.5)};
+    if (k == 20 || k == 35) z.push_back(meas({-30, 30, 10}, 0.5, 0.95));
+    ASSERT_TRUE(t.update(frame_utime(k), z));
+    const auto out = t.confirmed(frame_utime(k));
+    if (k < 2) continue;
+    ASSERT_EQ(out.size(), 1u) << "frame " << k;
+    EXPECT_EQ(out[0].track_id, 1);
+    EXPECT_LT((out[0].p_target_in_world - truth).norm(), 1.5) << "frame " << k;
+  }
+  EXPECT_EQ(t.stats().confirmations, 1);
+}
+
+}  // namespace
