@@ -156,6 +156,14 @@ bool Runtime::spin_once(int timeout_ms) {
   return !(stop_requested() || end_of_input_);
 }
 
+int Runtime::drain(int max_messages) {
+  if (input_is_file_) return 0;
+  int n = 0;
+  lcm::LCM& in = input();
+  while (n < max_messages && !stop_requested() && in.handleTimeout(0) > 0) ++n;
+  return n;
+}
+
 int Runtime::spin() {
   while (spin_once(100)) {
   }

@@ -52,6 +52,13 @@ void StatusTracker::input_dropped(const std::string& ch, const std::string& reas
   last_error_ = reason;
 }
 
+void StatusTracker::item_dropped(const std::string& ch, const std::string& reason) {
+  Channel& c = channel(ch, kIn);
+  ++c.drops;
+  ++drops_total_;
+  last_error_ = reason;
+}
+
 void StatusTracker::output(const std::string& ch, int64_t utime) {
   Channel& c = channel(ch, kOut);
   ++c.count;

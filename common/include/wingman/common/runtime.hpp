@@ -77,6 +77,10 @@ class Runtime {
   /// Handles incoming messages for up to `timeout_ms` and publishes the heartbeat when due.
   /// Returns false when the process should end: SIGINT/SIGTERM, request_stop(), or end of a file input.
   bool spin_once(int timeout_ms = 100);
+  /// Handles every message already waiting, without blocking (at most `max_messages`). A process
+  /// that keeps only the newest input calls it before working, so stale inputs are superseded.
+  /// Returns the number handled. Not for file inputs (there every message is handled in turn).
+  int drain(int max_messages = 1000);
   /// spin_once() until it returns false, then shutdown(). Returns 0.
   int spin();
   /// Sets the state to STOPPING with `reason` (default: the signal or end of input) and publishes a

@@ -28,6 +28,9 @@ class StatusTracker {
   void input(const std::string& channel, int64_t utime);
   /// An input message was dropped (could not be decoded or validated); `reason` names the channel and field.
   void input_dropped(const std::string& channel, const std::string& reason);
+  /// Part of a handled input could not be used (e.g. one box of a detections message); counts a drop
+  /// on `channel` without counting another message. `reason` names the field.
+  void item_dropped(const std::string& channel, const std::string& reason);
   /// A message was published. `utime`: its utime field.
   void output(const std::string& channel, int64_t utime);
   /// The source lost `count` frames before they reached `channel` (e.g. a V4L2 sequence gap).
