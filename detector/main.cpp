@@ -1,21 +1,95 @@
 // SPDX-License-Identifier: MIT
-// wingman-detector: camera images in, drone detections out (the CNN arrives with the detector issue).
+// wingman-detector: camera images in, drone detections out (Algorithm 2 on an OpenCL or CPU backend).
+#include "wingman/detector/detection_pipeline.hpp"
 #include "wingman/detector/detector_options.hpp"
+#include "wingman/detector/model_loader.hpp"
+#include "wingman/detector/preprocess.hpp"
 
 #include <wingman/common/runtime.hpp>
-#include <wingman/status_t.hpp>
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <optional>
+#include <stdexcept>
+
+namespace {
+
+using namespace wingman;
+
+/// Without weights: check and count images only (the state says why).
+int run_without_model(common::Runtime& rt, const detector::DetectorOptions& o, const common::ImageLimits& limits) {
+  rt.status().set_state(status_t::STATE_DEGRADED, "no model.weights configured: images are checked and counted only");
+  rt.subscribe<image_t>(
+      o.input_channel, [&rt](const image_t& img) { rt.status().set_last_processed_seq(img.seq); },
+      [limits](const image_t& img) { return common::validate_message(img, limits); });
+  return rt.spin();
+}
+
+int run(common::Runtime& rt, const detector::DetectorOptions& o) {
+  const common::ImageLimits limits{o.max_image_width, o.max_image_height};
+  rt.status().declare_output(o.output_channel);
+  if (o.weights.empty()) return run_without_model(rt, o, limits);
+
+  const detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
+  std::string why;
+  auto backend = detector::make_backend(o.backend, model, o.opencl, o.opencl.max_batch, &why);
+  spdlog::info("{}", why);
+  detector::DetectionPipeline pipeline(o.detection, std::move(backend), model);
+
+  auto detect_and_publish = [&](const image_t& img) {
+    std::string error;
+    const cv::Mat bgr = detector::image_to_bgr(img, &error);
+    if (!error.empty()) throw std::invalid_argument(error);
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<detector::Box> boxes = pipeline.detect(bgr);
+    const auto latency_us =
+        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+    detections_t out{};
+    out.utime = img.utime;
+    out.seq = img.seq;
+    out.camera_id = img.camera_id;
+    out.image_width = img.width;
+    out.image_height = img.height;
+    out.inference_latency_us = static_cast<int32_t>(latency_us);
+    for (const auto& b : boxes) out.detections.push_back({b.cx, b.cy, b.w, b.h, b.confidence, 0, b.zoom_refined});
+    out.num_detections = static_cast<int32_t>(out.detections.size());
+    rt.publish(o.output_channel, out);
+    rt.status().set_last_processed_seq(img.seq);
+  };
+  auto validate = [limits](const image_t& img) { return common::validate_message(img, limits); };
+
+  if (o.mode == "replay" || rt.input_is_file()) {
+    // Every frame, in order, inside its handler: deterministic, and lockstep-friendly.
+    rt.subscribe<image_t>(o.input_channel, detect_and_publish, validate);
+    return rt.spin();
+  }
+  // Real time: keep the newest frame; a frame superseded before it was processed is a counted drop.
+  std::optional<image_t> pending;
+  rt.subscribe<image_t>(
+      o.input_channel,
+      [&](const image_t& img) {
+        if (pending) rt.status().item_dropped(o.input_channel, "frame superseded by a newer one while busy");
+        pending = img;
+      },
+      validate);
+  while (rt.spin_once(100)) {
+    rt.drain();
+    if (!pending) continue;
+    const image_t img = std::move(*pending);
+    pending.reset();
+    try {
+      detect_and_publish(img);
+    } catch (const std::invalid_argument& e) {
+      rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + e.what());
+    }
+  }
+  return rt.shutdown();
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  using namespace wingman;
   const common::ProcessInfo info{"detector", "wingman-detector", "Detects drones in camera images (OpenCL CNN)"};
-  return common::run_process<detector::DetectorOptions>(
-      info, argc, argv, [](common::Runtime& rt, const detector::DetectorOptions& o) {
-        const common::ImageLimits limits{o.max_image_width, o.max_image_height};
-        rt.status().declare_output(o.output_channel);
-        rt.status().set_state(status_t::STATE_DEGRADED, "no detection model yet: images are checked and counted only");
-        rt.subscribe<image_t>(
-            o.input_channel, [&rt](const image_t& img) { rt.status().set_last_processed_seq(img.seq); },
-            [limits](const image_t& img) { return common::validate_message(img, limits); });
-        return rt.spin();
-      });
+  return common::run_process<detector::DetectorOptions>(info, argc, argv, run);
 }

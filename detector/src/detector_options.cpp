@@ -13,6 +13,10 @@ std::vector<std::string> DetectorOptions::validate() const {
   if (output_channel.empty()) p.push_back(problem("output.channel", output_channel, "must not be empty"));
   if (max_image_width < 1) p.push_back(problem("input.max_image_width", max_image_width, "must be >= 1"));
   if (max_image_height < 1) p.push_back(problem("input.max_image_height", max_image_height, "must be >= 1"));
+  if (mode != "realtime" && mode != "replay") p.push_back(problem("input.mode", mode, "must be realtime or replay"));
+  if (backend != "auto" && backend != "opencl" && backend != "cpu")
+    p.push_back(problem("model.backend", backend, "must be auto, opencl or cpu"));
+  for (const auto& part : {detection.validate(), opencl.validate()}) p.insert(p.end(), part.begin(), part.end());
   return p;
 }
 

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types), localize (one box
-// to 3D).
+// to 3D), predict (detector on images).
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
+#include "wingman/tools/predict.hpp"
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/spy.hpp"
 
@@ -83,6 +84,23 @@ int main(int argc, char** argv) {
                "With --image-size: scale the calibration to that size (a uniform resize) instead of failing");
   lo->add_flag("--json", localize.json, "Print one JSON object");
 
+  PredictOptions predict;
+  auto* pr = app.add_subcommand(
+      "predict", "Run the detector on image files or folders; write YOLO-format labels (and drawn images)");
+  pr->add_option("inputs", predict.inputs, "Image files and/or folders of images")->required();
+  pr->add_option("--cfg", predict.cfg,
+                 "Darknet .cfg (default: the built-in thesis network, models/tiny-yolo-thesis.cfg)");
+  pr->add_option("--weights", predict.weights, "Darknet .weights")->required();
+  pr->add_option("--backend", predict.backend, "Inference backend: auto (default), opencl or cpu");
+  pr->add_option("--out", predict.out_dir, "Output folder for <stem>.txt (default predictions)");
+  pr->add_flag("--draw", predict.draw, "Also write <stem>.pred.jpg with the boxes drawn");
+  pr->add_option("--p-thresh", predict.detection.p_thresh, "Confidence threshold (default 0.2)");
+  pr->add_option("--o-thresh", predict.detection.o_thresh, "Non-max suppression IoU threshold (default 0.2)");
+  pr->add_flag("--subsquare", predict.detection.subsquare, "Detect in the centred h x h square of a wide image");
+  pr->add_flag("--zoom-in", predict.detection.zoom_in, "Re-detect in full-resolution crops around detections");
+  pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
+  pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -104,6 +122,7 @@ int main(int argc, char** argv) {
     }
     if (*s) return run_spy(spy);
     if (*lo) return run_localize(localize, std::cout, std::cerr);
+    if (*pr) return run_predict(predict, std::cout, std::cerr);
     if (*mv) {
       make_video(video);
       std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;

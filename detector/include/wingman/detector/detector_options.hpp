@@ -2,25 +2,41 @@
 // Options of wingman-detector (config/detector.yaml).
 #pragma once
 
+#include "wingman/detector/detection_pipeline.hpp"
+#include "wingman/detector/opencl_options.hpp"
+
 #include <string>
 #include <vector>
 
 namespace wingman::detector {
 
-/// Options of the detector process. The CNN and its OpenCL backend arrive with the detector issue;
-/// until then the process checks and counts images and publishes no detections.
+/// Options of the detector process.
 struct DetectorOptions {
   std::string input_channel = "IMAGE_CAM0";        ///< image_t input channel
   std::string output_channel = "DETECTIONS_CAM0";  ///< detections_t output channel
   int max_image_width = 8192;                      ///< larger images are dropped and counted, pixels
   int max_image_height = 8192;                     ///< pixels
+  /// realtime: when busy, keep only the newest frame (older ones are dropped and counted);
+  /// replay: process every frame in order (deterministic; for logs and lockstep replays).
+  std::string mode = "realtime";
+  std::string cfg;      ///< Darknet .cfg; "" = the built-in thesis network (models/tiny-yolo-thesis.cfg)
+  std::string weights;  ///< Darknet .weights; "" = no model: images are checked and counted, nothing is detected
+  std::string backend = "auto";  ///< auto | opencl | cpu
+  DetectorPipelineOptions detection;
+  OpenClOptions opencl;
 
   template <class V>
   void visit(V& v) {
     v("input.channel", input_channel, "image_t channel to read camera frames from");
-    v("output.channel", output_channel, "detections_t channel to publish detections on");
     v("input.max_image_width", max_image_width, "wider images are dropped and counted, pixels");
     v("input.max_image_height", max_image_height, "taller images are dropped and counted, pixels");
+    v("input.mode", mode, "realtime (newest frame when busy, drops counted) or replay (every frame, deterministic)");
+    v("output.channel", output_channel, "detections_t channel to publish detections on");
+    v("model.cfg", cfg, "Darknet .cfg; \"\" = built-in thesis network (models/tiny-yolo-thesis.cfg)");
+    v("model.weights", weights, "Darknet .weights; \"\" = no model (images are checked and counted only)");
+    v("model.backend", backend, "auto (OpenCL GPU if any, else the faster of opencl/cpu here), opencl or cpu");
+    detection.visit(v);
+    opencl.visit(v);
   }
   std::vector<std::string> validate() const;
 };

@@ -1,0 +1,21 @@
+// SPDX-License-Identifier: MIT
+// A detection box (centre, size, confidence) and its intersection over union.
+#pragma once
+
+namespace wingman::detector {
+
+/// One detection. Coordinates are pixels of the image the box refers to (network input, crop or full
+/// image, as each function says); the origin is the top-left corner of the top-left pixel.
+struct Box {
+  float cx = 0.0f;            ///< centre x, pixels
+  float cy = 0.0f;            ///< centre y, pixels
+  float w = 0.0f;             ///< width, pixels (>= 0)
+  float h = 0.0f;             ///< height, pixels (>= 0)
+  float confidence = 0.0f;    ///< objectness x class probability, 0..1
+  bool zoom_refined = false;  ///< true when the box comes from a zoom-in re-detection (Algorithm 2)
+};
+
+/// Intersection over union of two boxes in the same pixel frame, 0..1 (0 when both are empty).
+float iou(const Box& a, const Box& b);
+
+}  // namespace wingman::detector

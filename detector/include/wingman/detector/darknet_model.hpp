@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: MIT
+// A Darknet network in memory: the layers of a .cfg with their shapes and (after loading) weights.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace wingman::detector {
+
+/// Layer kinds the detector supports (Darknet section names in brackets).
+enum class LayerType {
+  kConvolutional,  ///< [convolutional]
+  kMaxpool,        ///< [maxpool]
+  kRegion,         ///< [region] (YOLOv2 head)
+  kRoute,          ///< [route]
+  kUpsample,       ///< [upsample]
+  kYolo,           ///< [yolo] (YOLOv3 head)
+};
+
+enum class Activation { kLinear, kLeaky, kLogistic };
+
+/// A tensor shape, channels-first: C x H x W (batch is separate).
+struct Shape {
+  int c = 0;
+  int h = 0;
+  int w = 0;
+  int64_t size() const { return static_cast<int64_t>(c) * h * w; }
+  bool operator==(const Shape& o) const { return c == o.c && h == o.h && w == o.w; }
+};
+
+/// One layer of the network, with its parameters as Darknet computes them.
+struct Layer {
+  LayerType type = LayerType::kConvolutional;
+  int cfg_line = 0;  ///< line of the section header in the .cfg (for messages)
+  Shape input;       ///< shape of the layer's input (for route: of its output)
+  Shape output;      ///< shape of the layer's output
+
+  // [convolutional]
+  int filters = 0;
+  int size = 1;  ///< kernel size (square)
+  int stride = 1;
+  int padding = 0;  ///< pixels of zero padding on each side (pad=1 means size/2)
+  bool batch_normalize = false;
+  Activation activation = Activation::kLinear;
+  // Weights as stored in a .weights file (float32). With batch_normalize: biases = beta,
+  // scales = gamma, rolling_mean, rolling_variance; without: biases only. weights: OIHW.
+  std::vector<float> biases, scales, rolling_mean, rolling_variance, weights;
+
+  // [maxpool]: output = (input + padding - size) / stride + 1, padding defaults to size - 1
+  // (Darknet pads the right/bottom edge, so size 2 stride 1 keeps the spatial size).
+  int pool_size = 2;
+  int pool_stride = 2;
+  int pool_padding = 1;
+
+  // [route]: absolute indices of the layers whose outputs are concatenated along channels.
+  std::vector<int> route_layers;
+  // [upsample]: nearest-neighbour factor.
+  int upsample_stride = 2;
+
+  // [region] / [yolo]
+  std::vector<float> anchors;  ///< all anchors (w, h pairs): grid cells for [region], pixels for [yolo]
+  std::vector<int> mask;       ///< [yolo]: which anchors this head uses
+  int classes = 1;
+  int num = 5;  ///< anchors per cell ([region]: num; [yolo]: mask size)
+};
+
+/// The [net] section: input size and the training settings (kept for the trainer).
+struct NetParams {
+  int width = 416;
+  int height = 416;
+  int channels = 3;
+  std::map<std::string, std::string> other;  ///< every other [net] key as written (batch, learning_rate, ...)
+};
+
+/// A whole network. Shapes are computed when the .cfg is parsed; weights are empty until loaded.
+struct DarknetModel {
+  NetParams net;
+  std::vector<Layer> layers;
+  std::string cfg_path;  ///< for messages
+  // .weights header
+  int32_t major = 0;
+  int32_t minor = 2;
+  int32_t revision = 0;
+  uint64_t seen = 0;  ///< images seen in training (uint64 when major*10+minor >= 2, else uint32)
+
+  /// Number of float32 values a .weights file must hold after its header.
+  int64_t weight_count() const;
+  /// Multiply-adds x 2 of one forward pass at the net's input size (convolutions only), FLOP.
+  double flops() const;
+};
+
+}  // namespace wingman::detector

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: MIT
+// Algorithm 2 of the thesis: subsquare, resize, detect, NMS, optional zoom-in re-detection.
+#pragma once
+
+#include "wingman/detector/backend.hpp"
+#include "wingman/detector/box.hpp"
+#include "wingman/detector/darknet_model.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace wingman::detector {
+
+/// Options of the detection pipeline (keys under `detection.` in config/detector.yaml).
+struct DetectorPipelineOptions {
+  double p_thresh = 0.2;       ///< confidence threshold: boxes with confidence < p_thresh are dropped, 0..1
+  double o_thresh = 0.2;       ///< NMS overlap threshold (Algorithm 1): IoU > o_thresh suppresses, 0..1
+  bool subsquare = false;      ///< detect in the centred h x h square of a wider image instead of the whole image
+  bool zoom_in = false;        ///< re-detect in a network-sized full-resolution crop around each detection
+  std::string policy = "all";  ///< which detections to return: "all" or "most_confident"
+  int max_detections = 10;     ///< at most this many boxes per image (and zoom-in crops), >= 1
+
+  template <class V>
+  void visit(V& v) {
+    v("detection.p_thresh", p_thresh, "confidence threshold, boxes below it are dropped (0..1)");
+    v("detection.o_thresh", o_thresh, "non-max suppression: IoU above this suppresses the less confident box (0..1)");
+    v("detection.subsquare", subsquare, "detect in the centred h x h square of a wider image (Algorithm 2)");
+    v("detection.zoom_in", zoom_in, "re-detect in a full-resolution network-sized crop around each detection");
+    v("detection.policy", policy, "all or most_confident");
+    v("detection.max_detections", max_detections, "at most this many boxes per image (>= 1)");
+  }
+  /// One "key = value: rule" line per invalid field; empty when valid.
+  std::vector<std::string> validate() const;
+};
+
+/// Algorithm 2, on one BGR image at a time, with any InferenceBackend whose network ends in [region]:
+///  1. region = the whole image, or with `subsquare` its centred min(w, h) square;
+///  2. stretch the region to the network input (bilinear), run the backend, decode the [region] output,
+///     keep confidence >= p_thresh;
+///  3. non-max suppression (Algorithm 1, o_thresh); apply `policy` and `max_detections`;
+///  4. with `zoom_in`: for each kept detection, a network-sized crop of the full-resolution image centred
+///     on it and clamped inside the image (zoom_crop()); all crops run as batches of up to
+///     backend.max_batch(); in each crop the most confident re-detection (>= p_thresh) replaces the
+///     detection (zoom_refined = true). When a crop finds nothing, the original box is kept unchanged
+///     (zoom_refined = false). The refined boxes go through NMS once more (two crops may find the same
+///     drone);
+///  5. boxes are returned in full-image pixels, most confident first.
+/// Buffers (network input batch, output tensor, box lists, resize scratch) are allocated at construction;
+/// detect() allocates only the returned vector (and a new image size's resize scratch).
+class DetectionPipeline {
+ public:
+  /// @param options  validated here (std::invalid_argument listing every problem).
+  /// @param backend  not null; its input_shape() must be the model's net size and its output_shape() the
+  ///                 [region] layer's input (std::invalid_argument otherwise).
+  /// @param model    the network the backend runs; must end in [region] (the anchors are taken from it).
+  DetectionPipeline(DetectorPipelineOptions options, std::unique_ptr<InferenceBackend> backend,
+                    const DarknetModel& model);
+
+  /// Detects drones in `bgr_image` (CV_8UC3, any size >= 1 x 1; std::invalid_argument otherwise).
+  /// Returns boxes in full-image pixels, most confident first.
+  std::vector<Box> detect(const cv::Mat& bgr_image);
+
+  const DetectorPipelineOptions& options() const { return options_; }
+  InferenceBackend& backend() { return *backend_; }
+
+ private:
+  /// Runs `count` images already in input_ through the backend and decodes image i's boxes (>= p_thresh,
+  /// network pixels) into candidates_[i].
+  void run_and_decode(int count);
+
+  DetectorPipelineOptions options_;
+  std::unique_ptr<InferenceBackend> backend_;
+  Layer region_;                              ///< the [region] layer (anchors, num, classes, input shape)
+  cv::Size net_size_;                         ///< network input, pixels
+  int batch_capacity_ = 1;                    ///< images input_ holds: min(max_batch, max_detections), >= 1
+  std::vector<float> input_;                  ///< batch_capacity_ x 3 x H x W network inputs
+  std::vector<float> output_;                 ///< raw output tensor of the last forward()
+  std::vector<std::vector<Box>> candidates_;  ///< per batch slot: decoded boxes
+  std::vector<Box> detections_;               ///< current detections, full-image pixels
+  std::vector<cv::Rect> crops_;               ///< zoom-in crops, full-image pixels
+  cv::Mat resized_;                           ///< resize scratch
+};
+
+}  // namespace wingman::detector

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: MIT
+// Tiny-YOLO inference on OpenCL: our own kernels on a 16-channel blocked layout (see docs/detector.md).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "wingman/detector/backend.hpp"
+#include "wingman/detector/darknet_model.hpp"
+#include "wingman/detector/opencl_options.hpp"
+
+namespace wingman::detector {
+
+/// Runs a DarknetModel ([convolutional] with batch normalisation folded in and bias + activation fused,
+/// [maxpool], [route], [upsample]; [region]/[yolo] heads pass their input through, decoding stays on the
+/// host) on one OpenCL 1.2 device.
+///
+/// Everything is prepared in the constructor: device selection, program builds (PoCL caches binaries
+/// under POCL_CACHE_DIR), weight folding and packing, every buffer for `max_batch` images and every
+/// kernel's arguments. forward() only enqueues: it allocates nothing on the device.
+class OpenClBackend : public InferenceBackend {
+ public:
+  /// Throws std::invalid_argument if the options are invalid or the model has a layer this backend
+  /// does not run or weights of the wrong size, std::runtime_error naming the available platforms and
+  /// devices if none matches, or an OpenCL build/runtime error with the build log.
+  OpenClBackend(const DarknetModel& model, const OpenClOptions& options);
+  ~OpenClBackend() override;
+  OpenClBackend(const OpenClBackend&) = delete;
+  OpenClBackend& operator=(const OpenClBackend&) = delete;
+
+  std::string name() const override;  ///< "opencl: <device name>"
+  Shape input_shape() const override;
+  Shape output_shape() const override;
+  int max_batch() const override;
+  /// input: `batch` CHW float images, contiguous; output resized to batch x output_shape().
+  /// Precondition: 1 <= batch <= max_batch(). Throws std::invalid_argument otherwise.
+  void forward(const float* input, int batch, std::vector<float>& output) override;
+
+  /// The selected device, e.g. "pthread-skylake-avx512-Intel(R) Xeon(R) Processor".
+  std::string device_name() const;
+  /// True when the selected device is a GPU (CL_DEVICE_TYPE_GPU).
+  bool is_gpu() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace wingman::detector

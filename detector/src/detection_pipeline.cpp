@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: MIT
+// Algorithm 2: the detection pipeline around an InferenceBackend.
+#include "wingman/detector/detection_pipeline.hpp"
+
+#include "wingman/detector/nms.hpp"
+#include "wingman/detector/preprocess.hpp"
+#include "wingman/detector/region_decode.hpp"
+
+#include <wingman/common/config.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace wingman::detector {
+
+std::vector<std::string> DetectorPipelineOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (!(p_thresh >= 0.0 && p_thresh <= 1.0)) p.push_back(problem("detection.p_thresh", p_thresh, "must be in 0..1"));
+  if (!(o_thresh >= 0.0 && o_thresh <= 1.0)) p.push_back(problem("detection.o_thresh", o_thresh, "must be in 0..1"));
+  if (policy != "all" && policy != "most_confident")
+    p.push_back(problem("detection.policy", policy, "must be all or most_confident"));
+  if (max_detections < 1) p.push_back(problem("detection.max_detections", max_detections, "must be >= 1"));
+  return p;
+}
+
+DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::unique_ptr<InferenceBackend> backend,
+                                     const DarknetModel& model)
+    : options_(std::move(options)), backend_(std::move(backend)) {
+  const std::vector<std::string> problems = options_.validate();
+  if (!problems.empty()) {
+    std::string all;
+    for (const auto& p : problems) all += (all.empty() ? "" : "; ") + p;
+    throw std::invalid_argument("DetectorPipelineOptions: " + all);
+  }
+  if (!backend_) throw std::invalid_argument("DetectionPipeline: backend is null");
+  if (model.layers.empty() || model.layers.back().type != LayerType::kRegion)
+    throw std::invalid_argument(fmt::format("DetectionPipeline: {} must end in a [region] layer", model.cfg_path));
+  region_ = model.layers.back();
+  net_size_ = cv::Size(model.net.width, model.net.height);
+  const Shape in = backend_->input_shape();
+  if (!(in == Shape{3, model.net.height, model.net.width}))
+    throw std::invalid_argument(fmt::format("DetectionPipeline: backend {} takes {}x{}x{}, the model 3x{}x{}",
+                                            backend_->name(), in.c, in.h, in.w, model.net.height, model.net.width));
+  const Shape out = backend_->output_shape();
+  if (!(out == region_.input))
+    throw std::invalid_argument(
+        fmt::format("DetectionPipeline: backend {} outputs {}x{}x{}, the [region] needs {}x{}x{}", backend_->name(),
+                    out.c, out.h, out.w, region_.input.c, region_.input.h, region_.input.w));
+  if (backend_->max_batch() < 1)
+    throw std::invalid_argument(
+        fmt::format("DetectionPipeline: backend {} has max_batch {}", backend_->name(), backend_->max_batch()));
+  batch_capacity_ = options_.zoom_in ? std::max(1, std::min(backend_->max_batch(), options_.max_detections)) : 1;
+  input_.resize(static_cast<size_t>(batch_capacity_) * in.size());
+  output_.resize(static_cast<size_t>(batch_capacity_) * out.size());
+  candidates_.resize(batch_capacity_);
+  const size_t per_image = static_cast<size_t>(out.h) * out.w * region_.num;
+  for (auto& c : candidates_) c.reserve(per_image);
+  detections_.reserve(per_image);
+  crops_.reserve(options_.max_detections);
+  resized_.create(net_size_, CV_8UC3);
+}
+
+void DetectionPipeline::run_and_decode(int count) {
+  backend_->forward(input_.data(), count, output_);
+  const size_t per_image = static_cast<size_t>(region_.input.size());
+  for (int i = 0; i < count; ++i) {
+    candidates_[i].clear();
+    decode_region(output_.data() + i * per_image, region_.input, region_, net_size_.width, net_size_.height,
+                  static_cast<float>(options_.p_thresh), candidates_[i]);
+  }
+}
+
+std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
+  if (bgr_image.empty() || bgr_image.type() != CV_8UC3)
+    throw std::invalid_argument(fmt::format("DetectionPipeline::detect: image {}x{} type {}: must be non-empty CV_8UC3",
+                                            bgr_image.cols, bgr_image.rows, bgr_image.type()));
+  const float o_thresh = static_cast<float>(options_.o_thresh);
+  const size_t input_size = static_cast<size_t>(backend_->input_shape().size());
+
+  // Steps 1-2: subsquare, resize, detect (Algorithm 2).
+  const cv::Rect roi = detection_region(bgr_image.size(), options_.subsquare);
+  to_network_input(bgr_image, roi, net_size_, resized_, input_.data());
+  run_and_decode(1);
+  // Step 3: NMS (Algorithm 1), policy, cap.
+  non_max_suppression(candidates_[0], o_thresh);
+  const size_t keep = options_.policy == "most_confident" ? 1 : static_cast<size_t>(options_.max_detections);
+  if (candidates_[0].size() > keep) candidates_[0].resize(keep);
+  detections_.clear();
+  for (const Box& b : candidates_[0]) detections_.push_back(network_to_image(b, roi, net_size_));
+
+  // Step 4: zoom-in re-detection, crops in batches.
+  if (options_.zoom_in && !detections_.empty()) {
+    crops_.clear();
+    for (const Box& b : detections_) crops_.push_back(zoom_crop(bgr_image.size(), net_size_, b.cx, b.cy));
+    for (size_t first = 0; first < crops_.size(); first += batch_capacity_) {
+      const int count = static_cast<int>(std::min(crops_.size() - first, static_cast<size_t>(batch_capacity_)));
+      for (int i = 0; i < count; ++i)
+        to_network_input(bgr_image, crops_[first + i], net_size_, resized_, input_.data() + i * input_size);
+      run_and_decode(count);
+      for (int i = 0; i < count; ++i) {
+        const std::vector<Box>& found = candidates_[i];
+        if (found.empty()) continue;  // nothing re-detected: keep the original box, zoom_refined stays false
+        const Box* best = &found[0];
+        for (const Box& b : found)
+          if (b.confidence > best->confidence) best = &b;
+        Box refined = network_to_image(*best, crops_[first + i], net_size_);
+        refined.zoom_refined = true;
+        detections_[first + i] = refined;
+      }
+    }
+    non_max_suppression(detections_, o_thresh);
+  }
+  return detections_;
+}
+
+}  // namespace wingman::detector

@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: MIT
+// Darknet .cfg / .weights: thesis network shapes and FLOPs, round trips, and errors that name the problem.
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <functional>
+
+namespace wingman::detector {
+namespace {
+
+DarknetModel thesis() { return parse_darknet_cfg(testing::source_path("models/tiny-yolo-thesis.cfg")); }
+
+std::string message_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const DarknetFormatError& e) {
+    return e.what();
+  }
+  return "(no DarknetFormatError)";
+}
+
+TEST(DarknetCfg, ThesisNetworkShapes) {
+  const DarknetModel m = thesis();
+  ASSERT_EQ(m.layers.size(), 16u);
+  EXPECT_EQ(m.net.width, 416);
+  EXPECT_EQ(m.net.height, 416);
+  EXPECT_EQ(m.net.channels, 3);
+  EXPECT_EQ(m.layers[0].output, (Shape{16, 416, 416}));
+  EXPECT_EQ(m.layers[1].output, (Shape{16, 208, 208}));
+  EXPECT_EQ(m.layers[9].output, (Shape{256, 13, 13}));
+  // Maxpool size 2 stride 1 with Darknet's padding keeps 13 x 13.
+  EXPECT_EQ(m.layers[11].type, LayerType::kMaxpool);
+  EXPECT_EQ(m.layers[11].pool_padding, 1);
+  EXPECT_EQ(m.layers[11].output, (Shape{512, 13, 13}));
+  EXPECT_EQ(m.layers[14].output, (Shape{30, 13, 13}));
+  EXPECT_EQ(m.layers[14].activation, Activation::kLinear);
+  EXPECT_FALSE(m.layers[14].batch_normalize);
+  const Layer& region = m.layers[15];
+  EXPECT_EQ(region.type, LayerType::kRegion);
+  EXPECT_EQ(region.num, 5);
+  EXPECT_EQ(region.classes, 1);
+  ASSERT_EQ(region.anchors.size(), 10u);
+  EXPECT_FLOAT_EQ(region.anchors[4], 6.63f);
+  EXPECT_EQ(m.net.other.at("batch"), "64");
+  EXPECT_EQ(m.net.other.at("subdivisions"), "8");
+  EXPECT_EQ(m.net.other.at("learning_rate"), "0.001");
+}
+
+TEST(DarknetCfg, ThesisFlopsAre6Point94Giga) {
+  // The thesis quotes 6.94 GFLOP per 416 x 416 frame (Darknet's count: 2 x multiply-adds of the convolutions).
+  EXPECT_NEAR(thesis().flops() / 1e9, 6.94, 0.005);
+}
+
+TEST(DarknetCfg, ThesisWeightCount) {
+  const DarknetModel m = thesis();
+  int64_t expected = 0;
+  int c = 3;
+  for (int f : {16, 32, 64, 128, 256, 512, 1024, 1024}) {
+    expected += 4 * f + static_cast<int64_t>(f) * c * 9;
+    c = f;
+  }
+  expected += 30 + 30 * 1024;
+  EXPECT_EQ(m.weight_count(), expected);
+}
+
+TEST(DarknetCfg, WriteThenParseRoundTrips) {
+  const DarknetModel a = thesis();
+  const std::string text = write_darknet_cfg(a);
+  const DarknetModel b = parse_darknet_cfg_string(text, "written.cfg");
+  EXPECT_EQ(write_darknet_cfg(b), text);
+  ASSERT_EQ(a.layers.size(), b.layers.size());
+  for (size_t i = 0; i < a.layers.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(a.layers[i].type, b.layers[i].type);
+    EXPECT_EQ(a.layers[i].input, b.layers[i].input);
+    EXPECT_EQ(a.layers[i].output, b.layers[i].output);
+    EXPECT_EQ(a.layers[i].anchors, b.layers[i].anchors);
+    EXPECT_EQ(a.layers[i].padding, b.layers[i].padding);
+    EXPECT_EQ(a.layers[i].activation, b.layers[i].activation);
+  }
+  EXPECT_EQ(a.net.other, b.net.other);
+}
+
+TEST(DarknetCfg, ModernTinyLayersRouteUpsampleYolo) {
+  // Odd sizes on purpose: 45 x 37 input.
+  const std::string cfg = R"([net]
+width=45
+height=37
+channels=3
+[convolutional]
+batch_normalize=1
+filters=8
+size=3
+stride=2
+pad=1
+activation=leaky
+[maxpool]
+size=2
+stride=2
+[convolutional]
+filters=18
+size=1
+stride=1
+pad=1
+activation=linear
+[yolo]
+mask=0,1,2
+anchors=10,14, 23,27, 37,58
+classes=1
+num=3
+[route]
+layers=-3
+[upsample]
+stride=2
+[route]
+layers=-2,1
+)";
+  const DarknetModel m = parse_darknet_cfg_string(cfg, "tiny.cfg");
+  ASSERT_EQ(m.layers.size(), 7u);
+  EXPECT_EQ(m.layers[0].output, (Shape{8, 19, 23}));  // (37 + 2 - 3) / 2 + 1 = 19, (45 + 2 - 3) / 2 + 1 = 23
+  EXPECT_EQ(m.layers[1].output, (Shape{8, 10, 12}));  // (19 + 1 - 2) / 2 + 1 = 10, (23 + 1 - 2) / 2 + 1 = 12
+  EXPECT_EQ(m.layers[2].output, (Shape{18, 10, 12}));
+  EXPECT_EQ(m.layers[3].num, 3);
+  EXPECT_EQ(m.layers[4].route_layers, std::vector<int>{1});
+  EXPECT_EQ(m.layers[5].output, (Shape{8, 20, 24}));
+  EXPECT_EQ(m.layers[6].output, (Shape{16, 10, 12}));
+  EXPECT_EQ(parse_darknet_cfg_string(write_darknet_cfg(m)).layers[6].route_layers, (std::vector<int>{4, 1}));
+}
+
+TEST(DarknetCfg, UnsupportedKeyNamesFileLineAndKey) {
+  const std::string cfg = "[net]\nwidth=32\nheight=32\n\n[convolutional]\nfilters=4\nsize=3\ndilation=2\n";
+  const std::string msg = message_of([&] { parse_darknet_cfg_string(cfg, "bad.cfg"); });
+  EXPECT_NE(msg.find("bad.cfg:8"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("dilation"), std::string::npos) << msg;
+}
+
+TEST(DarknetCfg, UnsupportedSectionAndBadValueAreErrors) {
+  EXPECT_NE(message_of([] { parse_darknet_cfg_string("[net]\n[shortcut]\nfrom=-3\n", "s.cfg"); }).find("s.cfg:2"),
+            std::string::npos);
+  const std::string msg =
+      message_of([] { parse_darknet_cfg_string("[net]\n[convolutional]\nfilters=4\nactivation=mish\n", "a.cfg"); });
+  EXPECT_NE(msg.find("a.cfg:4"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("mish"), std::string::npos) << msg;
+  // A region whose input channels do not match num x (5 + classes).
+  const std::string region = message_of([] {
+    parse_darknet_cfg_string("[net]\nwidth=32\nheight=32\n[convolutional]\nfilters=29\n[region]\nanchors=1,1\nnum=1\n",
+                             "r.cfg");
+  });
+  EXPECT_NE(region.find("r.cfg:6"), std::string::npos) << region;
+}
+
+TEST(DarknetWeights, WriteThenReadIsBitIdentical) {
+  testing::TempDir dir;
+  DarknetModel a = thesis();
+  a.seen = 123456789012ull;
+  randomize_weights(a, 7);
+  save_darknet_weights(a, dir.file("w.weights"));
+  DarknetModel b = thesis();
+  load_darknet_weights(b, dir.file("w.weights"));
+  EXPECT_EQ(b.seen, a.seen);
+  EXPECT_EQ(b.major, a.major);
+  EXPECT_EQ(b.minor, a.minor);
+  for (size_t i = 0; i < a.layers.size(); ++i) {
+    SCOPED_TRACE(i);
+    const Layer& x = a.layers[i];
+    const Layer& y = b.layers[i];
+    for (auto [p, q] : {std::pair{&x.biases, &y.biases},
+                        {&x.scales, &y.scales},
+                        {&x.rolling_mean, &y.rolling_mean},
+                        {&x.rolling_variance, &y.rolling_variance},
+                        {&x.weights, &y.weights}}) {
+      ASSERT_EQ(p->size(), q->size());
+      EXPECT_EQ(std::memcmp(p->data(), q->data(), p->size() * 4), 0);
+    }
+  }
+  EXPECT_EQ(serialize_darknet_weights(a), serialize_darknet_weights(b));
+  std::ifstream f(dir.file("w.weights"), std::ios::binary | std::ios::ate);
+  EXPECT_EQ(static_cast<int64_t>(f.tellg()), 20 + 4 * a.weight_count());
+}
+
+TEST(DarknetWeights, OldHeaderHas32BitSeen) {
+  DarknetModel m = parse_darknet_cfg_string("[net]\nwidth=9\nheight=7\n[convolutional]\nfilters=3\nsize=3\n");
+  m.major = 0;
+  m.minor = 1;
+  m.seen = 77;
+  randomize_weights(m, 3);
+  const std::vector<char> bytes = serialize_darknet_weights(m);
+  EXPECT_EQ(static_cast<int64_t>(bytes.size()), 16 + 4 * m.weight_count());
+  DarknetModel n = parse_darknet_cfg_string("[net]\nwidth=9\nheight=7\n[convolutional]\nfilters=3\nsize=3\n");
+  load_darknet_weights_from_buffer(n, bytes, "old.weights");
+  EXPECT_EQ(n.seen, 77u);
+  EXPECT_EQ(n.layers[0].weights, m.layers[0].weights);
+}
+
+TEST(DarknetWeights, WrongLengthNamesExpectedAndActualSize) {
+  testing::TempDir dir;
+  DarknetModel a = thesis();
+  randomize_weights(a, 1);
+  std::vector<char> bytes = serialize_darknet_weights(a);
+  const size_t expected = bytes.size();
+  bytes.resize(bytes.size() - 8);
+  {
+    std::ofstream out(dir.file("short.weights"), std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  DarknetModel b = thesis();
+  const std::string msg = message_of([&] { load_darknet_weights(b, dir.file("short.weights")); });
+  EXPECT_NE(msg.find("short.weights"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected " + std::to_string(expected) + " bytes"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("got " + std::to_string(expected - 8) + " bytes"), std::string::npos) << msg;
+}
+
+TEST(DarknetWeights, RandomizeIsDeterministicAndRealistic) {
+  DarknetModel a = thesis();
+  DarknetModel b = thesis();
+  randomize_weights(a, 42);
+  randomize_weights(b, 42);
+  EXPECT_EQ(serialize_darknet_weights(a), serialize_darknet_weights(b));
+  for (const Layer& l : a.layers) {
+    if (l.type != LayerType::kConvolutional) continue;
+    for (float v : l.rolling_variance) EXPECT_GT(v, 0.0f);
+    for (float g : l.scales) EXPECT_NEAR(g, 1.0f, 0.21f);
+  }
+  EXPECT_THROW(serialize_darknet_weights(thesis()), DarknetFormatError);  // never loaded
+}
+
+}  // namespace
+}  // namespace wingman::detector

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+// IoU and non-maximum suppression (Algorithm 1) on hand-computed cases.
+#include <wingman/detector/nms.hpp>
+
+#include <gtest/gtest.h>
+
+namespace wingman::detector {
+namespace {
+
+Box box(float cx, float cy, float w, float h, float conf) { return Box{cx, cy, w, h, conf, false}; }
+
+TEST(Iou, HandCases) {
+  EXPECT_FLOAT_EQ(iou(box(5, 5, 10, 10, 1), box(5, 5, 10, 10, 1)), 1.0f);
+  // Shifted by half a width: intersection 5 x 10 = 50, union 150.
+  EXPECT_FLOAT_EQ(iou(box(5, 5, 10, 10, 1), box(10, 5, 10, 10, 1)), 50.0f / 150.0f);
+  EXPECT_FLOAT_EQ(iou(box(0, 0, 2, 2, 1), box(2, 0, 2, 2, 1)), 0.0f);  // touching edges
+  EXPECT_FLOAT_EQ(iou(box(0, 0, 0, 0, 1), box(0, 0, 0, 0, 1)), 0.0f);  // empty
+}
+
+TEST(Nms, KeepsMostConfidentAndSortsDescending) {
+  std::vector<Box> b = {box(10, 10, 10, 10, 0.5f), box(12, 10, 10, 10, 0.9f), box(100, 100, 8, 8, 0.7f),
+                        box(11, 11, 10, 10, 0.3f)};
+  non_max_suppression(b, 0.2f);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_FLOAT_EQ(b[0].confidence, 0.9f);
+  EXPECT_FLOAT_EQ(b[1].confidence, 0.7f);
+}
+
+TEST(Nms, SuppressesOnlyAboveThreshold) {
+  // IoU of these two is exactly 1/3.
+  std::vector<Box> b = {box(5, 5, 10, 10, 0.4f), box(10, 5, 10, 10, 0.6f)};
+  non_max_suppression(b, 1.0f / 3.0f + 1e-4f);
+  EXPECT_EQ(b.size(), 2u);
+  non_max_suppression(b, 0.3f);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_FLOAT_EQ(b[0].confidence, 0.6f);
+}
+
+TEST(Nms, ASuppressedBoxDoesNotSuppressOthers) {
+  // A (0.9) suppresses B (0.8); B would suppress C (0.7), but B is gone, and C does not overlap A enough.
+  std::vector<Box> b = {box(0, 0, 10, 10, 0.9f), box(6, 0, 10, 10, 0.8f), box(12, 0, 10, 10, 0.7f)};
+  non_max_suppression(b, 0.2f);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_FLOAT_EQ(b[0].confidence, 0.9f);
+  EXPECT_FLOAT_EQ(b[1].confidence, 0.7f);
+}
+
+TEST(Nms, EmptyInput) {
+  std::vector<Box> b;
+  non_max_suppression(b, 0.2f);
+  EXPECT_TRUE(b.empty());
+}
+
+}  // namespace
+}  // namespace wingman::detector

@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: MIT
+// wingman-detector as a process, file to file, with random weights written by our own writer:
+// one detections_t per good frame carrying the frame's utime and seq; bad frames dropped and counted;
+// the same input gives the same detections (but for the measured latency) run after run.
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <wingman/detections_t.hpp>
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+#include <wingman/detector/model_loader.hpp>
+#include <wingman/image_t.hpp>
+#include <wingman/status_t.hpp>
+
+#include <fstream>
+#include <iostream>
+
+namespace {
+
+using namespace std::chrono_literals;
+using wingman::testing::bin_path;
+using wingman::testing::LogEvent;
+using wingman::testing::read_log;
+using wingman::testing::run;
+using wingman::testing::TempDir;
+
+constexpr int kFrames = 6;
+
+/// Random weights for the built-in thesis network (fixed seed).
+std::string write_random_weights(const TempDir& dir) {
+  auto model = wingman::detector::parse_darknet_cfg_string(wingman::detector::builtin_thesis_cfg(), "thesis");
+  wingman::detector::randomize_weights(model, 7);
+  const std::string path = dir.file("random.weights");
+  wingman::detector::save_darknet_weights(model, path);
+  return path;
+}
+
+/// kFrames camera frames (the real camera driver, fast mode) plus one impossible and one garbage image.
+std::string write_input_log(const TempDir& dir) {
+  const std::string video = dir.file("clip.avi");
+  wingman::testing::write_test_video(video, kFrames, 320, 240, 30.0);
+  const std::string cfg = dir.file("cam.yaml");
+  std::ofstream(cfg) << "source: {kind: file}\nfile: {path: " << video
+                     << ", mode: fast, start_utime: 1700000000000000}\n";
+  const std::string frames = dir.file("frames.lcmlog");
+  const auto r =
+      run({bin_path("wingman-camera-driver"), "--config", cfg, "--lcm-out", "file://" + frames + "?mode=w"}, 30s);
+  if (r.exit_code != 0) throw std::runtime_error(r.err);
+  std::vector<LogEvent> events;
+  for (auto& e : read_log(frames)) {
+    if (e.channel == "IMAGE_CAM0") events.push_back(e);
+  }
+  wingman::image_t bad{};
+  bad.utime = 1700000001000000;
+  bad.width = 320;
+  bad.height = 240;
+  bad.stride = 100;  // shorter than a row of BGR8
+  bad.pixel_format = wingman::image_t::BGR8;
+  bad.data.assign(100 * 240, 0);
+  bad.size = static_cast<int32_t>(bad.data.size());
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", bad, 1));
+  events.push_back({2, "IMAGE_CAM0", {9, 9, 9}});
+  const std::string path = dir.file("in.lcmlog");
+  wingman::testing::write_log(path, events);
+  return path;
+}
+
+struct DetectorRun {
+  std::vector<wingman::detections_t> detections;
+  wingman::status_t status;
+};
+
+DetectorRun run_detector(const TempDir& dir, const std::string& in, const std::string& weights,
+                         const std::string& backend, const std::string& name) {
+  const std::string cfg = dir.file(name + ".yaml");
+  std::ofstream(cfg) << "model: {weights: " << weights << ", backend: " << backend << "}\ninput: {mode: replay}\n";
+  const std::string out = dir.file(name + ".lcmlog");
+  const auto r = run({bin_path("wingman-detector"), "--config", cfg, "--lcm-in", "file://" + in + "?speed=0",
+                      "--lcm-out", "file://" + out + "?mode=w"},
+                     120s);
+  if (r.exit_code != 0) throw std::runtime_error("detector failed: " + r.err);
+  DetectorRun result;
+  for (const auto& e : read_log(out)) {
+    if (e.channel == "DETECTIONS_CAM0") {
+      wingman::detections_t d;
+      d.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+      result.detections.push_back(d);
+    } else if (e.channel == "STATUS_DETECTOR") {
+      result.status.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+    }
+  }
+  return result;
+}
+
+TEST(DetectorProcess, OpenClBackendPublishesOneDetectionsPerGoodFrameAndCountsBadOnes) {
+  TempDir dir;
+  const std::string weights = write_random_weights(dir);
+  const std::string in = write_input_log(dir);
+  const DetectorRun a = run_detector(dir, in, weights, "opencl", "a");
+  ASSERT_EQ(a.detections.size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    const auto& d = a.detections[i];
+    EXPECT_EQ(d.seq, i);
+    EXPECT_EQ(d.utime, 1700000000000000 + static_cast<int64_t>(i * 1e6 / 30.0 + 0.5));
+    EXPECT_EQ(d.image_width, 320);
+    EXPECT_EQ(d.image_height, 240);
+    EXPECT_GT(d.inference_latency_us, 0);
+    for (const auto& b : d.detections) {
+      EXPECT_GE(b.confidence, 0.2f);  // detection.p_thresh
+      EXPECT_GT(b.w, 0.0f);
+    }
+  }
+  EXPECT_EQ(a.status.drops_total, 2) << a.status.last_error;
+  int boxes = 0;
+  for (const auto& d : a.detections) boxes += d.num_detections;
+  std::cout << "random-weight network: " << boxes << " boxes in " << kFrames << " frames\n";
+
+  // Same input, same detections (inference_latency_us is the one wall-clock field).
+  const DetectorRun b = run_detector(dir, in, weights, "opencl", "b");
+  ASSERT_EQ(b.detections.size(), a.detections.size());
+  for (size_t i = 0; i < a.detections.size(); ++i) {
+    ASSERT_EQ(b.detections[i].num_detections, a.detections[i].num_detections) << "frame " << i;
+    for (int k = 0; k < a.detections[i].num_detections; ++k) {
+      EXPECT_EQ(b.detections[i].detections[k].cx, a.detections[i].detections[k].cx);
+      EXPECT_EQ(b.detections[i].detections[k].confidence, a.detections[i].detections[k].confidence);
+    }
+  }
+}
+
+TEST(DetectorProcess, CpuBackendHandlesTheSameStream) {
+  TempDir dir;
+  const DetectorRun c = run_detector(dir, write_input_log(dir), write_random_weights(dir), "cpu", "c");
+  EXPECT_EQ(c.detections.size(), static_cast<size_t>(kFrames));
+  EXPECT_EQ(c.status.drops_total, 2) << c.status.last_error;
+}
+
+TEST(DetectorProcess, MissingWeightsFileIsAOneLineErrorNamingIt) {
+  TempDir dir;
+  const std::string cfg = dir.file("d.yaml");
+  std::ofstream(cfg) << "model: {weights: /nonexistent/x.weights, backend: cpu}\n";
+  const auto r = run({bin_path("wingman-detector"), "--config", cfg, "--lcm-url", "memq://"}, 30s);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("wingman-detector: error:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent/x.weights"), std::string::npos) << r.err;
+}
+
+}  // namespace

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: MIT
+// `wingman predict`: detector on image files -> YOLO-format text files (and drawn images).
+#include "wingman/tools/predict.hpp"
+
+#include <fmt/format.h>
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+#include <wingman/detector/model_loader.hpp>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+namespace wingman::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_image(const fs::path& p) {
+  static const std::set<std::string> kExt = {".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".ppm", ".pgm"};
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return kExt.count(ext) > 0;
+}
+
+}  // namespace
+
+int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& err) {
+  const std::string prefix = "wingman predict: error: ";
+  const std::vector<std::string> problems = options.detection.validate();
+  if (!problems.empty()) {
+    for (const auto& p : problems) err << prefix << p << "\n";
+    return 2;
+  }
+  if (options.weights.empty()) {
+    err << prefix << "--weights is required\n";
+    return 2;
+  }
+  if (options.backend != "cpu" && options.backend != "opencl" && options.backend != "auto") {
+    err << prefix << fmt::format("--backend = '{}': must be auto, opencl or cpu", options.backend) << "\n";
+    return 2;
+  }
+  std::vector<fs::path> images;
+  for (const std::string& in : options.inputs) {
+    std::error_code ec;
+    if (fs::is_directory(in, ec)) {
+      std::vector<fs::path> found;
+      for (const auto& e : fs::directory_iterator(in, ec))
+        if (e.is_regular_file() && is_image(e.path())) found.push_back(e.path());
+      std::sort(found.begin(), found.end());
+      images.insert(images.end(), found.begin(), found.end());
+    } else if (fs::is_regular_file(in, ec)) {
+      images.emplace_back(in);
+    } else {
+      err << prefix << fmt::format("input '{}': no such file or folder", in) << "\n";
+      return 2;
+    }
+  }
+  if (images.empty()) {
+    err << prefix << "no input images\n";
+    return 2;
+  }
+
+  std::unique_ptr<detector::DetectionPipeline> pipeline;
+  try {
+    const detector::DarknetModel model = detector::load_model(options.cfg, options.weights);
+    const int batch = options.detection.zoom_in ? std::min(8, options.detection.max_detections) : 1;
+    std::string why;
+    auto backend = detector::make_backend(options.backend, model, detector::OpenClOptions{}, batch, &why);
+    err << "wingman predict: " << why << "\n";
+    pipeline = std::make_unique<detector::DetectionPipeline>(options.detection, std::move(backend), model);
+    fs::create_directories(options.out_dir);
+  } catch (const std::exception& e) {
+    err << prefix << e.what() << "\n";
+    return 1;
+  }
+
+  int failures = 0;
+  for (const fs::path& path : images) {
+    const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
+    if (bgr.empty()) {
+      err << prefix << fmt::format("{}: cannot read the image", path.string()) << "\n";
+      ++failures;
+      continue;
+    }
+    const std::vector<detector::Box> boxes = pipeline->detect(bgr);
+    const fs::path txt = fs::path(options.out_dir) / (path.stem().string() + ".txt");
+    std::ofstream f(txt);
+    const double W = bgr.cols, H = bgr.rows;
+    for (const detector::Box& b : boxes)
+      f << fmt::format("0 {:.6f} {:.6f} {:.6f} {:.6f} {:.6f}\n", b.cx / W, b.cy / H, b.w / W, b.h / H, b.confidence);
+    f.close();
+    if (!f) {
+      err << prefix << fmt::format("{}: cannot write", txt.string()) << "\n";
+      ++failures;
+      continue;
+    }
+    if (options.draw) {
+      cv::Mat drawn = bgr.clone();
+      for (const detector::Box& b : boxes) {
+        const cv::Point p0(cvRound(b.cx - b.w / 2), cvRound(b.cy - b.h / 2));
+        const cv::Point p1(cvRound(b.cx + b.w / 2), cvRound(b.cy + b.h / 2));
+        const cv::Scalar colour = b.zoom_refined ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255);
+        cv::rectangle(drawn, p0, p1, colour, 2);
+        cv::putText(drawn, fmt::format("{:.2f}", b.confidence), p0 + cv::Point(0, -4), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                    colour, 1);
+      }
+      const fs::path jpg = fs::path(options.out_dir) / (path.stem().string() + ".pred.jpg");
+      if (!cv::imwrite(jpg.string(), drawn)) {
+        err << prefix << fmt::format("{}: cannot write", jpg.string()) << "\n";
+        ++failures;
+      }
+    }
+    out << fmt::format("{}: {} detection(s) -> {}", path.string(), boxes.size(), txt.string()) << "\n";
+  }
+  return failures == 0 ? 0 : 1;
+}
+
+}  // namespace wingman::tools
