@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: MIT
+// wingman-detector in real-time mode on a live bus: when frames arrive faster than it can detect, it
+// keeps the newest, drops and counts the superseded ones, and never falls behind. Runs in a private
+// network namespace (ctest wraps it in tools/netns_run.sh).
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <wingman/detections_t.hpp>
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+#include <wingman/detector/model_loader.hpp>
+#include <wingman/image_t.hpp>
+#include <wingman/status_t.hpp>
+
+#include <csignal>
+#include <fstream>
+
+namespace {
+
+using namespace std::chrono_literals;
+
+struct Bus {
+  std::vector<wingman::detections_t> detections;
+  wingman::status_t status;
+  bool have_status = false;
+  void on_detections(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    wingman::detections_t d;
+    if (d.decode(rbuf->data, 0, rbuf->data_size) >= 0) detections.push_back(d);
+  }
+  void on_status(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    if (status.decode(rbuf->data, 0, rbuf->data_size) >= 0) have_status = true;
+  }
+};
+
+/// Handles messages until `done()` or the deadline; returns done().
+template <class Pred>
+bool spin_until(lcm::LCM& lcm, Pred done, std::chrono::seconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (!done() && std::chrono::steady_clock::now() < deadline) lcm.handleTimeout(20);
+  return done();
+}
+
+TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
+  wingman::testing::TempDir dir;
+  auto model = wingman::detector::parse_darknet_cfg_string(wingman::detector::builtin_thesis_cfg(), "thesis");
+  wingman::detector::randomize_weights(model, 7);
+  wingman::detector::save_darknet_weights(model, dir.file("random.weights"));
+  const std::string cfg = dir.file("detector.yaml");
+  std::ofstream(cfg) << "model: {weights: " << dir.file("random.weights")
+                     << ", backend: cpu}\ninput: {mode: realtime}\n";
+
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM lcm(url);
+  ASSERT_TRUE(lcm.good());
+  Bus bus;
+  lcm.subscribe("DETECTIONS_CAM0", &Bus::on_detections, &bus);
+  lcm.subscribe("STATUS_DETECTOR", &Bus::on_status, &bus);
+  wingman::testing::Child detector(
+      {wingman::testing::bin_path("wingman-detector"), "--lcm-url", url, "--config", cfg, "--status-period", "0.2"});
+  ASSERT_TRUE(spin_until(
+      lcm, [&] { return bus.have_status; }, 30s))
+      << detector.err();
+
+  // 20 frames at once: far faster than ~100 ms per frame on the CPU backend.
+  constexpr int kFrames = 20;
+  for (int i = 0; i < kFrames; ++i) {
+    wingman::image_t img{};
+    img.utime = 1700000000000000 + i * 33333;
+    img.seq = i;
+    img.width = 64;
+    img.height = 48;
+    img.stride = 64 * 3;
+    img.pixel_format = wingman::image_t::BGR8;
+    img.data.assign(static_cast<size_t>(img.stride) * img.height, static_cast<uint8_t>(10 * i));
+    img.size = static_cast<int32_t>(img.data.size());
+    lcm.publish("IMAGE_CAM0", &img);
+  }
+  // Every frame is accounted for: detected or superseded.
+  const bool settled = spin_until(
+      lcm,
+      [&] {
+        return bus.status.messages_handled == kFrames &&
+               static_cast<int64_t>(bus.detections.size()) + bus.status.drops_total == kFrames;
+      },
+      60s);
+  ASSERT_TRUE(settled) << "handled " << bus.status.messages_handled << ", detections " << bus.detections.size()
+                       << ", drops " << bus.status.drops_total << "; " << detector.err();
+  EXPECT_GT(bus.status.drops_total, 0) << "the detector kept up with a burst; the test proves nothing";
+  EXPECT_LT(bus.detections.size(), static_cast<size_t>(kFrames));
+  // The newest frame is always processed, and detections come out in order.
+  ASSERT_FALSE(bus.detections.empty());
+  EXPECT_EQ(bus.detections.back().seq, kFrames - 1);
+  for (size_t i = 1; i < bus.detections.size(); ++i) EXPECT_GT(bus.detections[i].seq, bus.detections[i - 1].seq);
+  EXPECT_NE(bus.status.last_error.find("superseded"), std::string::npos) << bus.status.last_error;
+
+  detector.signal(SIGTERM);
+  EXPECT_EQ(detector.wait(5s), 0) << detector.err();
+}
+
+}  // namespace
