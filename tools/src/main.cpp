@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types), localize (one box
-// to 3D), predict (detector on images).
+// to 3D), predict (detector on images), bench detector (detector timings).
+#include "wingman/tools/bench.hpp"
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
@@ -101,6 +102,22 @@ int main(int argc, char** argv) {
   pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
   pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
 
+  BenchDetectorOptions bench_detector;
+  auto* be = app.add_subcommand("bench", "Benchmarks (numbers, not tests)");
+  be->require_subcommand(1);
+  auto* bd = be->add_subcommand(
+      "detector", "Thesis network per frame: OpenCL vs CpuBackend vs bare OpenCV DNN, and the whole pipeline");
+  bd->add_option("--sizes", bench_detector.sizes, "Network input sizes, multiples of 32 (default 416,320,256)")
+      ->delimiter(',');
+  bd->add_option("--threads", bench_detector.threads,
+                 "OpenCV thread counts (default 1,2); OpenCL: POCL_MAX_PTHREAD_COUNT")
+      ->delimiter(',');
+  bd->add_option("--repetitions", bench_detector.repetitions, "Timed runs per row (default 7)");
+  bd->add_option("--warmup", bench_detector.warmup, "Untimed runs before each row (default 2)");
+  bd->add_option("--weights", bench_detector.weights, "Darknet .weights (default: random weights, fixed seed)");
+  bd->add_option("--seed", bench_detector.seed, "Seed of the random weights (default 42)");
+  bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -123,6 +140,7 @@ int main(int argc, char** argv) {
     if (*s) return run_spy(spy);
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);
+    if (*bd) return run_bench_detector_verb(bench_detector, std::cout, std::cerr);
     if (*mv) {
       make_video(video);
       std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;

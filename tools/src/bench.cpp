@@ -1,0 +1,480 @@
+// SPDX-License-Identifier: MIT
+// `wingman bench detector`: the thesis network per frame on OpenCL, CpuBackend and bare OpenCV DNN; the pipeline.
+#include "wingman/tools/bench.hpp"
+
+#include <fmt/format.h>
+#include <wingman/detector/cpu_backend.hpp>
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+#include <wingman/detector/detection_pipeline.hpp>
+#include <wingman/detector/model_loader.hpp>
+#include <wingman/detector/opencl_backend.hpp>
+#include <wingman/detector/opencl_device.hpp>
+#include <wingman/detector/preprocess.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/core/version.hpp>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+namespace wingman::tools {
+
+namespace {
+
+using detector::DarknetModel;
+using detector::InferenceBackend;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+TimingMs summarize(std::vector<double> ms) {
+  TimingMs t;
+  if (ms.empty()) return t;
+  std::sort(ms.begin(), ms.end());
+  const size_t n = ms.size();
+  t.median = n % 2 == 1 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+  t.min = ms.front();
+  t.max = ms.back();
+  t.runs = static_cast<int>(n);
+  return t;
+}
+
+/// `warmup` untimed then `repetitions` timed calls of `fn`, milliseconds each.
+TimingMs time_runs(int warmup, int repetitions, const std::function<void()>& fn) {
+  for (int i = 0; i < warmup; ++i) fn();
+  std::vector<double> ms;
+  for (int i = 0; i < repetitions; ++i) {
+    const auto t0 = Clock::now();
+    fn();
+    ms.push_back(ms_since(t0));
+  }
+  return summarize(ms);
+}
+
+std::string env_or_unset(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? std::string(v) : std::string("(unset)");
+}
+
+std::string cpu_model_name() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(" \t", colon + 1));
+    }
+  }
+  return "(unknown)";
+}
+
+/// The thesis network at `size` x `size`: the built-in cfg with [net] width/height changed.
+DarknetModel thesis_model(int size, const BenchDetectorOptions& o) {
+  DarknetModel m =
+      detector::parse_darknet_cfg_string(detector::builtin_thesis_cfg(), "<built-in tiny-yolo-thesis.cfg>");
+  m.net.width = size;
+  m.net.height = size;
+  detector::compute_shapes(m);
+  if (o.weights.empty())
+    detector::randomize_weights(m, o.seed);
+  else
+    detector::load_darknet_weights(m, o.weights);
+  return m;
+}
+
+/// Frame `i` of the synthetic stream: a diagonal grey-blue gradient with a dark blob (a drone-ish
+/// silhouette) moving left to right.
+cv::Mat synthetic_frame(int width, int height, int i) {
+  cv::Mat bgr(height, width, CV_8UC3);
+  for (int y = 0; y < height; ++y) {
+    auto* row = bgr.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < width; ++x) {
+      const int g = 90 + 120 * (x + y) / (width + height);
+      row[x] = cv::Vec3b(static_cast<uchar>(std::min(255, g + 40)), static_cast<uchar>(g), static_cast<uchar>(g - 20));
+    }
+  }
+  const cv::Point centre(width / 4 + (i * width / 16) % (width / 2), height / 2);
+  const int r = std::max(4, height / 12);
+  cv::ellipse(bgr, centre, cv::Size(r * 2, r / 2), 0, 0, 360, cv::Scalar(25, 25, 30), cv::FILLED);
+  cv::circle(bgr, centre - cv::Point(r * 2, r / 2), r / 2, cv::Scalar(20, 20, 20), cv::FILLED);
+  cv::circle(bgr, centre + cv::Point(r * 2, -r / 2), r / 2, cv::Scalar(20, 20, 20), cv::FILLED);
+  return bgr;
+}
+
+/// Counts and times the forwards of the backend it wraps (the pipeline owns it; the stats outlive it).
+struct ForwardStats {
+  double ms = 0;
+  int64_t calls = 0;
+  int64_t images = 0;
+};
+
+class TimedBackend : public InferenceBackend {
+ public:
+  TimedBackend(std::unique_ptr<InferenceBackend> inner, ForwardStats* stats)
+      : inner_(std::move(inner)), stats_(stats) {}
+  std::string name() const override { return inner_->name(); }
+  detector::Shape input_shape() const override { return inner_->input_shape(); }
+  detector::Shape output_shape() const override { return inner_->output_shape(); }
+  int max_batch() const override { return inner_->max_batch(); }
+  void forward(const float* input, int batch, std::vector<float>& output) override {
+    const auto t0 = Clock::now();
+    inner_->forward(input, batch, output);
+    stats_->ms += ms_since(t0);
+    stats_->calls += 1;
+    stats_->images += batch;
+  }
+
+ private:
+  std::unique_ptr<InferenceBackend> inner_;
+  ForwardStats* stats_;
+};
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20)
+          out += fmt::format("\\u{:04x}", static_cast<int>(c));
+        else
+          out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_timing(const TimingMs& t) {
+  return fmt::format("{{\"median\": {:.4f}, \"min\": {:.4f}, \"max\": {:.4f}, \"runs\": {}}}", t.median, t.min, t.max,
+                     t.runs);
+}
+
+ForwardResult forward_row(const std::string& backend, int size, int threads, const std::string& note) {
+  ForwardResult r;
+  r.backend = backend;
+  r.size = size;
+  r.threads = threads;
+  r.threads_note = note;
+  return r;
+}
+
+/// The OpenCL thread count PoCL's pthread device uses: POCL_MAX_PTHREAD_COUNT, else all cores.
+int pocl_threads(int cores) {
+  const char* v = std::getenv("POCL_MAX_PTHREAD_COUNT");
+  if (v) {
+    const int n = std::atoi(v);
+    if (n > 0) return std::min(n, cores);
+  }
+  return cores;
+}
+
+}  // namespace
+
+std::vector<std::string> BenchDetectorOptions::validate() const {
+  std::vector<std::string> p;
+  if (sizes.empty()) p.push_back("sizes = (empty): give at least one size");
+  for (const int s : sizes)
+    if (s < 32 || s % 32 != 0) p.push_back(fmt::format("sizes = {}: each must be a multiple of 32, >= 32", s));
+  if (threads.empty()) p.push_back("threads = (empty): give at least one thread count");
+  for (const int t : threads)
+    if (t < 1) p.push_back(fmt::format("threads = {}: each must be >= 1", t));
+  if (repetitions < 1) p.push_back(fmt::format("repetitions = {}: must be >= 1", repetitions));
+  if (warmup < 0) p.push_back(fmt::format("warmup = {}: must be >= 0", warmup));
+  if (stream_width < 32) p.push_back(fmt::format("stream_width = {}: must be >= 32", stream_width));
+  if (stream_height < 32) p.push_back(fmt::format("stream_height = {}: must be >= 32", stream_height));
+  if (pipeline_max_batch < 1) p.push_back(fmt::format("pipeline_max_batch = {}: must be >= 1", pipeline_max_batch));
+  return p;
+}
+
+BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostream* progress) {
+  BenchDetectorReport report;
+  report.repetitions = o.repetitions;
+  report.warmup = o.warmup;
+  report.stream_width = o.stream_width;
+  report.stream_height = o.stream_height;
+  report.weights = o.weights.empty() ? fmt::format("random (seed {})", o.seed) : o.weights;
+  MachineInfo& m = report.machine;
+  m.cpu_model = cpu_model_name();
+  m.cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  try {
+    m.opencl_devices = detector::list_opencl_devices();
+  } catch (const std::exception& e) {
+    m.opencl_devices.push_back(std::string("(none: ") + e.what() + ")");
+  }
+  m.pocl_affinity = env_or_unset("POCL_AFFINITY");
+  m.pocl_max_pthread_count = env_or_unset("POCL_MAX_PTHREAD_COUNT");
+  m.opencv_version = CV_VERSION;
+
+  const int saved_threads = cv::getNumThreads();
+  const int max_threads = *std::max_element(o.threads.begin(), o.threads.end());
+  const int ocl_threads = pocl_threads(m.cores);
+  const std::string ocl_note = fmt::format("POCL_MAX_PTHREAD_COUNT={}", m.pocl_max_pthread_count);
+  auto say = [&](const std::string& line) {
+    if (progress) *progress << "wingman bench detector: " << line << std::endl;
+  };
+
+  std::vector<cv::Mat> stream;
+  for (int i = 0; i < 8; ++i) stream.push_back(synthetic_frame(o.stream_width, o.stream_height, i));
+
+  for (const int size : o.sizes) {
+    const DarknetModel model = thesis_model(size, o);
+    const double flops = model.flops();
+    const cv::Size net(size, size);
+    // The same frame for every backend: our CHW input, and the net-sized BGR image for bare cv::dnn.
+    std::vector<float> chw(static_cast<size_t>(3) * size * size);
+    cv::Mat resized;
+    detector::to_network_input(stream[0], cv::Rect(0, 0, o.stream_width, o.stream_height), net, resized, chw.data());
+    cv::Mat net_bgr;
+    cv::resize(stream[0], net_bgr, net, 0, 0, cv::INTER_LINEAR);
+
+    auto finish = [&](ForwardResult r) {
+      if (r.error.empty() && r.ms.median > 0) r.gflop_per_s = flops / (r.ms.median * 1e-3) * 1e-9;
+      say(r.error.empty()
+              ? fmt::format("{:>10} {} px, {} thread(s): median {:.2f} ms", r.backend, size, r.threads, r.ms.median)
+              : fmt::format("{:>10} {} px: {}", r.backend, size, r.error));
+      report.forward.push_back(std::move(r));
+    };
+
+    // Bare OpenCV DNN: readNetFromDarknet on the same cfg + weights bytes, blobFromImage + forward timed.
+    const std::string cfg_text = detector::write_darknet_cfg(model);
+    const std::vector<char> weight_bytes = detector::serialize_darknet_weights(model);
+    for (const int t : o.threads) {
+      ForwardResult r = forward_row("opencv-dnn", size, t, "cv::setNumThreads");
+      try {
+        cv::setNumThreads(t);
+        cv::dnn::Net dnn =
+            cv::dnn::readNetFromDarknet(cfg_text.data(), cfg_text.size(), weight_bytes.data(), weight_bytes.size());
+        dnn.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+        dnn.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+        cv::Mat out;
+        r.ms = time_runs(o.warmup, o.repetitions, [&] {
+          dnn.setInput(cv::dnn::blobFromImage(net_bgr, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F));
+          out = dnn.forward();
+        });
+      } catch (const std::exception& e) {
+        r.error = e.what();
+      }
+      finish(std::move(r));
+    }
+    // CpuBackend (our wrapper of cv::dnn).
+    for (const int t : o.threads) {
+      ForwardResult r = forward_row("cpu", size, t, "cv::setNumThreads");
+      try {
+        cv::setNumThreads(t);
+        detector::CpuBackend backend(model, 1);
+        r.device = backend.name();
+        std::vector<float> out;
+        r.ms = time_runs(o.warmup, o.repetitions, [&] { backend.forward(chw.data(), 1, out); });
+      } catch (const std::exception& e) {
+        r.error = e.what();
+      }
+      finish(std::move(r));
+    }
+    // OpenCL: PoCL fixes its thread count at platform init, so once, with the environment's count.
+    {
+      ForwardResult r = forward_row("opencl", size, ocl_threads, ocl_note);
+      try {
+        detector::OpenClOptions ocl;
+        ocl.max_batch = 1;
+        detector::OpenClBackend backend(model, ocl);
+        r.device = backend.device_name();
+        std::vector<float> out;
+        r.ms = time_runs(o.warmup, o.repetitions, [&] { backend.forward(chw.data(), 1, out); });
+      } catch (const std::exception& e) {
+        r.error = e.what();
+      }
+      finish(std::move(r));
+    }
+  }
+  // Speed-up vs bare OpenCV DNN at the same size and thread count (OpenCL: the DNN row with its thread
+  // count, else the one with the most threads).
+  for (ForwardResult& r : report.forward) {
+    if (!r.error.empty() || r.ms.median <= 0) continue;
+    const ForwardResult* best = nullptr;
+    for (const ForwardResult& d : report.forward) {
+      if (d.backend != "opencv-dnn" || d.size != r.size || !d.error.empty() || d.ms.median <= 0) continue;
+      if (d.threads == r.threads) {
+        best = &d;
+        break;
+      }
+      if (r.backend == "opencl" && (!best || d.threads > best->threads)) best = &d;
+    }
+    if (best) r.speedup_vs_dnn = best->ms.median / r.ms.median;
+  }
+
+  // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on.
+  cv::setNumThreads(max_threads);
+  for (const int size : o.sizes) {
+    const DarknetModel model = thesis_model(size, o);
+    for (const std::string kind : {"opencl", "cpu"}) {
+      for (const bool zoom : {false, true}) {
+        PipelineResult r;
+        r.backend = kind;
+        r.size = size;
+        r.threads = kind == "opencl" ? ocl_threads : max_threads;
+        r.zoom_in = zoom;
+        try {
+          ForwardStats stats;
+          std::unique_ptr<InferenceBackend> inner;
+          if (kind == "opencl") {
+            detector::OpenClOptions ocl;
+            ocl.max_batch = o.pipeline_max_batch;
+            inner = std::make_unique<detector::OpenClBackend>(model, ocl);
+          } else {
+            inner = std::make_unique<detector::CpuBackend>(model, o.pipeline_max_batch);
+          }
+          detector::DetectorPipelineOptions popt;
+          popt.zoom_in = zoom;
+          detector::DetectionPipeline pipeline(popt, std::make_unique<TimedBackend>(std::move(inner), &stats), model);
+          size_t frame = 0;
+          int64_t boxes = 0;
+          for (int i = 0; i < o.warmup; ++i) pipeline.detect(stream[frame++ % stream.size()]);
+          stats = ForwardStats{};
+          std::vector<double> ms;
+          for (int i = 0; i < o.repetitions; ++i) {
+            const auto t0 = Clock::now();
+            boxes += static_cast<int64_t>(pipeline.detect(stream[frame++ % stream.size()]).size());
+            ms.push_back(ms_since(t0));
+          }
+          r.ms = summarize(ms);
+          double total = 0;
+          for (const double v : ms) total += v;
+          const double n = o.repetitions;
+          r.frames_per_s = r.ms.median > 0 ? 1000.0 / r.ms.median : 0;
+          r.forwards_per_frame = static_cast<double>(stats.calls) / n;
+          r.images_per_frame = static_cast<double>(stats.images) / n;
+          r.detections_per_frame = static_cast<double>(boxes) / n;
+          r.non_forward_share = total > 0 ? std::max(0.0, (total - stats.ms) / total) : 0;
+          say(fmt::format("pipeline {} {} px zoom-in {}: median {:.2f} ms/frame", kind, size, zoom ? "on" : "off",
+                          r.ms.median));
+        } catch (const std::exception& e) {
+          r.error = e.what();
+          say(fmt::format("pipeline {} {} px zoom-in {}: {}", kind, size, zoom ? "on" : "off", r.error));
+        }
+        report.pipeline.push_back(std::move(r));
+      }
+    }
+  }
+  cv::setNumThreads(saved_threads);
+  return report;
+}
+
+std::string BenchDetectorReport::table() const {
+  std::ostringstream s;
+  s << "wingman bench detector: thesis network (built-in cfg), weights " << weights << "\n";
+  s << fmt::format("machine: {}, {} cores; OpenCV {}\n", machine.cpu_model, machine.cores, machine.opencv_version);
+  for (const auto& d : machine.opencl_devices) s << "OpenCL device: " << d << "\n";
+  s << fmt::format("POCL_AFFINITY={}  POCL_MAX_PTHREAD_COUNT={}\n", machine.pocl_affinity,
+                   machine.pocl_max_pthread_count);
+  s << fmt::format("{} warm-up + {} timed runs per row; ms per frame (batch 1)\n\n", warmup, repetitions);
+  s << fmt::format("{:<11} {:>5} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8}\n", "backend", "size", "threads", "median", "min",
+                   "max", "GFLOP/s", "vs DNN");
+  for (const ForwardResult& r : forward) {
+    if (!r.error.empty()) {
+      s << fmt::format("{:<11} {:>5} {:>7}  error: {}\n", r.backend, r.size, r.threads, r.error);
+      continue;
+    }
+    s << fmt::format("{:<11} {:>5} {:>6}{} {:>9.2f} {:>9.2f} {:>9.2f} {:>8.2f} {:>7.2f}x\n", r.backend, r.size,
+                     r.threads, r.backend == "opencl" ? "*" : " ", r.ms.median, r.ms.min, r.ms.max, r.gflop_per_s,
+                     r.speedup_vs_dnn);
+  }
+  s << "\n* OpenCL (PoCL) threads are not set per row: PoCL reads POCL_MAX_PTHREAD_COUNT once at platform init\n"
+       "  (unset = all cores). Its 'vs DNN' compares with OpenCV DNN at that thread count (else the most measured).\n"
+       "  vs DNN = bare OpenCV DNN median / row median (> 1: faster). Bare DNN time includes blobFromImage.\n"
+       "  GFLOP/s = DarknetModel::flops() (convolutions) / median.\n\n";
+  s << fmt::format("pipeline: DetectionPipeline::detect() on a synthetic {}x{} BGR stream (default options)\n",
+                   stream_width, stream_height);
+  s << fmt::format("{:<8} {:>5} {:>7} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend", "size",
+                   "threads", "zoom", "median", "min", "max", "fps", "forwards", "images", "boxes", "not-fwd %");
+  for (const PipelineResult& r : pipeline) {
+    if (!r.error.empty()) {
+      s << fmt::format("{:<8} {:>5} {:>7} {:>5}  error: {}\n", r.backend, r.size, r.threads, r.zoom_in ? "on" : "off",
+                       r.error);
+      continue;
+    }
+    s << fmt::format(
+        "{:<8} {:>5} {:>7} {:>5} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} {:>9.1f}%\n", r.backend,
+        r.size, r.threads, r.zoom_in ? "on" : "off", r.ms.median, r.ms.min, r.ms.max, r.frames_per_s,
+        r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, 100.0 * r.non_forward_share);
+  }
+  s << "\n  ms per frame; forwards/images/boxes: mean per frame; not-fwd %: share of detect() time outside\n"
+       "  backend.forward() (resize, decode, NMS), summed over the timed frames. With random weights there are\n"
+       "  many boxes, so zoom-in re-detects max_detections crops per frame.\n";
+  return s.str();
+}
+
+std::string BenchDetectorReport::json() const {
+  std::ostringstream s;
+  s << "{\"benchmark\": \"detector\", \"weights\": " << json_string(weights) << ", \"repetitions\": " << repetitions
+    << ", \"warmup\": " << warmup << ", \"stream\": [" << stream_width << ", " << stream_height
+    << "],\n \"machine\": {\"cpu_model\": " << json_string(machine.cpu_model) << ", \"cores\": " << machine.cores
+    << ", \"opencl_devices\": [";
+  for (size_t i = 0; i < machine.opencl_devices.size(); ++i)
+    s << (i ? ", " : "") << json_string(machine.opencl_devices[i]);
+  s << "], \"pocl_affinity\": " << json_string(machine.pocl_affinity)
+    << ", \"pocl_max_pthread_count\": " << json_string(machine.pocl_max_pthread_count)
+    << ", \"opencv_version\": " << json_string(machine.opencv_version) << "},\n \"forward\": [";
+  for (size_t i = 0; i < forward.size(); ++i) {
+    const ForwardResult& r = forward[i];
+    s << (i ? ",\n  " : "\n  ")
+      << fmt::format(
+             "{{\"backend\": {}, \"device\": {}, \"size\": {}, \"threads\": {}, \"threads_note\": {}, "
+             "\"ms\": {}, \"gflop_per_s\": {:.4f}, \"speedup_vs_dnn\": {:.4f}, \"error\": {}}}",
+             json_string(r.backend), json_string(r.device), r.size, r.threads, json_string(r.threads_note),
+             json_timing(r.ms), r.gflop_per_s, r.speedup_vs_dnn, json_string(r.error));
+  }
+  s << "],\n \"pipeline\": [";
+  for (size_t i = 0; i < pipeline.size(); ++i) {
+    const PipelineResult& r = pipeline[i];
+    s << (i ? ",\n  " : "\n  ")
+      << fmt::format(
+             "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"ms\": {}, "
+             "\"frames_per_s\": {:.4f}, \"forwards_per_frame\": {:.4f}, \"images_per_frame\": {:.4f}, "
+             "\"detections_per_frame\": {:.4f}, \"non_forward_share\": {:.4f}, \"error\": {}}}",
+             json_string(r.backend), r.size, r.threads, r.zoom_in ? "true" : "false", json_timing(r.ms), r.frames_per_s,
+             r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, r.non_forward_share,
+             json_string(r.error));
+  }
+  s << "]}\n";
+  return s.str();
+}
+
+int run_bench_detector_verb(const BenchDetectorOptions& options, std::ostream& out, std::ostream& err) {
+  const std::string prefix = "wingman bench detector: error: ";
+  const std::vector<std::string> problems = options.validate();
+  if (!problems.empty()) {
+    for (const auto& p : problems) err << prefix << p << "\n";
+    return 2;
+  }
+  try {
+    const BenchDetectorReport report = run_bench_detector(options, &err);
+    out << (options.json ? report.json() : report.table()) << std::flush;
+  } catch (const std::exception& e) {
+    err << prefix << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace wingman::tools
