@@ -62,25 +62,18 @@ class SectionReader {
   }
 
   std::vector<float> get_floats(const std::string& key) {
-    std::vector<float> out;
-    const Entry* e = find(key);
-    if (!e) return out;
-    std::stringstream ss(e->value);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-      item = trim(item);
-      if (item.empty()) continue;
-      char* end = nullptr;
-      const float v = std::strtof(item.c_str(), &end);
-      if (end == item.c_str() || *end != '\0')
-        fail(e->line, fmt::format("key '{}' = '{}': '{}' is not a number", key, e->value, item));
-      out.push_back(v);
-    }
-    return out;
+    return get_list<float>(key, "a number", [](const char* text, char** end) { return std::strtof(text, end); });
   }
 
   std::vector<int> get_ints(const std::string& key) {
-    std::vector<int> out;
+    return get_list<int>(key, "an integer",
+                         [](const char* text, char** end) { return static_cast<int>(std::strtol(text, end, 10)); });
+  }
+
+  /// A comma-separated list of `key` (empty when the key is absent); `parse` is strtof/strtol-like.
+  template <class T, class Parse>
+  std::vector<T> get_list(const std::string& key, const char* what, Parse parse) {
+    std::vector<T> out;
     const Entry* e = find(key);
     if (!e) return out;
     std::stringstream ss(e->value);
@@ -89,10 +82,10 @@ class SectionReader {
       item = trim(item);
       if (item.empty()) continue;
       char* end = nullptr;
-      const long v = std::strtol(item.c_str(), &end, 10);
+      const T v = parse(item.c_str(), &end);
       if (end == item.c_str() || *end != '\0')
-        fail(e->line, fmt::format("key '{}' = '{}': '{}' is not an integer", key, e->value, item));
-      out.push_back(static_cast<int>(v));
+        fail(e->line, fmt::format("key '{}' = '{}': '{}' is not {}", key, e->value, item, what));
+      out.push_back(v);
     }
     return out;
   }
