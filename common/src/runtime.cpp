@@ -113,12 +113,11 @@ void Runtime::publish_heartbeat() {
   const double window_s = std::chrono::duration<double>(now - last_heartbeat_).count();
   const int64_t uptime_us = std::chrono::duration_cast<std::chrono::microseconds>(now - start_).count();
   last_heartbeat_ = now;
-  wingman::status_t s = status_.heartbeat(wall_utime(), uptime_us, window_s);
-  const int size = s.getEncodedSize();
-  std::vector<uint8_t> buf(static_cast<size_t>(size));
-  s.encode(buf.data(), 0, size);
-  if (lcm_out_->publish(status_channel_, buf.data(), static_cast<unsigned int>(buf.size())) != 0) {
-    spdlog::warn("channel {}: failed to publish the status heartbeat", status_channel_);
+  const wingman::status_t s = status_.heartbeat(wall_utime(), uptime_us, window_s);
+  try {
+    publish(status_channel_, s);  // counted as an output like any other message
+  } catch (const std::exception& e) {
+    spdlog::warn("channel {}: failed to publish the status heartbeat: {}", status_channel_, e.what());
   }
 }
 

@@ -115,6 +115,7 @@ class Runtime {
   RuntimeOptions options_;
   std::string instance_;
   std::string status_channel_;
+  std::vector<uint8_t> publish_buffer_;  ///< encoding buffer of publish(), reused
   std::string in_url_;
   std::unique_ptr<lcm::LCM> lcm_in_;
   std::unique_ptr<lcm::LCM> lcm_out_owned_;
@@ -188,12 +189,13 @@ void Runtime::subscribe(const std::string& channel, std::function<void(const Msg
 
 template <class Msg>
 void Runtime::publish(const std::string& channel, const Msg& msg) {
+  // One buffer reused for every message: no allocation per frame once it has grown to the largest.
   const int size = msg.getEncodedSize();
-  std::vector<uint8_t> buf(static_cast<size_t>(size));
-  if (msg.encode(buf.data(), 0, size) < 0) {
+  if (publish_buffer_.size() < static_cast<size_t>(size)) publish_buffer_.resize(static_cast<size_t>(size));
+  if (msg.encode(publish_buffer_.data(), 0, size) < 0) {
     throw std::runtime_error("channel " + channel + ": cannot encode " + Msg::getTypeName());
   }
-  publish_raw(channel, buf.data(), buf.size());
+  publish_raw(channel, publish_buffer_.data(), static_cast<size_t>(size));
   status_.output(channel, msg.utime);
 }
 
