@@ -13,6 +13,8 @@ packages=(
   # vision, maths, OpenCL (PoCL on the CPU), V4L2
   libopencv-dev libeigen3-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
   clinfo libv4l-dev
+  # simulator (WINGMAN_WITH_SIM): offscreen OpenGL through EGL on Mesa llvmpipe, mesh loading
+  libegl-dev libgles-dev libgl1-mesa-dri libassimp-dev
   # configuration, CLI, logging
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   # tests and benchmarks

@@ -113,10 +113,11 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     m.age_s = static_cast<float>(t.age_s);
     m.source_utime = t.source_utime;
     m.predicted_utime = t.predicted_utime;
+    m.detection_source = d.source;
     out.targets.push_back(m);
   }
   out.num_targets = static_cast<int32_t>(out.targets.size());
-  if (out.num_targets > 0) result.targets = std::move(out);
+  if (out.num_targets > 0 || options_.publish_empty) result.targets = std::move(out);
   return result;
 }
 
@@ -136,6 +137,7 @@ wingman::targets_t Localizer::camera_frame_targets(const wingman::detections_t& 
     t.confidence = static_cast<float>(m.confidence);
     t.source_utime = d.utime;
     t.predicted_utime = d.utime;
+    t.detection_source = d.source;
     out.targets.push_back(t);
   }
   out.num_targets = static_cast<int32_t>(out.targets.size());

@@ -21,8 +21,8 @@ namespace wingman::localizer {
 
 /// What one detections message gave.
 struct LocalizerOutput {
-  /// Targets to publish; nullopt when there is nothing to publish (no confirmed track, or no fresh
-  /// own pose and output.publish_camera_frame_only is off).
+  /// Targets to publish; nullopt when there is nothing to publish (no confirmed track and output.publish_empty
+  /// off, or no fresh own pose and output.publish_camera_frame_only off).
   std::optional<wingman::targets_t> targets;
   /// One line per box that could not be used and per missing own pose, naming the field and why;
   /// the process counts each as a drop.

@@ -48,6 +48,9 @@ struct LocalizerOptions {
   std::string output_channel = "TARGETS";              ///< targets_t output channel
   /// Publish camera-frame-only targets (world_valid = false) when no own pose is fresh enough.
   bool publish_camera_frame_only = true;
+  /// Publish a targets_t with no targets for detections that leave no confirmed track (subscribers see the
+  /// pipeline is alive, and lockstep simulation gets one targets_t per image).
+  bool publish_empty = true;
   CameraOptions camera;
   SphereLocalizerOptions sphere;
   ExtrinsicsOptions extrinsics;
@@ -61,6 +64,8 @@ struct LocalizerOptions {
     v("output.channel", output_channel, "targets_t channel to publish tracked targets on");
     v("output.publish_camera_frame_only", publish_camera_frame_only,
       "without a fresh own pose, publish camera-frame targets (world_valid false) instead of nothing");
+    v("output.publish_empty", publish_empty,
+      "publish an empty targets_t when detections leave no confirmed track (one targets_t per detections_t)");
     camera.visit(v);
     sphere.visit(v);
     extrinsics.visit(v);
