@@ -2,6 +2,7 @@
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types), localize (one box
 // to 3D), predict (detector on images), bench detector (detector timings).
 #include "wingman/tools/bench.hpp"
+#include "wingman/tools/eval.hpp"
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
@@ -102,6 +103,28 @@ int main(int argc, char** argv) {
   pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
   pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
 
+  EvalOptions eval;
+  std::vector<double> eval_offset;
+  bool eval_json_stdout = false;
+  auto* ev = app.add_subcommand(
+      "eval", "Localization and formation errors of a simulated flight's log against its ground truth");
+  ev->add_option("log", eval.log, "LCM log with GROUND_TRUTH and TARGETS (and DETECTIONS_CAM0)")->required();
+  ev->add_option("--formation-offset", eval_offset, "Desired follower minus leader position x,y,z (ENU), metres")
+      ->expected(3)
+      ->delimiter(',');
+  ev->add_option("--formation-height", eval.formation_height_m, "The follower's constant height, metres");
+  ev->add_option("--settle", eval.settle_s, "Skip this many seconds before measuring formation error (default 5)");
+  ev->add_option("--leader-id", eval.leader_id, "vehicle_id of the leader in ground truth (default 1)");
+  ev->add_option("--follower-id", eval.follower_id, "vehicle_id of the camera vehicle (default 0)");
+  ev->add_option("--match-radius", eval.match_radius_m, "Farther targets are false targets, metres (default 3)");
+  ev->add_option("--truth-channel", eval.truth_channel, "ground_truth_t channel (default GROUND_TRUTH)");
+  ev->add_option("--targets-channel", eval.targets_channel, "targets_t channel (default TARGETS)");
+  ev->add_option("--detections-channel", eval.detections_channel, "detections_t channel (default DETECTIONS_CAM0)");
+  ev->add_option("--json", eval.json_path, "Also write the result as JSON to this file");
+  ev->add_flag("--json-stdout", eval_json_stdout, "Print JSON instead of the table");
+  ev->add_option("--report", eval.report_path, "Write a self-contained HTML report to this file");
+  ev->add_option("--title", eval.title, "Report title");
+
   BenchDetectorOptions bench_detector;
   auto* be = app.add_subcommand("bench", "Benchmarks (numbers, not tests)");
   be->require_subcommand(1);
@@ -141,6 +164,15 @@ int main(int argc, char** argv) {
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);
     if (*bd) return run_bench_detector_verb(bench_detector, std::cout, std::cerr);
+    if (*ev) {
+      if (!eval_offset.empty()) {
+        eval.formation_offset_in_world = {eval_offset[0], eval_offset[1], eval_offset[2]};
+        eval.has_formation = true;
+      }
+      const EvalResult result = evaluate_log(eval);
+      std::cout << (eval_json_stdout ? result.json() + "\n" : result.report()) << std::flush;
+      if (!eval.report_path.empty()) std::cerr << "report written to " << eval.report_path << std::endl;
+    }
     if (*mv) {
       make_video(video);
       std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;
