@@ -133,6 +133,34 @@ TEST(LocalizerProcess, ScriptedFlightGivesOneConfirmedTrackAtTheTruePositionPred
   EXPECT_EQ(r.last_status.drops_total, 0) << r.last_status.last_error;
 }
 
+TEST(LocalizerProcess, OneTargetsMessagePerDetectionsEmptyUntilConfirmedWithTheSourceFlagCopied) {
+  TempDir dir;
+  std::vector<LogEvent> events;
+  int n_detections = 0;
+  for (const LogEvent& e : scripted_flight()) {
+    if (e.channel != "DETECTIONS_CAM0") {
+      events.push_back(e);
+      continue;
+    }
+    wingman::detections_t d;
+    d.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+    d.source = wingman::detections_t::SOURCE_GROUND_TRUTH;
+    events.push_back(make_event("DETECTIONS_CAM0", d, e.timestamp));
+    ++n_detections;
+  }
+  const LocalizerRun r = run_localizer(dir, events);
+  ASSERT_EQ(static_cast<int>(r.targets.size()), n_detections) << r.err;
+  // tracker.birth_hits = 3: the first two images give empty targets_t, the third a confirmed track.
+  EXPECT_EQ(r.targets[0].num_targets, 0);
+  EXPECT_EQ(r.targets[1].num_targets, 0);
+  ASSERT_EQ(r.targets[2].num_targets, 1);
+  for (const auto& t : r.targets) {
+    for (const auto& target : t.targets) {
+      EXPECT_EQ(target.detection_source, wingman::detections_t::SOURCE_GROUND_TRUTH);
+    }
+  }
+}
+
 TEST(LocalizerProcess, BadBoxesAndMessagesAreDroppedAndCountedNeverFatal) {
   TempDir dir;
   std::vector<LogEvent> events = scripted_flight();
