@@ -1,19 +1,42 @@
 // SPDX-License-Identifier: MIT
-// wingman-follower-ctrl: targets and own pose in, autopilot setpoints out (controllers arrive with the simulation
-// issue).
-#include "wingman/follower_ctrl/follower_options.hpp"
+// wingman-follower-ctrl: own pose and targets (formation) or detections (pid_1d) in, autopilot setpoints out.
+#include "wingman/follower_ctrl/follower.hpp"
 
 #include <wingman/common/runtime.hpp>
 
+namespace {
+
+using namespace wingman;
+
+int run(common::Runtime& rt, const follower_ctrl::FollowerOptions& o) {
+  follower_ctrl::Follower follower(o);
+  rt.status().declare_output(o.output_channel);
+  rt.status().set_state(status_t::STATE_DEGRADED, follower.status().detail);
+  // Publishes what an input gave, counts the parts it could not use, and reports the state.
+  auto handle = [&](const std::string& channel, const follower_ctrl::FollowerOutput& out) {
+    for (const auto& why : out.rejections) rt.status().item_dropped(channel, why);
+    if (out.setpoint) rt.publish(o.output_channel, *out.setpoint);
+    rt.status().set_state(follower.status().flying ? status_t::STATE_OK : status_t::STATE_DEGRADED,
+                          follower.status().detail);
+  };
+  rt.subscribe<own_pose_t>(o.own_pose_channel,
+                           [&](const own_pose_t& p) { handle(o.own_pose_channel, follower.on_own_pose(p)); });
+  if (follower.mode() == follower_ctrl::ControllerMode::kFormation) {
+    rt.subscribe<targets_t>(o.targets_channel,
+                            [&](const targets_t& t) { handle(o.targets_channel, follower.on_targets(t)); });
+  } else {
+    rt.subscribe<detections_t>(o.detections_channel, [&](const detections_t& d) {
+      rt.status().set_last_processed_seq(d.seq);
+      handle(o.detections_channel, follower.on_detections(d));
+    });
+  }
+  return rt.spin();
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace wingman;
-  const common::ProcessInfo info{"follower_ctrl", "wingman-follower-ctrl", "Flies in formation on localized targets"};
-  return common::run_process<follower_ctrl::FollowerOptions>(
-      info, argc, argv, [](common::Runtime& rt, const follower_ctrl::FollowerOptions& o) {
-        rt.status().declare_output(o.output_channel);
-        rt.status().set_state(status_t::STATE_DEGRADED, "no controller yet: inputs are checked and counted only");
-        rt.subscribe<targets_t>(o.targets_channel, [](const targets_t&) {});
-        rt.subscribe<own_pose_t>(o.own_pose_channel, [](const own_pose_t&) {});
-        return rt.spin();
-      });
+  const common::ProcessInfo info{"follower_ctrl", "wingman-follower-ctrl",
+                                 "Flies the follower: formation on tracked targets, or the thesis's 1-D PID"};
+  return common::run_process<follower_ctrl::FollowerOptions>(info, argc, argv, run);
 }

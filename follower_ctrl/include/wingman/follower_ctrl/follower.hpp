@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: MIT
+// The follower's logic without LCM: own poses and driving inputs in, one setpoint per driving input out,
+// with the hold rules.
+#pragma once
+
+#include "wingman/follower_ctrl/follower_options.hpp"
+#include "wingman/follower_ctrl/formation_controller.hpp"
+#include "wingman/follower_ctrl/pid_1d_controller.hpp"
+#include "wingman/follower_ctrl/target_selection.hpp"
+#include "wingman/follower_ctrl/world_frame.hpp"
+
+#include <wingman/detections_t.hpp>
+#include <wingman/own_pose_t.hpp>
+#include <wingman/setpoint_t.hpp>
+#include <wingman/targets_t.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace wingman::follower_ctrl {
+
+/// What the follower is doing, for the status heartbeat.
+struct FollowerStatus {
+  bool flying = false;  ///< true: the last setpoint was MODE_VELOCITY; false: holding (or nothing published yet)
+  std::string detail = "waiting for inputs";  ///< one line: what it follows, or why it holds
+};
+
+/// What one input gave.
+struct FollowerOutput {
+  /// The setpoint to publish: always one for a driving input (targets_t in mode formation,
+  /// detections_t in mode pid_1d); for an own pose only the lost-input hold.
+  std::optional<wingman::setpoint_t> setpoint;
+  /// Parts of the input that could not be used, one line each naming the field (counted as drops).
+  std::vector<std::string> rejections;
+};
+
+/// The follower process's logic. Time is message time only (utimes); the same inputs in the same
+/// order give the same setpoints.
+///
+/// Driving inputs are targets_t (mode formation) or detections_t (mode pid_1d). Each gives exactly
+/// one setpoint with the input's utime: MODE_VELOCITY from the mode's controller, or MODE_HOLD when
+///  - no own pose has arrived yet, or the newest is more than hold.timeout_s older than the input;
+///  - no usable target: none yet, or none for longer than hold.timeout_s (input utime minus the
+///    source_utime of the last usable target, resp. the utime of the last detections with a box).
+/// Within the timeout, without a usable target in the input:
+///  - formation coasts on the last target's constant-velocity prediction (the tracker's model);
+///  - pid_1d commands 0 along its axis (ramped by the acceleration limit), height still held.
+/// Own poses: when no driving input has arrived for longer than hold.timeout_s of own-pose time
+/// (counted from the first own pose when none has arrived yet), each own pose gives one MODE_HOLD
+/// with its utime, so a stopped localizer or detector cannot leave the follower flying.
+/// Every hold forgets the PID memory and the previous command; a track switch forgets the PID memory.
+/// setpoint_t.detection_source is copied from the data behind the setpoint (the followed target, the
+/// detections message; for a hold the newest known); target_track_id is the followed track (0 for pid_1d and holds).
+class Follower {
+ public:
+  /// Throws std::invalid_argument listing options.validate() problems.
+  explicit Follower(const FollowerOptions& options);
+
+  /// An own pose (ENU or NED). Throws std::invalid_argument naming the field when its utime is not
+  /// after the previous own pose's (duplicate or out of order); the caller drops and counts it.
+  FollowerOutput on_own_pose(const wingman::own_pose_t& pose);
+  /// A targets_t (mode formation). Throws std::invalid_argument naming the field for a message before
+  /// the previous one, or a target with an unknown detection_source; throws std::logic_error in mode pid_1d.
+  FollowerOutput on_targets(const wingman::targets_t& targets);
+  /// A detections_t (mode pid_1d). Throws std::invalid_argument naming the field for a message before
+  /// the previous one or an unknown source; throws std::logic_error in mode formation.
+  FollowerOutput on_detections(const wingman::detections_t& detections);
+
+  const FollowerStatus& status() const { return status_; }
+  ControllerMode mode() const { return mode_; }
+
+ private:
+  wingman::setpoint_t hold(int64_t utime, const std::string& reason);
+  /// "" when the own pose is usable at `utime`, else why not.
+  std::string own_pose_problem(int64_t utime) const;
+  void accept_driving_input(const char* field, int64_t utime);
+  wingman::setpoint_t fly(int64_t utime, const VelocityCommand& command, int32_t track_id, int8_t source,
+                          const std::string& what);
+
+  FollowerOptions options_;
+  ControllerMode mode_;
+  int64_t timeout_us_;
+  SelectPolicy select_policy_;
+  FormationController formation_;
+  Pid1dController pid_1d_;
+  std::optional<OwnState> own_;
+  std::optional<int64_t> first_pose_utime_;
+  double start_height_m_ = 0.0;
+  std::optional<int64_t> last_driving_utime_;
+  int8_t last_source_ = wingman::detections_t::SOURCE_CNN;
+  int32_t followed_track_id_ = 0;           ///< formation: the track followed, 0 none
+  std::optional<TargetState> last_target_;  ///< formation: the last usable state of the followed track
+  std::optional<int64_t> last_box_utime_;   ///< pid_1d: utime of the last detections with a usable box
+  FollowerStatus status_;
+};
+
+}  // namespace wingman::follower_ctrl

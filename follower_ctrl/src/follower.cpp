@@ -1,0 +1,191 @@
+// SPDX-License-Identifier: MIT
+// The follower's logic: hold rules around the two controllers.
+#include "wingman/follower_ctrl/follower.hpp"
+
+#include "setpoint_message.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace wingman::follower_ctrl {
+namespace {
+
+const FollowerOptions& checked(const FollowerOptions& o) {
+  const auto problems = o.validate();
+  if (!problems.empty()) {
+    std::string all = "invalid FollowerOptions:";
+    for (const auto& q : problems) all += " " + q + ";";
+    throw std::invalid_argument(all);
+  }
+  return o;
+}
+
+double seconds(int64_t us) { return static_cast<double>(us) * 1e-6; }
+
+const char* source_name(int8_t source) {
+  return source == wingman::detections_t::SOURCE_GROUND_TRUTH ? "ground-truth boxes" : "CNN boxes";
+}
+
+bool known_source(int8_t source) {
+  return source == wingman::detections_t::SOURCE_CNN || source == wingman::detections_t::SOURCE_GROUND_TRUTH;
+}
+
+}  // namespace
+
+Follower::Follower(const FollowerOptions& options)
+    : options_(checked(options)),
+      mode_(options.controller_mode()),
+      timeout_us_(options.hold_timeout_us()),
+      select_policy_(*parse_select_policy(options.formation.select)),
+      formation_(options.formation, options.limits, options.camera_mount.rotation()),
+      pid_1d_(options.pid_1d, options.limits, options.camera_mount.rotation()) {}
+
+FollowerOutput Follower::on_own_pose(const wingman::own_pose_t& pose) {
+  if (own_ && pose.utime <= own_->utime)
+    throw std::invalid_argument(fmt::format("own_pose_t.utime = {}: not after the previous own pose ({}): {}",
+                                            pose.utime, own_->utime,
+                                            pose.utime == own_->utime ? "duplicate" : "out of order"));
+  own_ = own_state_from_message(pose);
+  if (!first_pose_utime_) {
+    first_pose_utime_ = pose.utime;
+    start_height_m_ = own_->p_body_in_world.z();
+  }
+  FollowerOutput out;
+  const int64_t since = last_driving_utime_.value_or(*first_pose_utime_);
+  if (pose.utime - since > timeout_us_) {
+    const bool formation = mode_ == ControllerMode::kFormation;
+    out.setpoint = hold(pose.utime, fmt::format("no {} on {} for {:.3f} s of own-pose time (hold.timeout_s = {})",
+                                                formation ? "targets_t" : "detections_t",
+                                                formation ? options_.targets_channel : options_.detections_channel,
+                                                seconds(pose.utime - since), options_.hold_timeout_s));
+  }
+  return out;
+}
+
+FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
+  if (mode_ != ControllerMode::kFormation)
+    throw std::logic_error("Follower::on_targets called in controller.mode pid_1d");
+  for (size_t i = 0; i < msg.targets.size(); ++i) {
+    if (!known_source(msg.targets[i].detection_source))
+      throw std::invalid_argument(
+          fmt::format("targets_t.targets[{}].detection_source = {}: must be SOURCE_CNN (0) "
+                      "or SOURCE_GROUND_TRUTH (1)",
+                      i, msg.targets[i].detection_source));
+  }
+  accept_driving_input("targets_t.utime", msg.utime);
+  FollowerOutput out;
+  if (const std::string why = own_pose_problem(msg.utime); !why.empty()) {
+    out.setpoint = hold(msg.utime, why);
+    return out;
+  }
+  const OwnState own = own_->predicted_to(msg.utime);
+  const std::vector<TargetState> usable = usable_targets(msg, timeout_us_);
+  const std::optional<TargetState> chosen =
+      select_target(usable, followed_track_id_, select_policy_, own.p_body_in_world);
+  TargetState target;
+  std::string detail;
+  if (chosen) {
+    if (chosen->track_id != followed_track_id_) formation_.reset_pid();  // track switch
+    followed_track_id_ = chosen->track_id;
+    last_target_ = *chosen;
+    last_source_ = chosen->detection_source;
+    target = chosen->predicted_to(msg.utime);
+    detail = fmt::format("following track {} on {}", followed_track_id_, source_name(target.detection_source));
+  } else if (last_target_ && msg.utime - last_target_->source_utime <= timeout_us_) {
+    target = last_target_->predicted_to(msg.utime);
+    detail = fmt::format("coasting on track {}: no usable update, newest image {:.3f} s old", followed_track_id_,
+                         seconds(msg.utime - last_target_->source_utime));
+  } else {
+    const std::string why =
+        last_target_
+            ? fmt::format("target lost: track {} not seen for {:.3f} s (hold.timeout_s = {})", followed_track_id_,
+                          seconds(msg.utime - last_target_->source_utime), options_.hold_timeout_s)
+            : std::string("no usable target yet (world-frame targets with an image within hold.timeout_s)");
+    out.setpoint = hold(msg.utime, why);  // the lost track is remembered: a later hold still names it
+    return out;
+  }
+  const VelocityCommand cmd = formation_.update(target, own, msg.utime, start_height_m_);
+  if (cmd.avoiding)
+    detail += fmt::format(", avoiding: target {:.2f} m away (formation.avoid_radius_m = {})",
+                          (target.p_target_in_world - own.p_body_in_world).norm(), options_.formation.avoid_radius_m);
+  out.setpoint = fly(msg.utime, cmd, followed_track_id_, target.detection_source, detail);
+  return out;
+}
+
+FollowerOutput Follower::on_detections(const wingman::detections_t& msg) {
+  if (mode_ != ControllerMode::kPid1d)
+    throw std::logic_error("Follower::on_detections called in controller.mode formation");
+  if (!known_source(msg.source))
+    throw std::invalid_argument(
+        fmt::format("detections_t.source = {}: must be SOURCE_CNN (0) or SOURCE_GROUND_TRUTH (1)", msg.source));
+  accept_driving_input("detections_t.utime", msg.utime);
+  last_source_ = msg.source;
+  FollowerOutput out;
+  for (size_t i = 0; i < msg.detections.size(); ++i) {
+    const float cx = msg.detections[i].cx;
+    if (!(cx >= 0 && cx <= static_cast<float>(msg.image_width)))
+      out.rejections.push_back(
+          fmt::format("detections_t.detections[{}].cx = {}: outside the image [0, {}]", i, cx, msg.image_width));
+  }
+  if (const std::string why = own_pose_problem(msg.utime); !why.empty()) {
+    out.setpoint = hold(msg.utime, why);
+    return out;
+  }
+  const OwnState own = own_->predicted_to(msg.utime);
+  const std::optional<wingman::detection_t> box = most_confident_box(msg);
+  if (box) last_box_utime_ = msg.utime;
+  if (!last_box_utime_ || msg.utime - *last_box_utime_ > timeout_us_) {
+    out.setpoint =
+        hold(msg.utime, last_box_utime_ ? fmt::format("target lost: no box for {:.3f} s (hold.timeout_s = {})",
+                                                      seconds(msg.utime - *last_box_utime_), options_.hold_timeout_s)
+                                        : std::string("no box yet"));
+    return out;
+  }
+  const std::optional<Eigen::Vector3d> axis = pid_1d_.axis_in_world(own);
+  if (!axis) {
+    out.setpoint =
+        hold(msg.utime, "pid_1d.axis camera_right: the camera's x axis is vertical in the world (no horizontal axis)");
+    return out;
+  }
+  std::optional<double> error;
+  if (box) error = box_centre_error(*box, msg.image_width);
+  const Pid1dCommand cmd = pid_1d_.update(error, *axis, own, msg.utime, start_height_m_);
+  const std::string detail =
+      error ? fmt::format("following the most confident box (e = {:+.3f}) on {}", *error, source_name(msg.source))
+            : fmt::format("no box for {:.3f} s: 0 along the axis, height held", seconds(msg.utime - *last_box_utime_));
+  out.setpoint = fly(msg.utime, cmd.command, 0, msg.source, detail);
+  return out;
+}
+
+void Follower::accept_driving_input(const char* field, int64_t utime) {
+  if (last_driving_utime_ && utime < *last_driving_utime_)
+    throw std::invalid_argument(
+        fmt::format("{} = {}: before the previous input ({}): out of order", field, utime, *last_driving_utime_));
+  last_driving_utime_ = utime;
+}
+
+std::string Follower::own_pose_problem(int64_t utime) const {
+  if (!own_) return "no own pose yet";
+  if (utime - own_->utime > timeout_us_)
+    return fmt::format("own pose stale: newest is {:.3f} s older than the input (hold.timeout_s = {})",
+                       seconds(utime - own_->utime), options_.hold_timeout_s);
+  return "";
+}
+
+wingman::setpoint_t Follower::hold(int64_t utime, const std::string& reason) {
+  formation_.reset();
+  pid_1d_.reset();
+  status_.flying = false;
+  status_.detail = "holding: " + reason;
+  return detail::hold_setpoint(utime, own_ ? &*own_ : nullptr, last_source_);
+}
+
+wingman::setpoint_t Follower::fly(int64_t utime, const VelocityCommand& command, int32_t track_id, int8_t source,
+                                  const std::string& what) {
+  status_.flying = true;
+  status_.detail = what;
+  return detail::velocity_setpoint(utime, own_->frame, command, track_id, source);
+}
+
+}  // namespace wingman::follower_ctrl

@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: MIT
+// Own state in ENU/FLU, NED <-> ENU conversions and angle helpers.
+#include "wingman/follower_ctrl/world_frame.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+namespace wingman::follower_ctrl {
+
+OwnState OwnState::predicted_to(int64_t to_utime) const {
+  OwnState out = *this;
+  out.utime = to_utime;
+  out.p_body_in_world = p_body_in_world + v_body_in_world * (static_cast<double>(to_utime - utime) * 1e-6);
+  return out;
+}
+
+double OwnState::yaw() const { return std::atan2(R_body_to_world(1, 0), R_body_to_world(0, 0)); }
+
+OwnState own_state_from_message(const wingman::own_pose_t& m) {
+  OwnState s;
+  s.utime = m.utime;
+  s.frame = m.frame;
+  const Eigen::Vector3d p(m.p_body_in_world[0], m.p_body_in_world[1], m.p_body_in_world[2]);
+  const Eigen::Vector3d v(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond(m.q_body_to_world[0], m.q_body_to_world[1], m.q_body_to_world[2], m.q_body_to_world[3])
+          .normalized()
+          .toRotationMatrix();
+  if (m.frame == wingman::own_pose_t::FRAME_NED) {
+    Eigen::Matrix3d R_ned_to_enu;
+    R_ned_to_enu << 0, 1, 0,  //
+        1, 0, 0,              //
+        0, 0, -1;
+    const Eigen::Matrix3d R_flu_to_frd = Eigen::Vector3d(1, -1, -1).asDiagonal();
+    s.p_body_in_world = swap_ned_enu(p);
+    s.v_body_in_world = swap_ned_enu(v);
+    s.R_body_to_world = R_ned_to_enu * R * R_flu_to_frd;
+  } else {
+    s.p_body_in_world = p;
+    s.v_body_in_world = v;
+    s.R_body_to_world = R;
+  }
+  return s;
+}
+
+double wrap_pi(double a) {
+  a = std::remainder(a, 2.0 * M_PI);  // [-pi, pi]
+  return a <= -M_PI ? a + 2.0 * M_PI : a;
+}
+
+double swap_ned_enu_yaw(double yaw_rad) { return wrap_pi(0.5 * M_PI - yaw_rad); }
+
+bool horizontal_azimuth(const Eigen::Vector3d& v, double min_horizontal, double* azimuth_rad) {
+  if (std::hypot(v.x(), v.y()) < min_horizontal) return false;
+  *azimuth_rad = std::atan2(v.y(), v.x());
+  return true;
+}
+
+}  // namespace wingman::follower_ctrl
