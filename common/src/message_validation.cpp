@@ -29,6 +29,13 @@ std::string check_frame(const char* type, int8_t frame) {
   return "";
 }
 
+std::string check_source(const char* field, int8_t source) {
+  if (source != wingman::detections_t::SOURCE_CNN && source != wingman::detections_t::SOURCE_GROUND_TRUTH) {
+    return fmt::format("{} = {}: must be SOURCE_CNN (0) or SOURCE_GROUND_TRUTH (1)", field, source);
+  }
+  return "";
+}
+
 std::string check_quaternion(const char* type, const char* field, const double (&q)[4]) {
   if (!all_finite(q)) return fmt::format("{}.{}: must be finite", type, field);
   const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
@@ -100,6 +107,7 @@ std::string validate_message(const wingman::detections_t& m) {
   if (m.image_width <= 0 || m.image_height <= 0)
     return fmt::format("detections_t.image_width x image_height = {} x {}: must be positive", m.image_width,
                        m.image_height);
+  if (auto e = check_source("detections_t.source", m.source); !e.empty()) return e;
   if (m.num_detections != static_cast<int32_t>(m.detections.size()) || m.num_detections < 0)
     return fmt::format("detections_t.num_detections = {}: does not match {} detections", m.num_detections,
                        m.detections.size());
@@ -134,6 +142,9 @@ std::string validate_message(const wingman::targets_t& m) {
         !all_finite(t.position_covariance) || !all_finite(t.velocity_covariance) || !std::isfinite(t.range))
       return fmt::format("targets_t.targets[{}]: positions, velocity, covariances and range must be finite", i);
     if (t.range < 0) return fmt::format("targets_t.targets[{}].range = {}: must be >= 0", i, t.range);
+    if (auto e = check_source(fmt::format("targets_t.targets[{}].detection_source", i).c_str(), t.detection_source);
+        !e.empty())
+      return e;
   }
   return "";
 }
@@ -146,6 +157,7 @@ std::string validate_message(const wingman::setpoint_t& m) {
     return fmt::format("setpoint_t.mode = {}: must be MODE_HOLD (0), MODE_POSITION (1) or MODE_VELOCITY (2)", m.mode);
   if (!all_finite(m.position) || !all_finite(m.velocity) || !std::isfinite(m.yaw) || !std::isfinite(m.yaw_rate))
     return "setpoint_t: position, velocity, yaw and yaw_rate must be finite";
+  if (auto e = check_source("setpoint_t.detection_source", m.detection_source); !e.empty()) return e;
   return "";
 }
 

@@ -96,3 +96,30 @@ TEST(ValidateSetpoint, RejectsUnknownMode) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(ValidateSourceFlags, UnknownDetectionSourceIsRejectedInEveryMessageThatCarriesIt) {
+  wingman::detections_t d{};
+  d.utime = 1;
+  d.image_width = 640;
+  d.image_height = 480;
+  d.source = wingman::detections_t::SOURCE_GROUND_TRUTH;
+  EXPECT_EQ(validate_message(d), "");
+  d.source = 3;
+  EXPECT_NE(validate_message(d).find("detections_t.source = 3"), std::string::npos) << validate_message(d);
+
+  wingman::targets_t t{};
+  t.utime = 1;
+  t.targets.resize(1);
+  t.num_targets = 1;
+  EXPECT_EQ(validate_message(t), "");
+  t.targets[0].detection_source = -1;
+  EXPECT_NE(validate_message(t).find("targets[0].detection_source = -1"), std::string::npos) << validate_message(t);
+
+  wingman::setpoint_t s{};
+  s.detection_source = 2;
+  EXPECT_NE(validate_message(s).find("setpoint_t.detection_source = 2"), std::string::npos) << validate_message(s);
+}
+
+}  // namespace
