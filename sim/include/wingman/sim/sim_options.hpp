@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: MIT
+// Options of wingman-sim (config/sim.yaml).
+#pragma once
+
+#include "wingman/sim/render_options.hpp"
+
+#include <wingman/localizer/extrinsics.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace wingman::sim {
+
+/// The simulated onboard camera. The defaults equal the localizer's built-in camera (config/localizer.yaml), so
+/// the pipeline works on embedded defaults.
+struct SimCameraOptions {
+  /// Calibration file (ROS camera_info, OpenCV FileStorage or Kalibr camchain YAML); "" = an ideal pinhole camera
+  /// from width, height and focal_px (principal point at the image centre), like the localizer's.
+  std::string calibration;
+  std::string kalibr_camera = "cam0";  ///< camera of a Kalibr camchain file
+  int camera_id = 0;                   ///< image_t / detections_t / truth_box_t camera_id
+  int width = 1280;                    ///< ideal pinhole: image width, pixels
+  int height = 720;                    ///< ideal pinhole: image height, pixels
+  double focal_px = 640.0;             ///< ideal pinhole: fx = fy, pixels
+  double rate_hz = 30.0;               ///< frames per simulated second, > 0
+
+  template <class V>
+  void visit(V& v) {
+    v("camera.calibration", calibration,
+      "calibration YAML (ROS camera_info, OpenCV, Kalibr); \"\" = ideal pinhole below (the localizer's default)");
+    v("camera.kalibr_camera", kalibr_camera, "which camera of a Kalibr camchain file");
+    v("camera.camera_id", camera_id, "camera_id of the published images, detections and truth boxes");
+    v("camera.width", width, "ideal pinhole only: image width, pixels");
+    v("camera.height", height, "ideal pinhole only: image height, pixels");
+    v("camera.focal_px", focal_px, "ideal pinhole only: focal length fx = fy, pixels");
+    v("camera.rate_hz", rate_hz, "frames per simulated second");
+  }
+  std::vector<std::string> validate() const;
+};
+
+/// Detections built from ground truth (for the pipeline until a trained detector exists).
+struct TruthDetectionOptions {
+  /// Publish detections_t from the truth boxes (source = SOURCE_GROUND_TRUTH) on output.detections_channel.
+  bool from_ground_truth = false;
+  /// silhouette: the truth box (the drone's projected outline, what a detector trained on rendered images boxes);
+  /// sphere: the exact box of the drone's bounding sphere (the localizer's model), which isolates the pipeline from
+  /// the sphere model's bias on real outlines.
+  std::string box = "silhouette";
+  double noise_px = 0.0;     ///< standard deviation of Gaussian noise added to each box edge, pixels (0 = exact)
+  int64_t seed = 1;          ///< noise seed (with the frame number), >= 0
+  double min_size_px = 2.0;  ///< boxes narrower or shorter than this (after noise and clipping) are left out, px
+  double max_range_m = 0.0;  ///< drones farther than this are left out, metres (0 = no limit)
+
+  template <class V>
+  void visit(V& v) {
+    v("detections.from_ground_truth", from_ground_truth,
+      "publish detections_t built from the truth boxes (SOURCE_GROUND_TRUTH) until a trained detector exists");
+    v("detections.box", box,
+      "silhouette (the truth box: the drone's outline) or sphere (the bounding sphere's box, the localizer's model)");
+    v("detections.noise_px", noise_px, "Gaussian noise on each box edge, standard deviation in pixels (0 = exact)");
+    v("detections.seed", seed, "noise seed (combined with the frame number)");
+    v("detections.min_size_px", min_size_px, "leave out boxes narrower or shorter than this, pixels");
+    v("detections.max_range_m", max_range_m, "leave out drones farther than this, metres (0 = no limit)");
+  }
+  std::vector<std::string> validate() const;
+};
+
+/// How simulated time advances against the other processes (docs/simulation.md, "Sync").
+struct SyncOptions {
+  /// lockstep: after each frame wait for a SETPOINT with utime >= the frame's (when the camera vehicle takes
+  /// setpoints); free: never wait; realtime: pace frames by the wall clock times `speed`.
+  std::string mode = "lockstep";
+  double timeout_s = 5.0;  ///< lockstep: longest wall-clock wait for the setpoint of a frame, s (> 0)
+  double speed = 1.0;      ///< realtime: simulated seconds per wall-clock second (> 0)
+  /// Process instance names whose STATUS_<NAME> heartbeat must be seen before the first frame, e.g.
+  /// [detector, localizer, follower_ctrl].
+  std::vector<std::string> wait_for;
+  double startup_timeout_s = 30.0;  ///< longest wall-clock wait for `wait_for`, s (> 0); then exit 1
+
+  template <class V>
+  void visit(V& v) {
+    v("sync.mode", mode, "lockstep (wait for each frame's SETPOINT), free (never wait) or realtime (wall clock)");
+    v("sync.timeout_s", timeout_s, "lockstep: longest wall-clock wait for a frame's setpoint, s (then go on)");
+    v("sync.speed", speed, "realtime: simulated seconds per wall-clock second");
+    v("sync.wait_for", wait_for, "process instances whose STATUS_<NAME> must be seen before the first frame");
+    v("sync.startup_timeout_s", startup_timeout_s, "longest wait for sync.wait_for, s (then exit 1 naming them)");
+  }
+  std::vector<std::string> validate() const;
+};
+
+/// Options of the simulator process.
+struct SimOptions {
+  /// Scenario file (config/scenarios/*.yaml); --scenario FILE overrides it. Required to run.
+  std::string scenario;
+  std::string setpoint_channel = "SETPOINT";           ///< setpoint_t input channel (camera vehicle commands)
+  std::string image_channel = "IMAGE_CAM0";            ///< image_t output channel (BGR8)
+  std::string own_pose_channel = "OWN_POSE";           ///< own_pose_t output channel (camera vehicle)
+  std::string ground_truth_channel = "GROUND_TRUTH";   ///< ground_truth_t output channel
+  std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t output (detections.from_ground_truth)
+  /// Render and publish images. Off: no image is published, no EGL is needed, and truth boxes are projected from
+  /// the drone models (no occlusion).
+  bool render = true;
+  SimCameraOptions camera;
+  localizer::ExtrinsicsOptions extrinsics;
+  TruthDetectionOptions detections;
+  SyncOptions sync;
+  RenderOptions render_options;
+
+  template <class V>
+  void visit(V& v) {
+    v("scenario.file", scenario, "scenario YAML (config/scenarios/); --scenario FILE overrides it");
+    v("input.setpoint_channel", setpoint_channel, "setpoint_t channel from wingman-follower-ctrl");
+    v("output.image_channel", image_channel, "image_t channel (BGR8), as wingman-camera-driver publishes");
+    v("output.own_pose_channel", own_pose_channel, "own_pose_t channel: the camera vehicle's pose at each frame");
+    v("output.ground_truth_channel", ground_truth_channel, "ground_truth_t channel: every vehicle and its box");
+    v("output.detections_channel", detections_channel, "detections_t channel for detections.from_ground_truth");
+    camera.visit(v);
+    extrinsics.visit(v);
+    detections.visit(v);
+    sync.visit(v);
+    v("render.enabled", render, "render and publish images (false: no images, no EGL; boxes projected from models)");
+    render_options.visit(v);
+  }
+  std::vector<std::string> validate() const;
+};
+
+}  // namespace wingman::sim

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: MIT
+// Validation of SimOptions.
+#include "wingman/sim/sim_options.hpp"
+
+#include <wingman/common/config.hpp>
+
+#include <cmath>
+#include <set>
+
+namespace wingman::sim {
+
+using common::problem;
+
+std::vector<std::string> SimCameraOptions::validate() const {
+  std::vector<std::string> p;
+  if (camera_id < 0) p.push_back(problem("camera.camera_id", camera_id, "must be >= 0"));
+  if (width < 1 || width > 8192) p.push_back(problem("camera.width", width, "must be in 1..8192"));
+  if (height < 1 || height > 8192) p.push_back(problem("camera.height", height, "must be in 1..8192"));
+  if (!(focal_px > 0) || !std::isfinite(focal_px)) p.push_back(problem("camera.focal_px", focal_px, "must be > 0"));
+  if (!(rate_hz > 0 && rate_hz <= 1000)) p.push_back(problem("camera.rate_hz", rate_hz, "must be in (0, 1000]"));
+  if (kalibr_camera.empty()) p.push_back(problem("camera.kalibr_camera", kalibr_camera, "must not be empty"));
+  return p;
+}
+
+std::vector<std::string> TruthDetectionOptions::validate() const {
+  std::vector<std::string> p;
+  if (box != "silhouette" && box != "sphere")
+    p.push_back(problem("detections.box", box, "must be silhouette or sphere"));
+  if (!(noise_px >= 0) || !std::isfinite(noise_px))
+    p.push_back(problem("detections.noise_px", noise_px, "must be >= 0"));
+  if (seed < 0) p.push_back(problem("detections.seed", static_cast<double>(seed), "must be >= 0"));
+  if (!(min_size_px >= 0) || !std::isfinite(min_size_px))
+    p.push_back(problem("detections.min_size_px", min_size_px, "must be >= 0"));
+  if (!(max_range_m >= 0) || !std::isfinite(max_range_m))
+    p.push_back(problem("detections.max_range_m", max_range_m, "must be >= 0 (0 = no limit)"));
+  return p;
+}
+
+std::vector<std::string> SyncOptions::validate() const {
+  std::vector<std::string> p;
+  if (mode != "lockstep" && mode != "free" && mode != "realtime")
+    p.push_back(problem("sync.mode", mode, "must be lockstep, free or realtime"));
+  if (!(timeout_s > 0 && timeout_s <= 3600)) p.push_back(problem("sync.timeout_s", timeout_s, "must be in (0, 3600]"));
+  if (!(speed > 0 && speed <= 1000)) p.push_back(problem("sync.speed", speed, "must be in (0, 1000]"));
+  if (!(startup_timeout_s > 0 && startup_timeout_s <= 3600))
+    p.push_back(problem("sync.startup_timeout_s", startup_timeout_s, "must be in (0, 3600]"));
+  std::set<std::string> seen;
+  for (const auto& name : wait_for) {
+    if (name.empty()) p.push_back(problem("sync.wait_for", name, "names must not be empty"));
+    if (!seen.insert(name).second) p.push_back(problem("sync.wait_for", name, "listed twice"));
+  }
+  return p;
+}
+
+std::vector<std::string> SimOptions::validate() const {
+  std::vector<std::string> p;
+  auto channel = [&](const char* key, const std::string& value) {
+    if (value.empty()) p.push_back(problem(key, value, "must not be empty"));
+  };
+  channel("input.setpoint_channel", setpoint_channel);
+  channel("output.image_channel", image_channel);
+  channel("output.own_pose_channel", own_pose_channel);
+  channel("output.ground_truth_channel", ground_truth_channel);
+  channel("output.detections_channel", detections_channel);
+  for (const auto& part :
+       {camera.validate(), extrinsics.validate(), detections.validate(), sync.validate(), render_options.validate()}) {
+    p.insert(p.end(), part.begin(), part.end());
+  }
+  return p;
+}
+
+}  // namespace wingman::sim

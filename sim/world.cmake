@@ -1,0 +1,22 @@
+# SPDX-License-Identifier: MIT
+# wingman::sim_world: multirotor dynamics, motion scripts, scenarios and the Simulator (testable without LCM), plus
+# the wingman-sim process (thin main). Included by sim/CMakeLists.txt after render.cmake.
+add_library(wingman_sim_world
+  src/world/multirotor.cpp
+  src/world/vehicle_command.cpp
+  src/world/motion_script.cpp
+  src/world/yaml_reader.cpp
+  src/world/scenario.cpp
+  src/world/sim_options.cpp
+  src/world/simulator.cpp
+  src/world/truth_detections.cpp)
+add_library(wingman::sim_world ALIAS wingman_sim_world)
+target_include_directories(wingman_sim_world PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+target_link_libraries(wingman_sim_world
+  PUBLIC wingman::sim_render wingman::localizer wingman::common wingman::lcmtypes Eigen3::Eigen opencv_core
+  PRIVATE yaml-cpp fmt::fmt)
+wingman_warnings(wingman_sim_world)
+
+add_executable(wingman-sim main.cpp)
+target_link_libraries(wingman-sim PRIVATE wingman::sim_world wingman::common spdlog::spdlog fmt::fmt)
+wingman_warnings(wingman-sim)

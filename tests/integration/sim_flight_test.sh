@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# CI flight: 20 s of the 2-D formation scenario through the real processes (wingman-sim, -detector, -localizer,
+# -follower-ctrl) on LCM multicast in a private network namespace, in lockstep; asserts the formation and
+# localization errors stay within the bounds stated in docs/simulation.md and that the flight is flagged when its
+# detections came from ground truth. Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR
+set -euo pipefail
+src="$1"; bin="$2"
+out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
+cd "$src"
+log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 --out "$out" 2>&1) \
+  || { echo "$log"; echo "sim_flight_test: the flight failed" >&2; exit 1; }
+echo "$log"
+fail() { echo "sim_flight_test: $1" >&2; exit 1; }
+[ -s "$out/eval.json" ] || fail "no eval.json"
+[ -s "$out/report.html" ] || fail "no report.html"
+grep -q '<svg id="topdown"' "$out/report.html" || fail "the report has no top-down plot"
+PYENV_VERSION=system python3 - "$out/eval.json" "$bin" <<'PY'
+import json, os, sys
+r = json.load(open(sys.argv[1]))
+weights = [f for f in os.listdir("models") if f.endswith(".weights")]
+problems = []
+def check(ok, what):
+    if not ok: problems.append(what)
+# Bounds (docs/simulation.md): 20 s of formation_2d, lockstep, 0.1 s command delay.
+check(r["duration_s"] >= 19.5, f"flew {r['duration_s']} s, expected 20")
+check(r["truth_frames"] >= 590, f"{r['truth_frames']} ground-truth frames, expected ~600")
+check(r["track_ids_on_leader"] == 1, f"{r['track_ids_on_leader']} track ids on the leader, expected 1")
+check(r["false_targets"] == 0, f"{r['false_targets']} false targets")
+loc, fh, fv = r["localization"], r["formation_horizontal"], r["formation_vertical"]
+check(loc["n"] >= 500, f"only {loc['n']} localized targets matched to truth")
+check(loc["rms_m"] <= 0.5, f"localization RMS {loc['rms_m']:.3f} m > 0.5 m")
+check(fh["n"] >= 400, f"only {fh['n']} formation samples")
+check(fh["rms_m"] <= 1.0, f"formation horizontal RMS {fh['rms_m']:.3f} m > 1.0 m")
+check(fh["max_m"] <= 2.0, f"formation horizontal max {fh['max_m']:.3f} m > 2.0 m")
+check(fv["max_m"] <= 0.5, f"formation vertical max {fv['max_m']:.3f} m > 0.5 m")
+if not weights:
+    check(r["detection_source"] == "ground_truth", f"detection_source {r['detection_source']}, expected ground_truth")
+print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
+sys.exit(1 if problems else 0)
+PY
+grep -q "SIMULATOR'S GROUND TRUTH\|detections from the CNN" <<<"$log" || fail "the flight did not say where detections came from"

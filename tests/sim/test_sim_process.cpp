@@ -1,0 +1,381 @@
+// SPDX-License-Identifier: MIT
+// wingman-sim as a process: its config file, file-to-file runs (channels, order, utimes, truth boxes, ground-truth
+// detections), lockstep with a fake follower on a private network namespace's bus and from a setpoint log (both
+// equal to the library driven directly), lockstep timeouts, the startup wait, rendering, and errors.
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <wingman/detections_t.hpp>
+#include <wingman/ground_truth_t.hpp>
+#include <wingman/image_t.hpp>
+#include <wingman/own_pose_t.hpp>
+#include <wingman/setpoint_t.hpp>
+#include <wingman/sim/scenario.hpp>
+#include <wingman/sim/simulator.hpp>
+#include <wingman/status_t.hpp>
+
+#include <csignal>
+#include <fstream>
+#include <iterator>
+#include <thread>
+
+namespace {
+
+using namespace std::chrono_literals;
+using wingman::testing::bin_path;
+using wingman::testing::Child;
+using wingman::testing::LogEvent;
+using wingman::testing::read_log;
+using wingman::testing::run;
+using wingman::testing::source_path;
+using wingman::testing::TempDir;
+
+constexpr int64_t kStart = 1767225600000000;
+
+/// One second at 30 Hz: the follower 8 m behind a leader that hovers 1 m to the right (east) of the camera's axis.
+const std::string kTinyScenario = R"(name: tiny
+description: "process test"
+start_utime: 1767225600000000
+duration_s: 1
+vehicles:
+  - name: follower
+    id: 0
+    initial: {position: [0, 0, 5], yaw_deg: 90}
+  - name: leader
+    id: 1
+    initial: {position: [1, 8, 5], yaw_deg: 90}
+    motion: {type: hover}
+)";
+
+template <class Msg>
+Msg decode(const LogEvent& e) {
+  Msg m;
+  if (m.decode(e.data.data(), 0, static_cast<int>(e.data.size())) < 0)
+    throw std::runtime_error("cannot decode " + e.channel);
+  return m;
+}
+
+std::vector<LogEvent> without_status(const std::vector<LogEvent>& events) {
+  std::vector<LogEvent> out;
+  for (const auto& e : events) {
+    if (e.channel.rfind("STATUS_", 0) != 0) out.push_back(e);
+  }
+  return out;
+}
+
+struct Files {
+  TempDir dir;
+  std::string scenario = dir.file("tiny.yaml");
+  std::string config = dir.file("sim.yaml");
+  std::string out = dir.file("out.lcmlog");
+  Files(const std::string& config_text, const std::string& scenario_text = kTinyScenario) {
+    std::ofstream(scenario) << scenario_text;
+    std::ofstream(config) << config_text;
+  }
+  std::string out_url() const { return "file://" + out + "?mode=w"; }
+};
+
+wingman::setpoint_t velocity_setpoint(int64_t utime, double ve) {
+  wingman::setpoint_t sp{};
+  sp.utime = utime;
+  sp.mode = wingman::setpoint_t::MODE_VELOCITY;
+  sp.frame = wingman::own_pose_t::FRAME_ENU;
+  sp.velocity[0] = ve;
+  return sp;
+}
+
+/// The fake follower's law: east at 1 m/s for the first half second, then west at 0.5 m/s.
+double fake_follower_velocity(int64_t utime) { return utime < kStart + 500000 ? 1.0 : -0.5; }
+
+/// Own poses the library gives for the tiny scenario with the fake follower's setpoint after every frame.
+std::vector<std::vector<uint8_t>> library_own_poses(const std::string& scenario_path) {
+  wingman::sim::Simulator sim(wingman::sim::load_scenario(scenario_path),
+                              {wingman::localizer::CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5),
+                               wingman::localizer::Extrinsics::from_options({}), 30.0, 0});
+  std::vector<std::vector<uint8_t>> out;
+  while (!sim.done()) {
+    const auto f = sim.step();
+    out.push_back(wingman::testing::make_event("OWN_POSE", f.own_pose, 0).data);
+    sim.on_setpoint(velocity_setpoint(f.utime, fake_follower_velocity(f.utime)));
+  }
+  return out;
+}
+
+TEST(SimProcess, ShippedConfigFileEqualsTheBuiltInDefaultsWithACommentOnEveryKey) {
+  const auto defaults = run({bin_path("wingman-sim"), "--print-config"});
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  const auto from_file = run({bin_path("wingman-sim"), "--print-config", "--config", source_path("config/sim.yaml")});
+  ASSERT_EQ(from_file.exit_code, 0) << from_file.err;
+  EXPECT_EQ(defaults.out.substr(defaults.out.find('\n')), from_file.out.substr(from_file.out.find('\n')));
+  // The file itself is the printed defaults (every key, nothing left to the built-in values).
+  std::ifstream whole(source_path("config/sim.yaml"));
+  const std::string text((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, defaults.out) << "regenerate it: wingman-sim --print-config > config/sim.yaml";
+  std::ifstream in(source_path("config/sim.yaml"));
+  std::string prev, line;
+  int keys = 0;
+  while (std::getline(in, line)) {
+    const auto colon = line.find(':');
+    if (colon != std::string::npos && line.find('#') == std::string::npos && colon + 1 < line.size()) {
+      ++keys;
+      EXPECT_NE(prev.find('#'), std::string::npos) << "key without a comment: " << line;
+    }
+    prev = line;
+  }
+  EXPECT_GT(keys, 30);
+  // The camera defaults are the localizer's, so the pipeline works on embedded defaults.
+  const auto loc = run({bin_path("wingman-localizer"), "--print-config"});
+  for (const char* key :
+       {"  width: 1280\n", "  height: 720\n", "  focal_px: 640.0\n", "  calibration: \"\"\n",
+        "  p_cam_in_body: [0.0, 0.0, 0.0]\n", "  R_cam_to_body: [0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0]\n"}) {
+    EXPECT_NE(defaults.out.find(key), std::string::npos) << key;
+    EXPECT_NE(loc.out.find(key), std::string::npos) << key;
+  }
+}
+
+TEST(SimProcess, FreeRunFileToFilePublishesPoseTruthAndDetectionsPerFrameInOrder) {
+  Files f("sync:\n  mode: free\nrender:\n  enabled: false\ndetections:\n  from_ground_truth: true\n");
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-in", "memq://",
+                      "--lcm-out", f.out_url()},
+                     30s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("detections come from GROUND TRUTH"), std::string::npos) << r.err;
+  const auto all = read_log(f.out);
+  const auto events = without_status(all);
+  ASSERT_EQ(events.size(), 30u * 3);
+  for (int64_t k = 0; k < 30; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const int64_t t_k = kStart + std::llround(k * 1e6 / 30.0);
+    ASSERT_EQ(events[3 * k].channel, "OWN_POSE");
+    ASSERT_EQ(events[3 * k + 1].channel, "GROUND_TRUTH");
+    ASSERT_EQ(events[3 * k + 2].channel, "DETECTIONS_CAM0");
+    const auto pose = decode<wingman::own_pose_t>(events[3 * k]);
+    const auto truth = decode<wingman::ground_truth_t>(events[3 * k + 1]);
+    const auto det = decode<wingman::detections_t>(events[3 * k + 2]);
+    EXPECT_EQ(pose.utime, t_k);
+    EXPECT_EQ(truth.utime, t_k);
+    EXPECT_EQ(det.utime, t_k);
+    EXPECT_EQ(det.seq, k);
+    EXPECT_EQ(truth.image_seq, -1);           // render off: no image
+    EXPECT_EQ(pose.p_body_in_world[2], 5.0);  // no setpoints: the follower hovers
+    ASSERT_EQ(truth.num_vehicles, 2);
+    EXPECT_EQ(truth.vehicles[1].name, "leader");
+    ASSERT_EQ(truth.num_boxes, 1);
+    const auto& b = truth.boxes[0];
+    EXPECT_TRUE(b.visible);
+    EXPECT_NEAR(b.range, std::sqrt(65.0), 1e-9);
+    EXPECT_NEAR(b.cx, 640 + 640 * 1.0 / 8.0, 4.0);  // 1 m right at 8 m: 80 px right of the centre
+    EXPECT_GT(b.cy, 360.0);                         // the landing gear hangs lower than the motors stand up
+    EXPECT_LT(b.cy, 370.0);
+    ASSERT_EQ(det.num_detections, 1);
+    EXPECT_EQ(int{det.source}, int{wingman::detections_t::SOURCE_GROUND_TRUTH});
+    EXPECT_FLOAT_EQ(det.detections[0].cx, b.cx);
+    EXPECT_FLOAT_EQ(det.detections[0].w, b.w);
+    EXPECT_EQ(det.image_width, 1280);
+  }
+  const auto last = decode<wingman::status_t>(all.back());
+  EXPECT_EQ(all.back().channel, "STATUS_SIM");
+  EXPECT_EQ(int{last.state}, int{wingman::status_t::STATE_STOPPING});
+  EXPECT_EQ(last.detail, "end of scenario");
+  EXPECT_EQ(last.last_processed_seq, 29);
+}
+
+TEST(SimProcess, DurationOptionShortensTheRun) {
+  Files f("sync:\n  mode: free\nrender:\n  enabled: false\n");
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--duration", "0.5",
+                      "--lcm-in", "memq://", "--lcm-out", f.out_url()},
+                     30s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int truths = 0;
+  for (const auto& e : read_log(f.out)) truths += e.channel == "GROUND_TRUTH";
+  EXPECT_EQ(truths, 15);  // frames with t_k < 0.5 s at 30 Hz
+  const auto bad = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--duration", "-1"}, 10s);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("wingman-sim: error: --duration = '-1': must be a number of simulated seconds > 0"),
+            std::string::npos)
+      << bad.err;
+}
+
+TEST(SimProcess, LockstepFromASetpointLogEqualsTheLibrary) {
+  Files f("sync:\n  mode: lockstep\nrender:\n  enabled: false\n");
+  // The follower's answers, one per frame, as a log the simulator reads in lockstep (no wall clock involved).
+  std::vector<LogEvent> setpoints;
+  for (int64_t k = 0; k < 30; ++k) {
+    const int64_t t_k = kStart + std::llround(k * 1e6 / 30.0);
+    setpoints.push_back(
+        wingman::testing::make_event("SETPOINT", velocity_setpoint(t_k, fake_follower_velocity(t_k)), t_k));
+  }
+  const std::string in = f.dir.file("setpoints.lcmlog");
+  wingman::testing::write_log(in, setpoints);
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-in",
+                      "file://" + in + "?speed=0", "--lcm-out", f.out_url()},
+                     30s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::vector<uint8_t>> poses;
+  for (const auto& e : read_log(f.out)) {
+    if (e.channel == "OWN_POSE") poses.push_back(e.data);
+  }
+  const auto expected = library_own_poses(f.scenario);
+  ASSERT_EQ(expected.size(), 30u);
+  EXPECT_EQ(poses, expected);
+  // The follower did move: east, then back west.
+  const auto mid = decode<wingman::own_pose_t>(LogEvent{0, "OWN_POSE", poses[15]});
+  EXPECT_GT(mid.p_body_in_world[0], 0.1);
+}
+
+TEST(SimProcess, LockstepWithAFakeFollowerOnTheBusEqualsTheLibrary) {
+  Files f(
+      "sync:\n  mode: lockstep\n  timeout_s: 10\n  wait_for: [fake_follower]\n  startup_timeout_s: 20\n"
+      "render:\n  enabled: false\n");
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM bus(url);
+  ASSERT_TRUE(bus.good());
+  struct Fake {
+    lcm::LCM* bus;
+    std::vector<std::vector<uint8_t>> poses;
+    int truths = 0;
+    void on_truth(const lcm::ReceiveBuffer*, const std::string&, const wingman::ground_truth_t* t) {
+      ++truths;
+      const wingman::setpoint_t sp = velocity_setpoint(t->utime, fake_follower_velocity(t->utime));
+      bus->publish("SETPOINT", &sp);
+    }
+    void on_pose(const lcm::ReceiveBuffer* rb, const std::string&, const wingman::own_pose_t*) {
+      poses.emplace_back(static_cast<const uint8_t*>(rb->data), static_cast<const uint8_t*>(rb->data) + rb->data_size);
+    }
+  } fake{&bus, {}, 0};
+  bus.subscribe("GROUND_TRUTH", &Fake::on_truth, &fake);
+  bus.subscribe("OWN_POSE", &Fake::on_pose, &fake);
+
+  Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
+  wingman::status_t hb{};
+  hb.process = "fake_follower";
+  hb.state = wingman::status_t::STATE_OK;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  int exit_code = -1;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fake.truths == 0) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
+    bus.handleTimeout(50);
+    if (!sim.running()) {
+      exit_code = sim.wait(1s);
+      break;
+    }
+  }
+  while (bus.handleTimeout(100) > 0) {
+  }
+  ASSERT_EQ(exit_code, 0) << sim.err();
+  EXPECT_EQ(fake.truths, 30);
+  EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
+  EXPECT_EQ(fake.poses, library_own_poses(f.scenario));
+}
+
+TEST(SimProcess, LockstepWithoutAFollowerTimesOutCountsAndGoesOn) {
+  Files f("sync:\n  mode: lockstep\n  timeout_s: 0.2\nrender:\n  enabled: false\n",
+          std::string(kTinyScenario).replace(kTinyScenario.find("duration_s: 1"), 13, "duration_s: 0.1"));
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-in",
+                      wingman::testing::netns_lcm_url(), "--lcm-out", f.out_url(), "--status-period", "0.05"},
+                     30s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("3 frames"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 lockstep timeouts"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no SETPOINT with utime >= the frame's within 0.2 s"), std::string::npos) << r.err;
+  bool degraded = false;
+  for (const auto& e : read_log(f.out)) {
+    if (e.channel != "STATUS_SIM") continue;
+    const auto s = decode<wingman::status_t>(e);
+    if (s.state == wingman::status_t::STATE_DEGRADED && s.detail.find("lockstep timeouts") != std::string::npos)
+      degraded = true;
+  }
+  EXPECT_TRUE(degraded);
+}
+
+TEST(SimProcess, MissingProcessesAtStartupExitOneNamingThem) {
+  Files f("sync:\n  wait_for: [ghost, localizer]\n  startup_timeout_s: 0.5\nrender:\n  enabled: false\n");
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url",
+                      wingman::testing::netns_lcm_url()},
+                     30s);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("wingman-sim: error: sync.wait_for: no status heartbeat within 0.5 s from ghost (STATUS_GHOST), "
+                       "localizer (STATUS_LOCALIZER)"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(SimProcess, SigtermWhileWaitingForASetpointExitsZero) {
+  Files f("sync:\n  mode: lockstep\n  timeout_s: 60\nrender:\n  enabled: false\n");
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM bus(url);
+  struct Counter {
+    int truths = 0;
+    void on(const lcm::ReceiveBuffer*, const std::string&) { ++truths; }
+  } counter;
+  bus.subscribe("GROUND_TRUTH", &Counter::on, &counter);
+  const int& truths = counter.truths;
+  Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (truths == 0 && std::chrono::steady_clock::now() < deadline) bus.handleTimeout(50);
+  ASSERT_EQ(truths, 1);
+  sim.signal(SIGTERM);
+  EXPECT_EQ(sim.wait(5s), 0) << sim.err();
+}
+
+TEST(SimProcess, RealtimeRunPublishesEveryFrame) {
+  Files f("sync:\n  mode: realtime\n  speed: 10\nrender:\n  enabled: false\n");
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-in",
+                      wingman::testing::netns_lcm_url(), "--lcm-out", f.out_url()},
+                     30s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int truths = 0;
+  for (const auto& e : read_log(f.out)) truths += e.channel == "GROUND_TRUTH";
+  EXPECT_EQ(truths, 30);
+}
+
+TEST(SimProcess, RenderedImagesArePublishedLikeTheCameraDriversAfterPoseAndTruth) {
+  Files f("sync:\n  mode: free\n",
+          std::string(kTinyScenario).replace(kTinyScenario.find("duration_s: 1"), 13, "duration_s: 0.1"));
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-in", "memq://",
+                      "--lcm-out", f.out_url()},
+                     120s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto events = without_status(read_log(f.out));
+  ASSERT_EQ(events.size(), 3u * 3);
+  for (int64_t k = 0; k < 3; ++k) {
+    ASSERT_EQ(events[3 * k].channel, "OWN_POSE");
+    ASSERT_EQ(events[3 * k + 1].channel, "GROUND_TRUTH");
+    ASSERT_EQ(events[3 * k + 2].channel, "IMAGE_CAM0");
+    const auto truth = decode<wingman::ground_truth_t>(events[3 * k + 1]);
+    const auto image = decode<wingman::image_t>(events[3 * k + 2]);
+    EXPECT_EQ(truth.image_seq, k);
+    EXPECT_EQ(image.seq, k);
+    EXPECT_EQ(image.utime, truth.utime);
+    EXPECT_EQ(int{image.pixel_format}, int{wingman::image_t::BGR8});
+    EXPECT_EQ(image.width, 1280);
+    EXPECT_EQ(image.height, 720);
+    EXPECT_EQ(image.stride, 3 * 1280);
+    EXPECT_EQ(image.size, 3 * 1280 * 720);
+    ASSERT_EQ(truth.num_boxes, 1);
+    EXPECT_TRUE(truth.boxes[0].visible);
+  }
+}
+
+TEST(SimProcess, BadScenarioAndMissingScenarioAreConfigurationErrors) {
+  Files f("render:\n  enabled: false\n",
+          std::string(kTinyScenario).replace(kTinyScenario.find("type: hover"), 11, "type: hovr"));
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--lcm-url", "memq://"}, 10s);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line expected: " << r.err;
+  EXPECT_NE(r.err.find("wingman-sim: error: 1 problem in scenario: " + f.scenario +
+                       ":12: vehicles[1].motion.type: 'hovr' is not a motion type"),
+            std::string::npos)
+      << r.err;
+  const auto none = run({bin_path("wingman-sim"), "--lcm-url", "memq://"}, 10s);
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.err.find("wingman-sim: error: no scenario: give --scenario FILE"), std::string::npos) << none.err;
+  const auto no_file = run({bin_path("wingman-sim"), "--scenario", "/nonexistent.yaml", "--lcm-url", "memq://"}, 10s);
+  EXPECT_EQ(no_file.exit_code, 2);
+  EXPECT_NE(no_file.err.find("/nonexistent.yaml: cannot open scenario file"), std::string::npos) << no_file.err;
+  const auto no_arg = run({bin_path("wingman-sim"), "--scenario"}, 10s);
+  EXPECT_EQ(no_arg.exit_code, 2);
+}
+
+}  // namespace

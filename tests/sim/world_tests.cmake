@@ -1,0 +1,16 @@
+# SPDX-License-Identifier: MIT
+# Tests of the simulator's world: dynamics, scenarios and scripts, the Simulator (no rendering), and the process.
+
+# Library: multirotor dynamics, setpoint frames, scenario files and scripted motions, the Simulator without images.
+wingman_add_test(test_sim_world
+  SOURCES test_multirotor.cpp test_scenario.cpp test_simulator.cpp
+  LIBS wingman::sim_world wingman::test_support)
+
+# wingman-sim as a process: file to file, lockstep on the bus of a private network namespace, errors.
+wingman_add_test(test_sim_process
+  SOURCES test_sim_process.cpp
+  LIBS wingman::sim_world wingman::test_support wingman::lcmtypes
+  LABEL netns
+  TIMEOUT 180
+  NETNS)
+add_dependencies(test_sim_process wingman-sim wingman-localizer)

@@ -1,0 +1,129 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Flies a simulated scenario through the real pipeline: wingman-sim (camera + autopilot stand-in), wingman-detector,
+# wingman-localizer and wingman-follower-ctrl as separate processes on LCM multicast inside a private network
+# namespace, in lockstep (deterministic). Records the bus, prints the localization and formation errors and writes an
+# HTML report. Needs a build (tools/build.sh); the README's main command (tools/demo.sh) builds first.
+#
+# Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--no-render] [--record-images]
+#                     [--truth-box sphere|silhouette]
+#   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
+#   --out            output folder (default build/flights/NAME)
+#   --duration       stop after S simulated seconds (default: the scenario's own length)
+#   --no-render      no images (faster; needs ground-truth detections)
+#   --record-images  also record the camera images in the log (2.7 MB per 1280x720 frame)
+#   --truth-box      ground-truth detections: the bounding sphere's exact box, the localizer's model (default), or
+#                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
+# The detector uses the shipped trained model when models/ holds one (WINGMAN_MODEL_WEIGHTS overrides); without one,
+# the simulator publishes detections projected from ground truth, flagged as such in every message, and says so.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+src=$(pwd)
+bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
+
+scenario=formation_2d out="" duration="" render=true record_images=false truth_box=sphere
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --scenario) scenario="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --duration) duration="$2"; shift 2 ;;
+    --no-render) render=false; shift ;;
+    --record-images) record_images=true; shift ;;
+    --truth-box) truth_box="$2"; shift 2 ;;
+    -h|--help) sed -n 3,18p "$0"; exit 0 ;;
+    *) echo "fly: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+if [ -f "$scenario" ]; then scenario_file=$(realpath "$scenario"); name=$(basename "$scenario" .yaml)
+else scenario_file="$src/config/scenarios/$scenario.yaml"; name="$scenario"; fi
+case "$truth_box" in sphere|silhouette) ;; *) echo "fly: --truth-box '$truth_box': expected sphere or silhouette" >&2; exit 2 ;; esac
+[ -r "$scenario_file" ] || { echo "fly: no scenario '$scenario' (looked for $scenario_file)" >&2; exit 2; }
+out="${out:-$src/build/flights/$name}"
+for exe in wingman-sim wingman-detector wingman-localizer wingman-follower-ctrl wingman; do
+  [ -x "$bin/$exe" ] || { echo "fly: $bin/$exe is missing: build first (tools/build.sh)" >&2; exit 2; }
+done
+
+if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
+  exec tools/netns_run.sh "$0" --scenario "$scenario_file" --out "$out" ${duration:+--duration "$duration"} \
+    $([ "$render" = true ] || echo --no-render) $([ "$record_images" = true ] && echo --record-images) --truth-box "$truth_box"
+fi
+
+mkdir -p "$out"
+out=$(realpath "$out")
+url="$WINGMAN_LCM_URL"
+log="$out/flight.lcmlog"
+rm -f "$log"
+
+# A shipped model (issue 6 puts one in models/) makes the detector real; otherwise ground-truth detections.
+weights="${WINGMAN_MODEL_WEIGHTS:-}"
+if [ -z "$weights" ]; then weights=$(ls "$src"/models/*.weights 2>/dev/null | head -n 1 || true); fi
+if [ -n "$weights" ]; then
+  cfg="${weights%.weights}.cfg"
+  [ -r "$cfg" ] || { echo "fly: model $weights has no $cfg beside it" >&2; exit 2; }
+  truth_detections=false
+  echo "fly: detections from the CNN: $weights"
+else
+  truth_detections=true
+  echo "fly: no trained model in models/: detections come from the SIMULATOR'S GROUND TRUTH ($truth_box boxes," \
+       "1 px edge noise; flagged source=SOURCE_GROUND_TRUTH in detections, targets and setpoints); the detector" \
+       "process runs without weights"
+fi
+
+# Per-flight configs: the process defaults, plus config/flights/<scenario>.<process>.yaml where one exists.
+flight_cfg() { local f="$src/config/flights/$name.$1.yaml"; [ -r "$f" ] && echo "--config $f" || true; }
+cat > "$out/sim.yaml" <<YAML
+# Written by tools/fly.sh for this flight.
+scenario: {file: "$scenario_file"}
+sync: {mode: lockstep, timeout_s: 10.0, wait_for: [detector, localizer, follower_ctrl], startup_timeout_s: 60.0}
+detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0}
+render: {enabled: $render}
+YAML
+if [ -n "$weights" ]; then
+  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\n' \
+    "$cfg" "$weights" > "$out/detector.yaml"
+else
+  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\n' > "$out/detector.yaml"
+fi
+
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+trap cleanup EXIT
+
+echo "fly: scenario $name, LCM bus $url (private network namespace), output in $out"
+logger_args=(--lcm-url="$url" --force --quiet)
+[ "$record_images" = true ] || logger_args+=(--channel='IMAGE_.*' --invert-channels)
+lcm-logger "${logger_args[@]}" "$log" & pids+=($!)
+"$bin/wingman-detector" --lcm-url "$url" --config "$out/detector.yaml" --log-level warn & pids+=($!)
+# shellcheck disable=SC2046
+"$bin/wingman-localizer" --lcm-url "$url" $(flight_cfg localizer) --log-level warn & pids+=($!)
+# shellcheck disable=SC2046
+"$bin/wingman-follower-ctrl" --lcm-url "$url" $(flight_cfg follower_ctrl) --log-level warn & pids+=($!)
+
+sim_args=(--lcm-url "$url" --config "$out/sim.yaml")
+[ -n "$duration" ] && sim_args+=(--duration "$duration")
+SECONDS=0
+"$bin/wingman-sim" "${sim_args[@]}"
+wall=$SECONDS
+sleep 0.3   # let the logger write the last messages
+cleanup
+pids=()
+trap - EXIT
+
+# Formation target of this flight, from the follower's effective config.
+follower_cfg=$("$bin/wingman-follower-ctrl" $(flight_cfg follower_ctrl) --print-config)
+mode=$(echo "$follower_cfg" | awk '/^controller:/{c=1} c && /mode:/{gsub(/"/,"",$2); print $2; exit}')
+eval_args=("$log" --report "$out/report.html" --json "$out/eval.json" --title "Wingman flight: $name")
+if [ "$mode" = formation ]; then
+  offset=$(echo "$follower_cfg" | awk '/^formation:/{f=1} f && /offset_m:/{sub(/.*offset_m:/,""); gsub(/[][ ]/,""); print; exit}')
+  eval_args+=(--formation-offset "$offset")
+elif [ "$mode" = pid_1d ]; then
+  # The 1-D follow keeps the leader straight ahead: the desired position is the leader's, moved back to the
+  # follower's own line (the scenario's start), so the horizontal error is the error along the leader's path.
+  fy=$(awk '/name: follower/{f=1} f && /position:/{gsub(/[][,]/," "); print $3; exit}' "$scenario_file")
+  ly=$(awk '/name: leader/{l=1} l && /position:/{gsub(/[][,]/," "); print $3; exit}' "$scenario_file")
+  eval_args+=(--formation-offset "0,$(awk -v a="$fy" -v b="$ly" 'BEGIN{print a - b}'),0")
+fi
+echo
+echo "fly: $name flown in $wall s of wall-clock time; errors against ground truth:"
+"$bin/wingman" eval "${eval_args[@]}"
+echo "fly: log $log, report $out/report.html"
