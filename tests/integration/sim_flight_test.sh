@@ -3,15 +3,30 @@
 # CI flight: 20 s of the 2-D formation scenario through the real processes (wingman-sim, -detector, -localizer,
 # -follower-ctrl) on LCM multicast in a private network namespace, in lockstep; asserts the formation and
 # localization errors stay within the bounds stated in docs/simulation.md and that the flight is flagged when its
-# detections came from ground truth. Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR
+# detections came from ground truth. Without a trained model the 20 s flight runs without images (ground-truth
+# detections need none); `rendered` flies 2 s with rendered 1280x720 images through the detector process instead.
+# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered]
 set -euo pipefail
-src="$1"; bin="$2"
+src="$1"; bin="$2"; kind="${3:-flight}"
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 cd "$src"
-log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 --out "$out" 2>&1) \
-  || { echo "$log"; echo "sim_flight_test: the flight failed" >&2; exit 1; }
-echo "$log"
 fail() { echo "sim_flight_test: $1" >&2; exit 1; }
+if [ "$kind" = rendered ]; then
+  log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 2 --out "$out" 2>&1) \
+    || { echo "$log"; fail "the rendered flight failed"; }
+  echo "$log"
+  # 61 frames (t = 0 .. 2 s at 30 Hz): the detector handled every image and the follower every targets_t.
+  "$bin/wingman" loginfo "$out/flight.lcmlog" | tee "$out/loginfo.txt"
+  grep -Eq "^  detector .*handled 61, drops 0" "$out/loginfo.txt" || fail "the detector did not handle all 61 images"
+  grep -Eq "^SETPOINT +setpoint_t +61 " "$out/loginfo.txt" || fail "expected 61 setpoints"
+  echo "sim_flight_test: ok"
+  exit 0
+fi
+models=$(ls models/*.weights 2>/dev/null || true)
+render=(); [ -z "$models" ] && render=(--no-render)
+log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 "${render[@]}" \
+      --out "$out" 2>&1) || { echo "$log"; fail "the flight failed"; }
+echo "$log"
 [ -s "$out/eval.json" ] || fail "no eval.json"
 [ -s "$out/report.html" ] || fail "no report.html"
 grep -q '<svg id="topdown"' "$out/report.html" || fail "the report has no top-down plot"
@@ -22,18 +37,18 @@ weights = [f for f in os.listdir("models") if f.endswith(".weights")]
 problems = []
 def check(ok, what):
     if not ok: problems.append(what)
-# Bounds (docs/simulation.md): 20 s of formation_2d, lockstep, 0.1 s command delay.
+# Bounds (docs/simulation.md): 20 s of formation_2d, lockstep, 0.1 s command delay, 1 px edge noise.
 check(r["duration_s"] >= 19.5, f"flew {r['duration_s']} s, expected 20")
 check(r["truth_frames"] >= 590, f"{r['truth_frames']} ground-truth frames, expected ~600")
 check(r["track_ids_on_leader"] == 1, f"{r['track_ids_on_leader']} track ids on the leader, expected 1")
 check(r["false_targets"] == 0, f"{r['false_targets']} false targets")
 loc, fh, fv = r["localization"], r["formation_horizontal"], r["formation_vertical"]
 check(loc["n"] >= 500, f"only {loc['n']} localized targets matched to truth")
-check(loc["rms_m"] <= 0.5, f"localization RMS {loc['rms_m']:.3f} m > 0.5 m")
+check(loc["rms_m"] <= 0.2, f"localization RMS {loc['rms_m']:.3f} m > 0.2 m")
 check(fh["n"] >= 400, f"only {fh['n']} formation samples")
-check(fh["rms_m"] <= 1.0, f"formation horizontal RMS {fh['rms_m']:.3f} m > 1.0 m")
-check(fh["max_m"] <= 2.0, f"formation horizontal max {fh['max_m']:.3f} m > 2.0 m")
-check(fv["max_m"] <= 0.5, f"formation vertical max {fv['max_m']:.3f} m > 0.5 m")
+check(fh["rms_m"] <= 0.3, f"formation horizontal RMS {fh['rms_m']:.3f} m > 0.3 m")
+check(fh["max_m"] <= 0.75, f"formation horizontal max {fh['max_m']:.3f} m > 0.75 m")
+check(fv["max_m"] <= 0.1, f"formation vertical max {fv['max_m']:.3f} m > 0.1 m")
 if not weights:
     check(r["detection_source"] == "ground_truth", f"detection_source {r['detection_source']}, expected ground_truth")
 print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
