@@ -1,19 +1,11 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# README's main command. Installs and builds, then plays a short video through wingman-camera-driver
-# into the running pipeline (detector, localizer, follower) on LCM multicast inside a private network
-# namespace, records the bus, and shows what arrived.
-# Usage: tools/demo.sh [VIDEO]   (default: a synthetic clip made by `wingman make-video`;
-#        e.g. tools/demo.sh ../shared/datasets/halmstad/videos/V_DRONE_001.mp4 for a real one)
+# README's main command: installs what is missing, builds, then flies the thesis's 2-D formation in simulation
+# through the real pipeline (wingman-sim, wingman-detector, wingman-localizer, wingman-follower-ctrl as separate
+# processes on LCM in a private network namespace), records the bus, prints the localization and formation errors
+# and writes an HTML report with the top-down paths. Arguments go to tools/fly.sh (e.g. --scenario follow_1d,
+# --render, --duration 30); see tools/fly.sh --help. The camera-driver demo of a video file: tools/demo_camera.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/build.sh
-out=build/demo
-mkdir -p "$out"
-video="${1:-}"
-if [ -z "$video" ]; then
-  video="$out/synthetic.avi"
-  build/bin/wingman make-video "$video" --frames 150 --width 640 --height 480
-fi
-[ -r "$video" ] || { echo "demo: cannot read video '$video'" >&2; exit 1; }
-exec tools/netns_run.sh tools/demo_pipeline.sh "$video" "$out"
+exec tools/fly.sh "$@"

@@ -5,12 +5,13 @@
 # namespace, in lockstep (deterministic). Records the bus, prints the localization and formation errors and writes an
 # HTML report. Needs a build (tools/build.sh); the README's main command (tools/demo.sh) builds first.
 #
-# Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--no-render] [--record-images]
+# Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--render|--no-render] [--record-images]
 #                     [--truth-box sphere|silhouette]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
-#   --no-render      no images (faster; needs ground-truth detections)
+#   --render         render the camera images (1280x720, ~0.5 s a frame on llvmpipe here); the default with a model
+#   --no-render      no images (ground-truth detections need none); the default without a model
 #   --record-images  also record the camera images in the log (2.7 MB per 1280x720 frame)
 #   --truth-box      ground-truth detections: the bounding sphere's exact box, the localizer's model (default), or
 #                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
@@ -21,16 +22,17 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
-scenario=formation_2d out="" duration="" render=true record_images=false truth_box=sphere
+scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --duration) duration="$2"; shift 2 ;;
     --no-render) render=false; shift ;;
+    --render) render=true; shift ;;
     --record-images) record_images=true; shift ;;
     --truth-box) truth_box="$2"; shift 2 ;;
-    -h|--help) sed -n 3,18p "$0"; exit 0 ;;
+    -h|--help) sed -n 3,19p "$0"; exit 0 ;;
     *) echo "fly: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -45,7 +47,7 @@ done
 
 if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   exec tools/netns_run.sh "$0" --scenario "$scenario_file" --out "$out" ${duration:+--duration "$duration"} \
-    $([ "$render" = true ] || echo --no-render) $([ "$record_images" = true ] && echo --record-images) --truth-box "$truth_box"
+    $([ "$render" = true ] && echo --render) $([ "$render" = false ] && echo --no-render) $([ "$record_images" = true ] && echo --record-images) --truth-box "$truth_box"
 fi
 
 mkdir -p "$out"
@@ -61,12 +63,16 @@ if [ -n "$weights" ]; then
   cfg="${weights%.weights}.cfg"
   [ -r "$cfg" ] || { echo "fly: model $weights has no $cfg beside it" >&2; exit 2; }
   truth_detections=false
+  [ "$render" = false ] && { echo "fly: a detector model needs images: drop --no-render" >&2; exit 2; }
+  render=true
   echo "fly: detections from the CNN: $weights"
 else
   truth_detections=true
   echo "fly: no trained model in models/: detections come from the SIMULATOR'S GROUND TRUTH ($truth_box boxes," \
        "1 px edge noise; flagged source=SOURCE_GROUND_TRUTH in detections, targets and setpoints); the detector" \
        "process runs without weights"
+  [ "$render" = auto ] && render=false
+  [ "$render" = false ] && echo "fly: images are not rendered (ground-truth detections need none; --render renders them)"
 fi
 
 # Per-flight configs: the process defaults, plus config/flights/<scenario>.<process>.yaml where one exists.

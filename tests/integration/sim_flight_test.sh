@@ -12,7 +12,7 @@ out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 cd "$src"
 fail() { echo "sim_flight_test: $1" >&2; exit 1; }
 if [ "$kind" = rendered ]; then
-  log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 2 --out "$out" 2>&1) \
+  log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 2 --render --out "$out" 2>&1) \
     || { echo "$log"; fail "the rendered flight failed"; }
   echo "$log"
   # 61 frames (t = 0 .. 2 s at 30 Hz): the detector handled every image and the follower every targets_t.
@@ -22,10 +22,7 @@ if [ "$kind" = rendered ]; then
   echo "sim_flight_test: ok"
   exit 0
 fi
-models=$(ls models/*.weights 2>/dev/null || true)
-render=(); [ -z "$models" ] && render=(--no-render)
-log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 "${render[@]}" \
-      --out "$out" 2>&1) || { echo "$log"; fail "the flight failed"; }
+log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 --out "$out" 2>&1) || { echo "$log"; fail "the flight failed"; }
 echo "$log"
 [ -s "$out/eval.json" ] || fail "no eval.json"
 [ -s "$out/report.html" ] || fail "no report.html"
