@@ -91,14 +91,19 @@ else
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\n' > "$out/detector.yaml"
 fi
 
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+pids=() logger_pid=""
+# Stop the pipeline first (each process publishes a last STOPPING status), then the logger.
+cleanup() {
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  if [ -n "$logger_pid" ]; then sleep 0.3; kill -TERM "$logger_pid" 2>/dev/null || true; wait "$logger_pid" || true; fi
+}
 trap cleanup EXIT
 
 echo "fly: scenario $name, LCM bus $url (private network namespace), output in $out"
 logger_args=(--lcm-url="$url" --force --quiet)
 [ "$record_images" = true ] || logger_args+=(--channel='IMAGE_.*' --invert-channels)
-lcm-logger "${logger_args[@]}" "$log" & pids+=($!)
+lcm-logger "${logger_args[@]}" "$log" & logger_pid=$!
 "$bin/wingman-detector" --lcm-url "$url" --config "$out/detector.yaml" --log-level warn & pids+=($!)
 # shellcheck disable=SC2046
 "$bin/wingman-localizer" --lcm-url "$url" $(flight_cfg localizer) --log-level warn & pids+=($!)
@@ -110,9 +115,8 @@ sim_args=(--lcm-url "$url" --config "$out/sim.yaml")
 SECONDS=0
 "$bin/wingman-sim" "${sim_args[@]}"
 wall=$SECONDS
-sleep 0.3   # let the logger write the last messages
 cleanup
-pids=()
+pids=() logger_pid=""
 trap - EXIT
 
 # Formation target of this flight, from the follower's effective config.

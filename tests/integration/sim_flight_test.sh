@@ -15,10 +15,10 @@ if [ "$kind" = rendered ]; then
   log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 2 --render --out "$out" 2>&1) \
     || { echo "$log"; fail "the rendered flight failed"; }
   echo "$log"
-  # 61 frames (t = 0 .. 2 s at 30 Hz): the detector handled every image and the follower every targets_t.
+  # 60 frames (t = 0 .. 1.967 s at 30 Hz): the detector handled every image and the follower every targets_t.
   "$bin/wingman" loginfo "$out/flight.lcmlog" | tee "$out/loginfo.txt"
-  grep -Eq "^  detector .*handled 61, drops 0" "$out/loginfo.txt" || fail "the detector did not handle all 61 images"
-  grep -Eq "^SETPOINT +setpoint_t +61 " "$out/loginfo.txt" || fail "expected 61 setpoints"
+  grep -Eq "^  detector .*handled 60, drops 0" "$out/loginfo.txt" || fail "the detector did not handle all 60 images"
+  grep -Eq "^SETPOINT +setpoint_t +60 " "$out/loginfo.txt" || fail "expected 60 setpoints"
   echo "sim_flight_test: ok"
   exit 0
 fi
