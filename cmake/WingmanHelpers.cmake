@@ -16,9 +16,15 @@ function(wingman_add_test name)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  # The test environment goes through the emulator (`env VAR=...`): gtest_discover_tests keeps only the first entry
+  # of an ENVIRONMENT list property. NETNS tests then run inside tools/netns_run.sh's private network namespace.
+  set(_emulator env "WINGMAN_BIN_DIR=${CMAKE_BINARY_DIR}/bin" "WINGMAN_TEST_BIN_DIR=${CMAKE_BINARY_DIR}/tests"
+                "WINGMAN_SOURCE_DIR=${CMAKE_SOURCE_DIR}" "WINGMAN_BUILD_DIR=${CMAKE_BINARY_DIR}" "POCL_AFFINITY=1"
+                "OMP_WAIT_POLICY=PASSIVE")
   if(ARG_NETNS)
-    set_target_properties(${name} PROPERTIES CROSSCOMPILING_EMULATOR ${CMAKE_SOURCE_DIR}/tools/netns_run.sh)
+    list(APPEND _emulator ${CMAKE_SOURCE_DIR}/tools/netns_run.sh)
   endif()
+  set_target_properties(${name} PROPERTIES CROSSCOMPILING_EMULATOR "${_emulator}")
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gmock GTest::gtest_main)
   wingman_warnings(${name})
   if(NOT ARG_TIMEOUT)
@@ -27,6 +33,5 @@ function(wingman_add_test name)
   gtest_discover_tests(${name}
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR}
     PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS ${ARG_LABEL}
-               ENVIRONMENT "WINGMAN_BIN_DIR=${CMAKE_BINARY_DIR}/bin;WINGMAN_TEST_BIN_DIR=${CMAKE_BINARY_DIR}/tests;WINGMAN_SOURCE_DIR=${CMAKE_SOURCE_DIR};WINGMAN_BUILD_DIR=${CMAKE_BINARY_DIR};POCL_AFFINITY=1;OMP_WAIT_POLICY=PASSIVE"
     DISCOVERY_TIMEOUT 60)
 endfunction()

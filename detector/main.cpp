@@ -51,6 +51,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     out.camera_id = img.camera_id;
     out.image_width = img.width;
     out.image_height = img.height;
+    out.source = detections_t::SOURCE_CNN;
     out.inference_latency_us = static_cast<int32_t>(latency_us);
     for (const auto& b : boxes) out.detections.push_back({b.cx, b.cy, b.w, b.h, b.confidence, 0, b.zoom_refined});
     out.num_detections = static_cast<int32_t>(out.detections.size());

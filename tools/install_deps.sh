@@ -15,6 +15,8 @@ packages=(
   clinfo libv4l-dev
   # simulator (WINGMAN_WITH_SIM): offscreen OpenGL through EGL on Mesa llvmpipe, mesh loading
   libegl-dev libgles-dev libgl1-mesa-dri libassimp-dev
+  # trainer (WINGMAN_WITH_TRAINING): libtorch on the CPU
+  libtorch-dev
   # configuration, CLI, logging
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   # tests and benchmarks

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -61,6 +62,17 @@ class SectionReader {
     return static_cast<int>(v);
   }
 
+  float get_float(const std::string& key, float def) {
+    const Entry* e = find(key);
+    if (!e) return def;
+    errno = 0;
+    char* end = nullptr;
+    const float v = std::strtof(e->value.c_str(), &end);
+    if (errno != 0 || end == e->value.c_str() || *end != '\0' || !std::isfinite(v))
+      fail(e->line, fmt::format("key '{}' = '{}': expected a number", key, e->value));
+    return v;
+  }
+
   std::vector<float> get_floats(const std::string& key) {
     return get_list<float>(key, "a number", [](const char* text, char** end) { return std::strtof(text, end); });
   }
@@ -99,11 +111,6 @@ class SectionReader {
     for (const auto& e : s_.entries)
       if (e.key == key) return e.line;
     return s_.line;
-  }
-
-  /// Marks keys that are accepted but not kept (training-only).
-  void ignore(std::initializer_list<const char*> keys) {
-    for (const char* k : keys) used_.insert(k);
   }
 
   /// Every key that no getter asked for is an unsupported key.
@@ -276,8 +283,16 @@ DarknetModel parse_darknet_cfg_string(const std::string& cfg_text, const std::st
       const int coords = r.get_int("coords", 4);
       if (coords != 4) r.fail(r.line_of("coords"), fmt::format("key 'coords' = {}: only 4 is supported", coords));
       r.get_int("softmax", 0);
-      r.ignore({"bias_match", "jitter", "rescore", "object_scale", "noobject_scale", "class_scale", "coord_scale",
-                "absolute", "thresh", "random"});
+      l.object_scale = r.get_float("object_scale", l.object_scale);
+      l.noobject_scale = r.get_float("noobject_scale", l.noobject_scale);
+      l.class_scale = r.get_float("class_scale", l.class_scale);
+      l.coord_scale = r.get_float("coord_scale", l.coord_scale);
+      l.rescore = r.get_int("rescore", l.rescore);
+      l.bias_match = r.get_int("bias_match", l.bias_match);
+      l.absolute = r.get_int("absolute", l.absolute);
+      l.thresh = r.get_float("thresh", l.thresh);
+      l.jitter = r.get_float("jitter", l.jitter);
+      l.random = r.get_float("random", l.random);
       if (l.num < 1) r.fail(r.line_of("num"), fmt::format("key 'num' = {}: must be >= 1", l.num));
       if (l.anchors.size() != static_cast<size_t>(2 * l.num))
         r.fail(r.line_of("anchors"), fmt::format("key 'anchors': expected {} values (2 x num = {}), got {}", 2 * l.num,
@@ -288,7 +303,13 @@ DarknetModel parse_darknet_cfg_string(const std::string& cfg_text, const std::st
       l.mask = r.get_ints("mask");
       l.classes = r.get_int("classes", 20);
       const int total = r.get_int("num", static_cast<int>(l.anchors.size() / 2));
-      r.ignore({"jitter", "ignore_thresh", "truth_thresh", "random"});
+      l.scale_x_y = r.get_float("scale_x_y", l.scale_x_y);
+      l.ignore_thresh = r.get_float("ignore_thresh", l.ignore_thresh);
+      l.truth_thresh = r.get_float("truth_thresh", l.truth_thresh);
+      l.jitter = r.get_float("jitter", l.jitter);
+      l.random = r.get_float("random", l.random);
+      if (!(l.scale_x_y >= 1.0f))
+        r.fail(r.line_of("scale_x_y"), fmt::format("key 'scale_x_y' = {}: must be >= 1", l.scale_x_y));
       if (l.anchors.size() != static_cast<size_t>(2 * total))
         r.fail(r.line_of("anchors"), fmt::format("key 'anchors': expected {} values (2 x num = {}), got {}", 2 * total,
                                                  total, l.anchors.size()));
@@ -413,10 +434,18 @@ std::string write_darknet_cfg(const DarknetModel& model) {
       case LayerType::kRegion:
         s += fmt::format("anchors={}\nclasses={}\ncoords=4\nnum={}\nsoftmax=1\n", join_floats(l.anchors), l.classes,
                          l.num);
+        s += fmt::format(
+            "object_scale={}\nnoobject_scale={}\nclass_scale={}\ncoord_scale={}\nrescore={}\nbias_match={}\n"
+            "absolute={}\nthresh={}\njitter={}\nrandom={}\n",
+            l.object_scale, l.noobject_scale, l.class_scale, l.coord_scale, l.rescore, l.bias_match, l.absolute,
+            l.thresh, l.jitter, l.random);
         break;
       case LayerType::kYolo:
         s += fmt::format("mask={}\nanchors={}\nclasses={}\nnum={}\n", join_ints(l.mask), join_floats(l.anchors),
                          l.classes, l.anchors.size() / 2);
+        if (l.scale_x_y != 1.0f) s += fmt::format("scale_x_y={}\n", l.scale_x_y);  // not a key of every Darknet
+        s += fmt::format("ignore_thresh={}\ntruth_thresh={}\njitter={}\nrandom={}\n", l.ignore_thresh, l.truth_thresh,
+                         l.jitter, l.random);
         break;
       case LayerType::kRoute:
         s += fmt::format("layers={}\n", join_ints(l.route_layers));
@@ -437,6 +466,13 @@ int64_t DarknetModel::weight_count() const {
     n += static_cast<int64_t>(l.filters) * l.input.c * l.size * l.size;
   }
   return n;
+}
+
+std::vector<int> DarknetModel::heads() const {
+  std::vector<int> h;
+  for (size_t i = 0; i < layers.size(); ++i)
+    if (layers[i].type == LayerType::kRegion || layers[i].type == LayerType::kYolo) h.push_back(static_cast<int>(i));
+  return h;
 }
 
 double DarknetModel::flops() const {

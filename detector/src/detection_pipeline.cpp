@@ -36,27 +36,31 @@ DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::uniqu
     throw std::invalid_argument("DetectorPipelineOptions: " + all);
   }
   if (!backend_) throw std::invalid_argument("DetectionPipeline: backend is null");
-  if (model.layers.empty() || model.layers.back().type != LayerType::kRegion)
-    throw std::invalid_argument(fmt::format("DetectionPipeline: {} must end in a [region] layer", model.cfg_path));
-  region_ = model.layers.back();
+  for (const int h : model.heads()) heads_.push_back(model.layers[h]);
+  if (heads_.empty())
+    throw std::invalid_argument(
+        fmt::format("DetectionPipeline: {} has no [region] or [yolo] head to decode", model.cfg_path));
   net_size_ = cv::Size(model.net.width, model.net.height);
   const Shape in = backend_->input_shape();
   if (!(in == Shape{3, model.net.height, model.net.width}))
     throw std::invalid_argument(fmt::format("DetectionPipeline: backend {} takes {}x{}x{}, the model 3x{}x{}",
                                             backend_->name(), in.c, in.h, in.w, model.net.height, model.net.width));
-  const Shape out = backend_->output_shape();
-  if (!(out == region_.input))
+  const std::vector<Shape> outs = backend_->output_shapes();
+  std::string want, got;
+  for (const Layer& h : heads_) want += fmt::format(" {}x{}x{}", h.input.c, h.input.h, h.input.w);
+  for (const Shape& o : outs) got += fmt::format(" {}x{}x{}", o.c, o.h, o.w);
+  if (want != got)
     throw std::invalid_argument(
-        fmt::format("DetectionPipeline: backend {} outputs {}x{}x{}, the [region] needs {}x{}x{}", backend_->name(),
-                    out.c, out.h, out.w, region_.input.c, region_.input.h, region_.input.w));
+        fmt::format("DetectionPipeline: backend {} outputs{}, the heads need{}", backend_->name(), got, want));
   if (backend_->max_batch() < 1)
     throw std::invalid_argument(
         fmt::format("DetectionPipeline: backend {} has max_batch {}", backend_->name(), backend_->max_batch()));
   batch_capacity_ = options_.zoom_in ? std::max(1, std::min(backend_->max_batch(), options_.max_detections)) : 1;
   input_.resize(static_cast<size_t>(batch_capacity_) * in.size());
-  output_.resize(static_cast<size_t>(batch_capacity_) * out.size());
+  output_.resize(static_cast<size_t>(batch_capacity_) * output_size(outs));
   candidates_.resize(batch_capacity_);
-  const size_t per_image = static_cast<size_t>(out.h) * out.w * region_.num;
+  size_t per_image = 0;  // most boxes one image can decode to
+  for (const Layer& h : heads_) per_image += static_cast<size_t>(h.input.h) * h.input.w * h.num;
   for (auto& c : candidates_) c.reserve(per_image);
   detections_.reserve(per_image);
   crops_.reserve(options_.max_detections);
@@ -65,11 +69,15 @@ DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::uniqu
 
 void DetectionPipeline::run_and_decode(int count) {
   backend_->forward(input_.data(), count, output_);
-  const size_t per_image = static_cast<size_t>(region_.input.size());
+  const size_t per_image = output_.size() / static_cast<size_t>(count);
   for (int i = 0; i < count; ++i) {
     candidates_[i].clear();
-    decode_region(output_.data() + i * per_image, region_.input, region_, net_size_.width, net_size_.height,
-                  static_cast<float>(options_.p_thresh), candidates_[i]);
+    const float* raw = output_.data() + i * per_image;
+    for (const Layer& h : heads_) {
+      decode_head(raw, h.input, h, net_size_.width, net_size_.height, static_cast<float>(options_.p_thresh),
+                  candidates_[i]);
+      raw += h.input.size();
+    }
   }
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// YOLOv2 region decode.
+// YOLOv2 [region] and YOLOv3 [yolo] decode.
 #include "wingman/detector/region_decode.hpp"
 
 #include <fmt/format.h>
@@ -50,6 +50,56 @@ void decode_region(const float* raw, const Shape& shape, const Layer& region, in
       }
     }
   }
+}
+
+void decode_yolo(const float* raw, const Shape& shape, const Layer& yolo, int net_w, int net_h, float p_thresh,
+                 std::vector<Box>& boxes) {
+  const int per_anchor = 5 + yolo.classes;
+  const int num = static_cast<int>(yolo.mask.size());
+  if (!(shape == yolo.input) || num < 1 || shape.c != num * per_anchor)
+    throw std::invalid_argument(fmt::format(
+        "decode_yolo: tensor {}x{}x{} does not fit the [yolo] layer (input {}x{}x{}, mask of {}, classes {})", shape.c,
+        shape.h, shape.w, yolo.input.c, yolo.input.h, yolo.input.w, num, yolo.classes));
+  for (const int m : yolo.mask)
+    if (m < 0 || 2 * static_cast<size_t>(m) + 1 >= yolo.anchors.size())
+      throw std::invalid_argument(
+          fmt::format("decode_yolo: mask index {} has no anchor ({} anchors)", m, yolo.anchors.size() / 2));
+  const int plane = shape.h * shape.w;
+  const float s = yolo.scale_x_y;
+  const float shift = 0.5f * (s - 1.0f);
+  const float to_px_x = static_cast<float>(net_w) / shape.w;
+  const float to_px_y = static_cast<float>(net_h) / shape.h;
+  for (int k = 0; k < num; ++k) {
+    const float* base = raw + static_cast<size_t>(k) * per_anchor * plane;
+    const float a_w = yolo.anchors[2 * yolo.mask[k]];
+    const float a_h = yolo.anchors[2 * yolo.mask[k] + 1];
+    for (int row = 0; row < shape.h; ++row) {
+      for (int col = 0; col < shape.w; ++col) {
+        const int i = row * shape.w + col;
+        float max_t = base[5 * plane + i];  // sigma is increasing: max of sigma = sigma of max
+        for (int c = 1; c < yolo.classes; ++c) max_t = std::max(max_t, base[(5 + c) * plane + i]);
+        const float confidence = sigmoid(base[4 * plane + i]) * sigmoid(max_t);
+        if (confidence < p_thresh) continue;
+        Box b;
+        b.cx = (s * sigmoid(base[i]) - shift + col) * to_px_x;
+        b.cy = (s * sigmoid(base[plane + i]) - shift + row) * to_px_y;
+        b.w = a_w * std::exp(base[2 * plane + i]);
+        b.h = a_h * std::exp(base[3 * plane + i]);
+        b.confidence = confidence;
+        boxes.push_back(b);
+      }
+    }
+  }
+}
+
+void decode_head(const float* raw, const Shape& shape, const Layer& head, int net_w, int net_h, float p_thresh,
+                 std::vector<Box>& boxes) {
+  if (head.type == LayerType::kRegion)
+    decode_region(raw, shape, head, net_w, net_h, p_thresh, boxes);
+  else if (head.type == LayerType::kYolo)
+    decode_yolo(raw, shape, head, net_w, net_h, p_thresh, boxes);
+  else
+    throw std::invalid_argument("decode_head: the layer is neither [region] nor [yolo]");
 }
 
 }  // namespace wingman::detector

@@ -26,7 +26,7 @@ TEST(CpuBackend, ThesisNetworkOutputsRawRegionInput) {
   randomize_weights(m, 2024);
   CpuBackend backend(m, 2);
   EXPECT_EQ(backend.input_shape(), (Shape{3, 416, 416}));
-  EXPECT_EQ(backend.output_shape(), (Shape{30, 13, 13})) << backend.output_layer_name();
+  EXPECT_EQ(backend.output_shapes(), (std::vector<Shape>{{30, 13, 13}})) << backend.output_layer_names().front();
   const std::vector<float> input = random_input(backend.input_shape(), 2, 5);
   std::vector<float> out;
   backend.forward(input.data(), 2, out);
@@ -38,8 +38,8 @@ TEST(CpuBackend, ThesisNetworkOutputsRawRegionInput) {
     sum_sq += static_cast<double>(v) * v;
   }
   const double rms = std::sqrt(sum_sq / out.size());
-  EXPECT_GT(rms, 1e-3) << "layer " << backend.output_layer_name();
-  EXPECT_LT(rms, 1e3) << "layer " << backend.output_layer_name();
+  EXPECT_GT(rms, 1e-3) << "layer " << backend.output_layer_names().front();
+  EXPECT_LT(rms, 1e3) << "layer " << backend.output_layer_names().front();
   // Batch of one gives the first image's output of the batch of two.
   std::vector<float> single;
   backend.forward(input.data(), 1, single);
@@ -94,12 +94,60 @@ TEST(CpuBackend, NetworksMayEndInMaxpoolRouteOrUpsample) {
     DarknetModel m = parse_darknet_cfg_string(head + c.tail, "tail.cfg");
     randomize_weights(m, 9);
     CpuBackend backend(m, 1);
-    EXPECT_EQ(backend.output_shape(), c.expected);
+    EXPECT_EQ(backend.output_shapes(), (std::vector<Shape>{c.expected}));
     const std::vector<float> input = random_input(backend.input_shape(), 1, 4);
     std::vector<float> out;
     backend.forward(input.data(), 1, out);
-    EXPECT_EQ(static_cast<int64_t>(out.size()), c.expected.size()) << backend.output_layer_name();
+    EXPECT_EQ(static_cast<int64_t>(out.size()), c.expected.size()) << backend.output_layer_names().front();
   }
+}
+
+TEST(CpuBackend, TwoYoloHeadsGiveBothRawHeadInputsPerImage) {
+  // yolov3-tiny's shape, scaled down: a 13 x 13 head, a route back, upsample, concat and a 26 x 26 head.
+  const std::string yolo = "[yolo]\nmask={}\nanchors=10,14, 23,27, 37,58, 81,82, 135,169, 344,319\nclasses=2\nnum=6\n";
+  auto head = [&](const char* mask) {
+    std::string s = yolo;
+    return s.replace(s.find("{}"), 2, mask);
+  };
+  const std::string cfg =
+      "[net]\nwidth=52\nheight=52\nchannels=3\n"
+      "[convolutional]\nbatch_normalize=1\nfilters=8\nsize=3\npad=1\nactivation=leaky\n"
+      "[maxpool]\nsize=2\nstride=2\n"
+      "[convolutional]\nbatch_normalize=1\nfilters=16\nsize=3\npad=1\nactivation=leaky\n"
+      "[maxpool]\nsize=2\nstride=2\n"
+      "[convolutional]\nfilters=21\nsize=1\npad=1\nactivation=linear\n" +
+      head("3,4,5") +
+      "[route]\nlayers=-3\n"
+      "[upsample]\nstride=2\n"
+      "[route]\nlayers=-1,2\n"
+      "[convolutional]\nfilters=21\nsize=1\npad=1\nactivation=linear\n" +
+      head("0,1,2");
+  DarknetModel m = parse_darknet_cfg_string(cfg, "two-heads.cfg");
+  randomize_weights(m, 21);
+  CpuBackend backend(m, 2);
+  ASSERT_EQ(backend.output_shapes(), (std::vector<Shape>{{21, 13, 13}, {21, 26, 26}}));
+  EXPECT_EQ(backend.output_layer_names(), (std::vector<std::string>{"identity_5", "identity_10"}));
+  const std::vector<float> input = random_input(backend.input_shape(), 2, 8);
+  std::vector<float> both, first, second;
+  backend.forward(input.data(), 2, both);
+  backend.forward(input.data(), 1, first);
+  backend.forward(input.data() + backend.input_shape().size(), 1, second);
+  const size_t per_image = 21 * 13 * 13 + 21 * 26 * 26;
+  ASSERT_EQ(both.size(), 2 * per_image);
+  ASSERT_EQ(first.size(), per_image);
+  // Image after image, each with its 13 x 13 then its 26 x 26 tensor.
+  for (size_t i = 0; i < per_image; ++i) {
+    ASSERT_NEAR(both[i], first[i], 1e-4 * (1.0 + std::fabs(first[i]))) << i;
+    ASSERT_NEAR(both[per_image + i], second[i], 1e-4 * (1.0 + std::fabs(second[i]))) << i;
+  }
+  // The heads' inputs are the outputs of layers 4 and 9, as a network ending there computes them.
+  DarknetModel upto4 = m;
+  upto4.layers.resize(5);
+  CpuBackend b4(upto4, 1);
+  std::vector<float> o4;
+  b4.forward(input.data(), 1, o4);
+  ASSERT_EQ(o4.size(), 21u * 13 * 13);
+  for (size_t i = 0; i < o4.size(); ++i) ASSERT_NEAR(first[i], o4[i], 1e-4 * (1.0 + std::fabs(o4[i]))) << i;
 }
 
 }  // namespace

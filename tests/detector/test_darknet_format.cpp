@@ -133,6 +133,62 @@ layers=-2,1
   EXPECT_EQ(parse_darknet_cfg_string(write_darknet_cfg(m)).layers[6].route_layers, (std::vector<int>{4, 1}));
 }
 
+TEST(DarknetCfg, HeadTrainingKeysRoundTrip) {
+  // The thesis [region]: object_scale=5 noobject_scale=1 class_scale=1 coord_scale=1 rescore=1 bias_match=1
+  // absolute=1 thresh=.6 jitter=.2 random=1.
+  const DarknetModel a = thesis();
+  const Layer& r = a.layers.back();
+  EXPECT_FLOAT_EQ(r.object_scale, 5.0f);
+  EXPECT_FLOAT_EQ(r.noobject_scale, 1.0f);
+  EXPECT_EQ(r.rescore, 1);
+  EXPECT_EQ(r.bias_match, 1);
+  EXPECT_EQ(r.absolute, 1);
+  EXPECT_FLOAT_EQ(r.thresh, 0.6f);
+  EXPECT_FLOAT_EQ(r.random, 1.0f);
+  // Values away from every default, on a [region] and a [yolo], survive write -> read.
+  const std::string cfg =
+      "[net]\nwidth=64\nheight=64\n[convolutional]\nfilters=18\nsize=1\n[region]\nanchors=1,2\nnum=1\n"
+      "classes=13\nobject_scale=4.5\nnoobject_scale=0.25\nclass_scale=2\ncoord_scale=3\nrescore=1\n"
+      "bias_match=1\nabsolute=1\nthresh=.7\njitter=.3\nrandom=1\n"
+      "[convolutional]\nfilters=18\nsize=1\n[yolo]\nmask=1,2,3\nanchors=1,2,3,4,5,6,7,8\nclasses=1\n"
+      "scale_x_y=1.05\nignore_thresh=.7\ntruth_thresh=.9\njitter=.1\nrandom=1.5\n";
+  const DarknetModel m = parse_darknet_cfg_string(cfg, "keys.cfg");
+  const DarknetModel n = parse_darknet_cfg_string(write_darknet_cfg(m), "written.cfg");
+  for (const DarknetModel* x : {&m, &n}) {
+    SCOPED_TRACE(x == &m ? "read" : "written and read back");
+    const Layer& region = x->layers[1];
+    EXPECT_FLOAT_EQ(region.object_scale, 4.5f);
+    EXPECT_FLOAT_EQ(region.noobject_scale, 0.25f);
+    EXPECT_FLOAT_EQ(region.class_scale, 2.0f);
+    EXPECT_FLOAT_EQ(region.coord_scale, 3.0f);
+    EXPECT_EQ(region.rescore, 1);
+    EXPECT_EQ(region.bias_match, 1);
+    EXPECT_EQ(region.absolute, 1);
+    EXPECT_FLOAT_EQ(region.thresh, 0.7f);
+    EXPECT_FLOAT_EQ(region.jitter, 0.3f);
+    EXPECT_FLOAT_EQ(region.random, 1.0f);
+    const Layer& yolo = x->layers[3];
+    EXPECT_EQ(yolo.mask, (std::vector<int>{1, 2, 3}));
+    EXPECT_FLOAT_EQ(yolo.scale_x_y, 1.05f);
+    EXPECT_FLOAT_EQ(yolo.ignore_thresh, 0.7f);
+    EXPECT_FLOAT_EQ(yolo.truth_thresh, 0.9f);
+    EXPECT_FLOAT_EQ(yolo.jitter, 0.1f);
+    EXPECT_FLOAT_EQ(yolo.random, 1.5f);
+  }
+  // A bad number names the key, and scale_x_y below 1 is refused.
+  const std::string bad = message_of([] {
+    parse_darknet_cfg_string("[net]\n[convolutional]\nfilters=6\n[region]\nanchors=1,1\nnum=1\nobject_scale=x\n",
+                             "o.cfg");
+  });
+  EXPECT_NE(bad.find("o.cfg:7"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("object_scale"), std::string::npos) << bad;
+  const std::string low = message_of([] {
+    parse_darknet_cfg_string("[net]\n[convolutional]\nfilters=6\n[yolo]\nanchors=1,1\nmask=0\nscale_x_y=0.5\n",
+                             "y.cfg");
+  });
+  EXPECT_NE(low.find("scale_x_y"), std::string::npos) << low;
+}
+
 TEST(DarknetCfg, UnsupportedKeyNamesFileLineAndKey) {
   const std::string cfg = "[net]\nwidth=32\nheight=32\n\n[convolutional]\nfilters=4\nsize=3\ndilation=2\n";
   const std::string msg = message_of([&] { parse_darknet_cfg_string(cfg, "bad.cfg"); });

@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/dnn.hpp>
+
 #include <cmath>
 
 namespace wingman::detector {
@@ -39,7 +41,7 @@ class FakeBackend : public InferenceBackend {
       : script_(std::move(script)), max_batch_(max_batch), batches_(batches) {}
   std::string name() const override { return "fake"; }
   Shape input_shape() const override { return {3, 416, 416}; }
-  Shape output_shape() const override { return {30, 13, 13}; }
+  std::vector<Shape> output_shapes() const override { return {{30, 13, 13}}; }
   int max_batch() const override { return max_batch_; }
   void forward(const float*, int batch, std::vector<float>& output) override {
     const int plane = 13 * 13;
@@ -110,6 +112,152 @@ TEST(RegionDecode, HandComputedCell) {
   boxes.clear();
   decode_region(raw.data(), {30, 13, 13}, region, 416, 416, 0.9f, boxes);
   EXPECT_TRUE(boxes.empty());
+}
+
+/// A [yolo] head as in a .cfg: yolov3-tiny's six anchors (pixels), `mask`, `classes`, optional extra keys.
+std::string yolo_section(const char* mask, int classes, const std::string& extra = "") {
+  return std::string("[yolo]\nmask=") + mask +
+         "\nanchors=10,14, 23,27, 37,58, 81,82, 135,169, 344,319\nclasses=" + std::to_string(classes) + "\nnum=6\n" +
+         extra + "\n";
+}
+
+/// A yolov3-tiny-like network at `size` x `size`: a stride-32 head (mask 3,4,5), a route back, 1x1 conv,
+/// upsample x2, concat with the stride-16 features, a stride-16 head (mask 0,1,2). Layers 9 and 15 are the
+/// heads (13 x 13 and 26 x 26 at 416).
+std::string two_head_cfg(int size, int classes, const std::string& extra_first = "",
+                         const std::string& extra_second = "") {
+  const int f = 3 * (5 + classes);
+  auto conv = [](int filters, int ksize, const char* act, bool bn) {
+    return std::string("[convolutional]\n") + (bn ? "batch_normalize=1\n" : "") + "filters=" + std::to_string(filters) +
+           "\nsize=" + std::to_string(ksize) + "\nstride=1\npad=1\nactivation=" + act + "\n\n";
+  };
+  const std::string pool = "[maxpool]\nsize=2\nstride=2\n\n";
+  return "[net]\nwidth=" + std::to_string(size) + "\nheight=" + std::to_string(size) + "\nchannels=3\n\n" +
+         conv(4, 3, "leaky", true) + pool + pool + pool +                             // 0-3: stride 8
+         conv(8, 3, "leaky", true) + pool +                                           // 4-5: stride 16
+         conv(8, 3, "leaky", true) + pool +                                           // 6-7: stride 32
+         conv(f, 1, "linear", false) + yolo_section("3,4,5", classes, extra_first) +  // 8-9
+         "[route]\nlayers=-3\n\n" + conv(4, 1, "leaky", true) +                       // 10-11
+         "[upsample]\nstride=2\n\n[route]\nlayers=-1,5\n\n" +                         // 12-13: stride 16
+         conv(f, 1, "linear", false) + yolo_section("0,1,2", classes, extra_second);  // 14-15
+}
+
+TEST(YoloDecode, HandComputedCellWithScaleXY) {
+  // A 13 x 10 grid on a 416 x 320 input (32 px cells), mask 3,4,5, two classes, scale_x_y 1.05.
+  Layer yolo;
+  yolo.type = LayerType::kYolo;
+  yolo.anchors = {10, 14, 23, 27, 37, 58, 81, 82, 135, 169, 344, 319};
+  yolo.mask = {3, 4, 5};
+  yolo.num = 3;
+  yolo.classes = 2;
+  yolo.scale_x_y = 1.05f;
+  yolo.input = yolo.output = {21, 10, 13};
+  const int plane = 10 * 13;
+  std::vector<float> raw(21 * plane, 0.0f);
+  for (int k = 0; k < 3; ++k)
+    for (int p = 0; p < plane; ++p) raw[(k * 7 + 4) * plane + p] = -30.0f;  // no object anywhere...
+  const int p = 4 * 13 + 7;                                                 // ...but row 4, column 7
+  float* base = raw.data() + 1 * 7 * plane;                                 // of mask entry 1: anchor 4
+  base[p] = 0.5f;                                                           // t_x
+  base[plane + p] = -1.0f;                                                  // t_y
+  base[2 * plane + p] = 0.25f;                                              // t_w
+  base[3 * plane + p] = -0.5f;                                              // t_h
+  base[4 * plane + p] = 2.0f;                                               // t_o
+  base[5 * plane + p] = -1.0f;                                              // t_class 0
+  base[6 * plane + p] = 0.5f;                                               // t_class 1 (the larger)
+  std::vector<Box> boxes;
+  decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.2f, boxes);
+  ASSERT_EQ(boxes.size(), 1u);
+  // b_x = (1.05 sigma(0.5) - 0.025 + 7) / 13 * 416 = (0.6535823 - 0.025 + 7) * 32 = 244.1146
+  EXPECT_NEAR(boxes[0].cx, 244.1146f, 1e-3);
+  // b_y = (1.05 sigma(-1) - 0.025 + 4) / 10 * 320 = (0.2823885 - 0.025 + 4) * 32 = 136.2364
+  EXPECT_NEAR(boxes[0].cy, 136.2364f, 1e-3);
+  EXPECT_NEAR(boxes[0].w, 135.0f * std::exp(0.25f), 1e-3);                // 173.3434 px: anchor 4 is 135 x 169 px
+  EXPECT_NEAR(boxes[0].h, 169.0f * std::exp(-0.5f), 1e-3);                // 102.5037 px
+  EXPECT_NEAR(boxes[0].confidence, sigmoid(2.0f) * sigmoid(0.5f), 1e-6);  // 0.8808 x 0.6225 = 0.5483
+  EXPECT_NEAR(boxes[0].confidence, 0.54826f, 1e-4);
+  boxes.clear();
+  decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.55f, boxes);
+  EXPECT_TRUE(boxes.empty());
+  // With scale_x_y 1 (YOLOv3): b_x = (sigma(0.5) + 7) * 32.
+  yolo.scale_x_y = 1.0f;
+  decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.2f, boxes);
+  ASSERT_EQ(boxes.size(), 1u);
+  EXPECT_NEAR(boxes[0].cx, (sigmoid(0.5f) + 7) * 32, 1e-3);
+  // p_thresh 0 keeps every anchor of every cell.
+  boxes.clear();
+  decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.0f, boxes);
+  EXPECT_EQ(boxes.size(), 3u * plane);
+}
+
+TEST(YoloDecode, RejectsTensorsAndMasksThatDoNotFit) {
+  const DarknetModel m = parse_darknet_cfg_string(two_head_cfg(416, 1), "two-heads.cfg");
+  const Layer& head = m.layers[9];
+  ASSERT_EQ(head.type, LayerType::kYolo);
+  std::vector<float> raw(18 * 26 * 26, 0.0f);
+  std::vector<Box> boxes;
+  EXPECT_THROW(decode_yolo(raw.data(), {18, 26, 26}, head, 416, 416, 0.2f, boxes), std::invalid_argument);
+  EXPECT_THROW(decode_head(raw.data(), {18, 13, 13}, m.layers[0], 416, 416, 0.2f, boxes), std::invalid_argument);
+  Layer bad = head;
+  bad.mask = {3, 4, 6};  // anchor 6 does not exist
+  EXPECT_THROW(decode_yolo(raw.data(), {18, 13, 13}, bad, 416, 416, 0.2f, boxes), std::invalid_argument);
+  EXPECT_NO_THROW(decode_yolo(raw.data(), {18, 13, 13}, head, 416, 416, 0.2f, boxes));
+}
+
+TEST(YoloDecode, MatchesOpenCvDnnDecodeOnATinyYoloV3LikeNetwork) {
+  // OpenCV's Darknet importer decodes [yolo] heads itself (one row per cell and anchor: x, y, w, h relative
+  // to the input, objectness, objectness x sigma(class) when above `thresh`). Same random weights: our
+  // decode of CpuBackend's raw head inputs must give the same boxes. thresh=0 and nms_threshold=0 (keys
+  // only OpenCV reads) make it keep every cell. The second head has scale_x_y 1.1.
+  const int size = 128, classes = 2;
+  DarknetModel m = parse_darknet_cfg_string(two_head_cfg(size, classes, "", "scale_x_y=1.1"), "two-heads.cfg");
+  randomize_weights(m, 77);
+  std::string opencv_cfg = write_darknet_cfg(m);
+  for (size_t at = 0; (at = opencv_cfg.find("[yolo]\n", at)) != std::string::npos; at += 6)
+    opencv_cfg.insert(at + 7, "thresh=0\nnms_threshold=0\n");
+  const std::vector<char> weights = serialize_darknet_weights(m);
+  cv::dnn::Net net = cv::dnn::readNetFromDarknet(opencv_cfg.data(), opencv_cfg.size(), weights.data(), weights.size());
+  net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+  net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+  cv::Mat image(size, size, CV_32FC3);
+  cv::randu(image, 0.0f, 1.0f);
+  const cv::Mat blob = cv::dnn::blobFromImage(image);  // 1 x 3 x size x size, planes in order
+  net.setInput(blob);
+  std::vector<cv::Mat> decoded;
+  net.forward(decoded, std::vector<std::string>{"yolo_9", "yolo_15"});
+  ASSERT_EQ(decoded.size(), 2u);
+
+  CpuBackend backend(m, 1);
+  std::vector<float> raw;
+  backend.forward(blob.ptr<float>(), 1, raw);
+  const std::vector<int> heads = m.heads();
+  ASSERT_EQ(heads, (std::vector<int>{9, 15}));
+  const float* head_raw = raw.data();
+  for (int h = 0; h < 2; ++h) {
+    const Layer& head = m.layers[heads[h]];
+    SCOPED_TRACE("head " + std::to_string(h) + ", scale_x_y " + std::to_string(head.scale_x_y));
+    std::vector<Box> boxes;
+    decode_yolo(head_raw, head.input, head, size, size, 0.0f, boxes);  // order: anchor, row, column
+    head_raw += head.input.size();
+    const int rows = head.input.h, cols = head.input.w, num = head.num;
+    const cv::Mat& d = decoded[h];
+    ASSERT_EQ(d.rows, rows * cols * num);
+    ASSERT_EQ(d.cols, 5 + classes);
+    ASSERT_EQ(boxes.size(), static_cast<size_t>(d.rows));
+    for (int k = 0; k < num; ++k)
+      for (int y = 0; y < rows; ++y)
+        for (int x = 0; x < cols; ++x) {
+          const Box& b = boxes[(static_cast<size_t>(k) * rows + y) * cols + x];
+          const float* o = d.ptr<float>((y * cols + x) * num + k);
+          const std::string where =
+              "anchor " + std::to_string(k) + " row " + std::to_string(y) + " col " + std::to_string(x);
+          ASSERT_NEAR(b.cx / size, o[0], 1e-5) << where;
+          ASSERT_NEAR(b.cy / size, o[1], 1e-5) << where;
+          ASSERT_NEAR(b.w / size, o[2], 1e-5 * (1 + o[2])) << where;
+          ASSERT_NEAR(b.h / size, o[3], 1e-5 * (1 + o[3])) << where;
+          ASSERT_NEAR(b.confidence, std::max(o[5], o[6]), 1e-5) << where;
+        }
+  }
 }
 
 TEST(DetectorPipelineOptions, DefaultsAreValidAndBadValuesNamed) {
@@ -217,10 +365,73 @@ TEST(Algorithm2, RejectsABackendThatDoesNotFitTheModel) {
   class Wrong : public FakeBackend {
    public:
     Wrong() : FakeBackend({}, 1, nullptr) {}
-    Shape output_shape() const override { return {125, 13, 13}; }
+    std::vector<Shape> output_shapes() const override { return {{125, 13, 13}}; }
   };
   EXPECT_THROW(DetectionPipeline(DetectorPipelineOptions{}, std::make_unique<Wrong>(), thesis()),
                std::invalid_argument);
+}
+
+TEST(Algorithm2, DecodesBothHeadsOfATinyYoloV3) {
+  // A fake backend for the 416 two-head network: one confident cell in each head, nothing elsewhere.
+  class TwoHeads : public InferenceBackend {
+   public:
+    std::string name() const override { return "fake-yolo"; }
+    Shape input_shape() const override { return {3, 416, 416}; }
+    std::vector<Shape> output_shapes() const override { return {{18, 13, 13}, {18, 26, 26}}; }
+    int max_batch() const override { return 1; }
+    void forward(const float*, int batch, std::vector<float>& output) override {
+      const int p13 = 13 * 13, p26 = 26 * 26;
+      output.assign(static_cast<size_t>(batch) * 18 * (p13 + p26), 0.0f);
+      float* a = output.data();
+      float* b = a + 18 * p13;
+      for (int k = 0; k < 3; ++k) {
+        for (int p = 0; p < p13; ++p) a[(k * 6 + 4) * p13 + p] = -30.0f;
+        for (int p = 0; p < p26; ++p) b[(k * 6 + 4) * p26 + p] = -30.0f;
+      }
+      // Head 1 (stride 32), mask entry 0 = anchor 3 (81 x 82 px), row 2, column 3: centre (112, 80).
+      a[4 * p13 + 2 * 13 + 3] = 3.0f;
+      a[5 * p13 + 2 * 13 + 3] = 3.0f;
+      // Head 2 (stride 16), mask entry 2 = anchor 2 (37 x 58 px), row 20, column 10: centre (168, 328).
+      b[(2 * 6 + 4) * p26 + 20 * 26 + 10] = 1.0f;
+      b[(2 * 6 + 5) * p26 + 20 * 26 + 10] = 2.0f;
+    }
+  };
+  const DarknetModel m = parse_darknet_cfg_string(two_head_cfg(416, 1), "two-heads.cfg");
+  DetectionPipeline p(DetectorPipelineOptions{}, std::make_unique<TwoHeads>(), m);
+  const cv::Mat img(416, 416, CV_8UC3, cv::Scalar(0, 0, 0));  // network-sized: image pixels = network pixels
+  const auto boxes = p.detect(img);
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_NEAR(boxes[0].confidence, sigmoid(3.0f) * sigmoid(3.0f), 1e-5);  // 0.907
+  EXPECT_NEAR(boxes[0].cx, 112.0f, 1e-3);
+  EXPECT_NEAR(boxes[0].cy, 80.0f, 1e-3);
+  EXPECT_NEAR(boxes[0].w, 81.0f, 1e-3);
+  EXPECT_NEAR(boxes[0].h, 82.0f, 1e-3);
+  EXPECT_NEAR(boxes[1].confidence, sigmoid(1.0f) * sigmoid(2.0f), 1e-5);  // 0.644
+  EXPECT_NEAR(boxes[1].cx, 168.0f, 1e-3);
+  EXPECT_NEAR(boxes[1].cy, 328.0f, 1e-3);
+  EXPECT_NEAR(boxes[1].w, 37.0f, 1e-3);
+  EXPECT_NEAR(boxes[1].h, 58.0f, 1e-3);
+  // The backend's outputs must be the heads' inputs, in order.
+  class Swapped : public TwoHeads {
+   public:
+    std::vector<Shape> output_shapes() const override { return {{18, 26, 26}, {18, 13, 13}}; }
+  };
+  EXPECT_THROW(DetectionPipeline(DetectorPipelineOptions{}, std::make_unique<Swapped>(), m), std::invalid_argument);
+}
+
+TEST(Algorithm2, RunsATinyYoloV3OnTheCpuBackendWithRandomWeights) {
+  DarknetModel m = parse_darknet_cfg_string(two_head_cfg(416, 1), "two-heads.cfg");
+  randomize_weights(m, 5);
+  DetectorPipelineOptions o;
+  o.p_thresh = 0.0;  // keep every cell and anchor of both heads...
+  o.o_thresh = 1.0;  // ...and suppress none (IoU > 1 never happens)
+  o.max_detections = 10000;
+  DetectionPipeline p(o, std::make_unique<CpuBackend>(m, 1), m);
+  cv::Mat img(480, 640, CV_8UC3);
+  cv::randu(img, 0, 255);
+  const auto boxes = p.detect(img);
+  EXPECT_EQ(boxes.size(), 3u * 13 * 13 + 3u * 26 * 26);
+  for (size_t i = 1; i < boxes.size(); ++i) ASSERT_GE(boxes[i - 1].confidence, boxes[i].confidence);
 }
 
 TEST(Algorithm2, RunsOnTheCpuBackendWithRandomWeights) {

@@ -28,12 +28,13 @@ namespace {
 constexpr double kRelativeTolerance = 1e-3;
 
 /// Plain NCHW reference of one image through the model, Darknet semantics (BN eps 1e-6 inside the sqrt,
-/// as OpenCV's importer). Returns the output of the last layer that is not a [region]/[yolo] head.
+/// as OpenCV's importer). Returns what InferenceBackend::forward() returns for one image: the input of
+/// every [region]/[yolo] head in order, or without heads the last layer's output.
 std::vector<float> reference_forward(const DarknetModel& model, const float* image) {
   std::vector<std::vector<float>> outs(model.layers.size());
   std::vector<float> input(image, image + static_cast<size_t>(model.net.channels) * model.net.height * model.net.width);
   const std::vector<float>* x = &input;
-  const std::vector<float>* last = &input;
+  std::vector<float> result;
   for (size_t i = 0; i < model.layers.size(); ++i) {
     const Layer& l = model.layers[i];
     std::vector<float>& y = outs[i];
@@ -103,12 +104,13 @@ std::vector<float> reference_forward(const DarknetModel& model, const float* ima
       case LayerType::kRegion:
       case LayerType::kYolo:
         y = *x;
+        result.insert(result.end(), x->begin(), x->end());
         break;
     }
     x = &y;
-    if (l.type != LayerType::kRegion && l.type != LayerType::kYolo) last = &y;
   }
-  return *last;
+  if (model.heads().empty()) result = *x;
+  return result;
 }
 
 std::vector<float> random_images(const Shape& s, int batch, uint32_t seed) {
@@ -119,7 +121,8 @@ std::vector<float> random_images(const Shape& s, int batch, uint32_t seed) {
   return v;
 }
 
-/// "" when max|a-b| <= tol * max(1, max|b|), else a one-line description of the worst element.
+/// "" when max|a-b| <= tol * max(1, max|b|), else a one-line description of the worst element. `shape`:
+/// one output tensor per image (several outputs: the location is given as a flat index).
 std::string compare(const std::vector<float>& actual, const std::vector<float>& expected, const Shape& shape) {
   if (actual.size() != expected.size())
     return "size " + std::to_string(actual.size()) + " != expected " + std::to_string(expected.size());
@@ -160,11 +163,13 @@ void check_network(const std::string& cfg, const std::string& description, int b
   randomize_weights(model, 1234);
   OpenClBackend backend(model, options_for_batch(batch));
   const Shape in = backend.input_shape();
-  const Shape out = backend.output_shape();
+  const std::vector<Shape> outs = backend.output_shapes();
+  // For messages: the one output's shape, or all outputs of an image as one flat tensor.
+  const Shape out = outs.size() == 1 ? outs[0] : Shape{1, 1, static_cast<int>(output_size(outs))};
   const auto images = random_images(in, batch, 99);
   std::vector<float> got;
   backend.forward(images.data(), batch, got);
-  ASSERT_EQ(got.size(), static_cast<size_t>(out.size()) * batch);
+  ASSERT_EQ(got.size(), static_cast<size_t>(output_size(outs)) * batch);
   if (with_reference) {
     std::vector<float> expected;
     for (int n = 0; n < batch; ++n) {
@@ -175,7 +180,7 @@ void check_network(const std::string& cfg, const std::string& description, int b
   }
   if (with_opencv) {
     CpuBackend cpu(model, batch);
-    ASSERT_EQ(cpu.output_shape(), out);
+    ASSERT_EQ(cpu.output_shapes(), outs);
     std::vector<float> expected;
     cpu.forward(images.data(), batch, expected);
     EXPECT_EQ(compare(got, expected, out), "") << description << " vs OpenCV DNN, batch " << batch;
@@ -259,7 +264,7 @@ TEST(OpenClBackend, RejectsBadBatchAndMissingWeights) {
   randomize_weights(model, 1);
   OpenClBackend backend(model, options_for_batch(2));
   EXPECT_EQ(backend.max_batch(), 2);
-  EXPECT_EQ(backend.output_shape(), (Shape{4, 7, 5}));
+  EXPECT_EQ(backend.output_shapes(), (std::vector<Shape>{{4, 7, 5}}));
   std::vector<float> images(3 * 7 * 5 * 3, 0.5f), out;
   EXPECT_THROW(backend.forward(images.data(), 3, out), std::invalid_argument);
   EXPECT_THROW(backend.forward(images.data(), 0, out), std::invalid_argument);
@@ -281,6 +286,8 @@ TEST(OpenClConvolution, MatchesReferenceAndOpenCvOnOddShapes) {
       {16, 14, 26, 16, 3, 1, false, "leaky"},   // exact blocks, two tiles of 13
       {1, 7, 5, 3, 3, 1, true, "linear"},       // single channel
       {19, 6, 41, 17, 3, 1, true, "logistic"},  // width 41: prime
+      {3, 5, 301, 5, 3, 1, true, "leaky"},      // planar input, wide: 24 tiles of 13, the last with 2 columns
+      {16, 3, 97, 40, 3, 1, true, "leaky"},     // 16 planes planar, 3 output blocks (second pair half empty)
   };
   for (const auto& k : cases) {
     std::ostringstream d;
@@ -309,6 +316,10 @@ TEST(OpenClMaxpool, MatchesReferenceAndOpenCvOnOddShapes) {
         net_section(3, k[1], k[2]) + conv_section(k[0], 3, 1, true, "leaky") + maxpool_section(k[3], k[4]);
     check_network(cfg, d.str(), 2);
   }
+  // A network starting with a pooling: the input goes through the pack kernel instead of straight to a
+  // planar convolution input.
+  check_network(net_section(5, 13, 11) + maxpool_section(2, 2) + conv_section(7, 3, 1, true, "leaky"),
+                "maxpool 2/2 first on 5x13x11, then conv ->7", 2);
 }
 
 TEST(OpenClRoute, ConcatenatesChannelsAtUnalignedOffsets) {
@@ -341,9 +352,8 @@ TEST(OpenClNetwork, TinyYoloV3LikeNetworkWithTwoHeads) {
                     "[route]\nlayers=-3\n\n" + conv_section(8, 1, 1, true, "leaky") + "[upsample]\nstride=2\n\n" +
                     "[route]\nlayers=-1,2\n\n" + conv_section(18, 1, 1, false, "linear") +
                     "[yolo]\nmask=0,1,2\nanchors=10,14, 23,27, 37,58, 81,82, 135,169, 344,319\nclasses=1\nnum=6\n";
-  // Two heads: OpenCV DNN (CpuBackend) sees two outputs and refuses; the plain reference covers it. The
-  // backends return the raw input of the last head.
-  check_network(cfg, "tiny-yolov3-like 52x52, two yolo heads", 2, /*with_reference=*/true, /*with_opencv=*/false);
+  // Both backends return the raw inputs of the two heads (18x13x13 then 18x26x26) per image.
+  check_network(cfg, "tiny-yolov3-like 52x52, two yolo heads", 2);
 }
 
 TEST(OpenClNetwork, ThesisNetworkMatchesOpenCvAt416) {
@@ -369,7 +379,7 @@ TEST(OpenClNetwork, RepeatedForwardIsDeterministic) {
   EXPECT_EQ(a, b);
   // Image 1 alone gives the same as inside the batch.
   backend.forward(images.data() + backend.input_shape().size(), 1, single);
-  const size_t o = backend.output_shape().size();
+  const size_t o = output_size(backend.output_shapes());
   EXPECT_TRUE(std::equal(single.begin(), single.end(), a.begin() + o));
 }
 

@@ -119,6 +119,7 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   detections.image_width = kWidth;
   detections.image_height = kHeight;
   detections.inference_latency_us = 8500;
+  detections.source = wingman::detections_t::SOURCE_CNN;
   wingman::detection_t d;
   d.cx = kBoxCx;
   d.cy = kBoxCy;
@@ -158,6 +159,7 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   t.age_s = 4.5f;
   t.source_utime = utime;
   t.predicted_utime = utime + 20000;
+  t.detection_source = wingman::detections_t::SOURCE_CNN;
   targets.targets.push_back(t);
   targets.num_targets = static_cast<int32_t>(targets.targets.size());
   out.push_back(encode_sample("TARGETS", targets));
@@ -172,6 +174,7 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   setpoint.yaw = M_PI / 2;
   setpoint.yaw_rate = 0.0;
   setpoint.target_track_id = 1;
+  setpoint.detection_source = wingman::detections_t::SOURCE_CNN;
   out.push_back(encode_sample("SETPOINT", setpoint));
 
   wingman::status_t status;

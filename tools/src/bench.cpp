@@ -49,18 +49,6 @@ TimingMs summarize(std::vector<double> ms) {
   return t;
 }
 
-/// `warmup` untimed then `repetitions` timed calls of `fn`, milliseconds each.
-TimingMs time_runs(int warmup, int repetitions, const std::function<void()>& fn) {
-  for (int i = 0; i < warmup; ++i) fn();
-  std::vector<double> ms;
-  for (int i = 0; i < repetitions; ++i) {
-    const auto t0 = Clock::now();
-    fn();
-    ms.push_back(ms_since(t0));
-  }
-  return summarize(ms);
-}
-
 std::string env_or_unset(const char* name) {
   const char* v = std::getenv(name);
   return v ? std::string(v) : std::string("(unset)");
@@ -124,7 +112,7 @@ class TimedBackend : public InferenceBackend {
       : inner_(std::move(inner)), stats_(stats) {}
   std::string name() const override { return inner_->name(); }
   detector::Shape input_shape() const override { return inner_->input_shape(); }
-  detector::Shape output_shape() const override { return inner_->output_shape(); }
+  std::vector<detector::Shape> output_shapes() const override { return inner_->output_shapes(); }
   int max_batch() const override { return inner_->max_batch(); }
   void forward(const float* input, int batch, std::vector<float>& output) override {
     const auto t0 = Clock::now();
@@ -256,55 +244,118 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
       report.forward.push_back(std::move(r));
     };
 
+    // Every row's runner, created first; then the rows take turns, one forward each per round, so that
+    // load from elsewhere on the machine hits every row alike.
+    struct Row {
+      ForwardResult result;
+      std::function<void()> run;
+      std::vector<double> ms;
+    };
+    std::vector<Row> rows;
     // Bare OpenCV DNN: readNetFromDarknet on the same cfg + weights bytes, blobFromImage + forward timed.
     const std::string cfg_text = detector::write_darknet_cfg(model);
     const std::vector<char> weight_bytes = detector::serialize_darknet_weights(model);
+    cv::dnn::Net dnn;
+    cv::Mat dnn_out;
+    std::string dnn_error;
+    try {
+      dnn = cv::dnn::readNetFromDarknet(cfg_text.data(), cfg_text.size(), weight_bytes.data(), weight_bytes.size());
+      dnn.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+      dnn.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    } catch (const std::exception& e) {
+      dnn_error = e.what();
+    }
     for (const int t : o.threads) {
-      ForwardResult r = forward_row("opencv-dnn", size, t, "cv::setNumThreads");
-      try {
+      Row row{forward_row("opencv-dnn", size, t, "cv::setNumThreads"), nullptr, {}};
+      row.result.error = dnn_error;
+      row.run = [&dnn, &dnn_out, &net_bgr, t] {
         cv::setNumThreads(t);
-        cv::dnn::Net dnn =
-            cv::dnn::readNetFromDarknet(cfg_text.data(), cfg_text.size(), weight_bytes.data(), weight_bytes.size());
-        dnn.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-        dnn.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-        cv::Mat out;
-        r.ms = time_runs(o.warmup, o.repetitions, [&] {
-          dnn.setInput(cv::dnn::blobFromImage(net_bgr, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F));
-          out = dnn.forward();
-        });
-      } catch (const std::exception& e) {
-        r.error = e.what();
-      }
-      finish(std::move(r));
+        dnn.setInput(cv::dnn::blobFromImage(net_bgr, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F));
+        dnn_out = dnn.forward();
+      };
+      rows.push_back(std::move(row));
     }
     // CpuBackend (our wrapper of cv::dnn).
-    for (const int t : o.threads) {
-      ForwardResult r = forward_row("cpu", size, t, "cv::setNumThreads");
-      try {
-        cv::setNumThreads(t);
-        detector::CpuBackend backend(model, 1);
-        r.device = backend.name();
-        std::vector<float> out;
-        r.ms = time_runs(o.warmup, o.repetitions, [&] { backend.forward(chw.data(), 1, out); });
-      } catch (const std::exception& e) {
-        r.error = e.what();
-      }
-      finish(std::move(r));
+    std::unique_ptr<detector::CpuBackend> cpu;
+    std::vector<float> cpu_out;
+    std::string cpu_error;
+    try {
+      cpu = std::make_unique<detector::CpuBackend>(model, 1);
+    } catch (const std::exception& e) {
+      cpu_error = e.what();
     }
-    // OpenCL: PoCL fixes its thread count at platform init, so once, with the environment's count.
+    for (const int t : o.threads) {
+      Row row{forward_row("cpu", size, t, "cv::setNumThreads"), nullptr, {}};
+      row.result.error = cpu_error;
+      if (cpu) row.result.device = cpu->name();
+      row.run = [&cpu, &cpu_out, &chw, t] {
+        cv::setNumThreads(t);
+        cpu->forward(chw.data(), 1, cpu_out);
+      };
+      rows.push_back(std::move(row));
+    }
+    // OpenCL: PoCL fixes its thread count at platform init, so one row, with the environment's count.
+    std::unique_ptr<detector::OpenClBackend> ocl;
+    std::vector<float> ocl_out;
     {
-      ForwardResult r = forward_row("opencl", size, ocl_threads, ocl_note);
+      Row row{forward_row("opencl", size, ocl_threads, ocl_note), nullptr, {}};
       try {
-        detector::OpenClOptions ocl;
-        ocl.max_batch = 1;
-        detector::OpenClBackend backend(model, ocl);
-        r.device = backend.device_name();
-        std::vector<float> out;
-        r.ms = time_runs(o.warmup, o.repetitions, [&] { backend.forward(chw.data(), 1, out); });
+        detector::OpenClOptions options;
+        options.max_batch = 1;
+        ocl = std::make_unique<detector::OpenClBackend>(model, options);
+        row.result.device = ocl->device_name();
       } catch (const std::exception& e) {
-        r.error = e.what();
+        row.result.error = e.what();
       }
-      finish(std::move(r));
+      row.run = [&ocl, &ocl_out, &chw] { ocl->forward(chw.data(), 1, ocl_out); };
+      rows.push_back(std::move(row));
+    }
+    auto run_row = [&](Row& row, bool timed) {
+      if (!row.result.error.empty()) return;
+      try {
+        const auto t0 = Clock::now();
+        row.run();
+        if (timed) row.ms.push_back(ms_since(t0));
+      } catch (const std::exception& e) {
+        row.result.error = e.what();
+      }
+    };
+    for (int i = 0; i < o.warmup; ++i)
+      for (Row& row : rows) run_row(row, false);
+    for (int i = 0; i < o.repetitions; ++i)
+      for (Row& row : rows) run_row(row, true);
+    for (Row& row : rows) {
+      if (row.result.error.empty()) row.result.ms = summarize(row.ms);
+      finish(std::move(row.result));
+    }
+
+    // Per-layer device times of the OpenCL backend (OpenCL profiling events), after the timed rounds.
+    if (o.layers && ocl) {
+      try {
+        ocl->set_profiling(true);
+        for (int i = 0; i < o.repetitions; ++i) ocl->forward(chw.data(), 1, ocl_out);
+        const std::vector<detector::KernelTiming> timings = ocl->profile();
+        ocl->set_profiling(false);
+        double total = 0;
+        std::vector<LayerResult> layers;
+        for (const detector::KernelTiming& k : timings) {
+          LayerResult l;
+          l.size = size;
+          l.what = k.what;
+          l.layer = k.layer;
+          l.ms = summarize(k.ms);
+          l.gflop_per_s = k.flops > 0 && l.ms.median > 0 ? k.flops / (l.ms.median * 1e-3) * 1e-9 : 0;
+          total += l.ms.median;
+          layers.push_back(std::move(l));
+        }
+        for (LayerResult& l : layers) {
+          l.share = total > 0 ? l.ms.median / total : 0;
+          report.layers.push_back(std::move(l));
+        }
+        say(fmt::format("opencl {} px: per-layer profile, sum of medians {:.2f} ms", size, total));
+      } catch (const std::exception& e) {
+        say(fmt::format("opencl {} px: per-layer profile failed: {}", size, e.what()));
+      }
     }
   }
   // Speed-up vs bare OpenCV DNN at the same size and thread count (OpenCL: the DNN row with its thread
@@ -325,7 +376,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
 
   // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on.
   cv::setNumThreads(max_threads);
-  for (const int size : o.sizes) {
+  for (const int size : o.pipeline ? o.sizes : std::vector<int>{}) {
     const DarknetModel model = thesis_model(size, o);
     for (const std::string kind : {"opencl", "cpu"}) {
       for (const bool zoom : {false, true}) {
@@ -402,7 +453,29 @@ std::string BenchDetectorReport::table() const {
   s << "\n* OpenCL (PoCL) threads are not set per row: PoCL reads POCL_MAX_PTHREAD_COUNT once at platform init\n"
        "  (unset = all cores). Its 'vs DNN' compares with OpenCV DNN at that thread count (else the most measured).\n"
        "  vs DNN = bare OpenCV DNN median / row median (> 1: faster). Bare DNN time includes blobFromImage.\n"
-       "  GFLOP/s = DarknetModel::flops() (convolutions) / median.\n\n";
+       "  GFLOP/s = DarknetModel::flops() (convolutions) / median. Rows take turns: one forward each per round.\n\n";
+  if (!layers.empty()) {
+    s << "OpenCL per layer: device time of each command (OpenCL profiling events), medians of the profiled runs\n";
+    s << fmt::format("{:>5} {:>9} {:>9} {:>8} {:>7}  {}\n", "size", "median", "min", "GFLOP/s", "share", "command");
+    int last_size = 0;
+    double sum = 0;
+    auto total_line = [&] {
+      if (last_size) s << fmt::format("{:>5} {:>9.3f} {:>9} {:>8} {:>7}  sum of medians\n", last_size, sum, "", "", "");
+    };
+    for (const LayerResult& l : layers) {
+      if (l.size != last_size) {
+        total_line();
+        last_size = l.size;
+        sum = 0;
+      }
+      sum += l.ms.median;
+      s << fmt::format("{:>5} {:>9.3f} {:>9.3f} {:>8.1f} {:>6.1f}%  {}\n", l.size, l.ms.median, l.ms.min, l.gflop_per_s,
+                       100.0 * l.share, l.what);
+    }
+    total_line();
+    s << "\n";
+  }
+  if (pipeline.empty()) return s.str();
   s << fmt::format("pipeline: DetectionPipeline::detect() on a synthetic {}x{} BGR stream (default options)\n",
                    stream_width, stream_height);
   s << fmt::format("{:<8} {:>5} {:>7} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend", "size",
@@ -443,6 +516,14 @@ std::string BenchDetectorReport::json() const {
              "\"ms\": {}, \"gflop_per_s\": {:.4f}, \"speedup_vs_dnn\": {:.4f}, \"error\": {}}}",
              json_string(r.backend), json_string(r.device), r.size, r.threads, json_string(r.threads_note),
              json_timing(r.ms), r.gflop_per_s, r.speedup_vs_dnn, json_string(r.error));
+  }
+  s << "],\n \"layers\": [";
+  for (size_t i = 0; i < layers.size(); ++i) {
+    const LayerResult& l = layers[i];
+    s << (i ? ",\n  " : "\n  ")
+      << fmt::format(
+             "{{\"size\": {}, \"layer\": {}, \"what\": {}, \"ms\": {}, \"gflop_per_s\": {:.4f}, \"share\": {:.4f}}}",
+             l.size, l.layer, json_string(l.what), json_timing(l.ms), l.gflop_per_s, l.share);
   }
   s << "],\n \"pipeline\": [";
   for (size_t i = 0; i < pipeline.size(); ++i) {

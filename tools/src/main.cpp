@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types), localize (one box
-// to 3D), predict (detector on images), bench detector (detector timings).
+// to 3D), predict (detector on images), bench detector (detector timings), train / val / import-halmstad (training).
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
 #include "wingman/tools/localize.hpp"
@@ -9,6 +9,10 @@
 #include "wingman/tools/predict.hpp"
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/spy.hpp"
+#include "wingman/tools/train_cli.hpp"
+#ifdef WINGMAN_WITH_SIM
+#include "wingman/tools/dataset_synth.hpp"
+#endif
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -141,6 +145,11 @@ int main(int argc, char** argv) {
   bd->add_option("--seed", bench_detector.seed, "Seed of the random weights (default 42)");
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
+  TrainingVerbs training(app);  // train, val, import-halmstad
+#ifdef WINGMAN_WITH_SIM
+  DatasetVerbs dataset(app);  // dataset synth
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -161,6 +170,10 @@ int main(int argc, char** argv) {
       return summary.ok ? 0 : 1;
     }
     if (*s) return run_spy(spy);
+    if (const int rc = training.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+#ifdef WINGMAN_WITH_SIM
+    if (const int rc = dataset.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+#endif
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);
     if (*bd) return run_bench_detector_verb(bench_detector, std::cout, std::cerr);

@@ -17,10 +17,9 @@ namespace wingman::detector {
 /// overload; no temporary files). It is the reference the OpenCL backend is checked against.
 ///
 /// The network may end in any supported layer (convolutional, maxpool, route, upsample; useful for
-/// single-layer comparisons). When it ends in [region] or [yolo], OpenCV would apply its own decode
-/// (and reorder the tensor); instead the head (which has no weights) is left out of the OpenCV network,
-/// so forward() returns the raw output of the layer before it (the last convolution): the tensor
-/// decode_region() takes.
+/// single-layer comparisons). OpenCV would apply its own decode to [region] and [yolo] heads (and reorder
+/// the tensor); instead each head (which has no weights) becomes a one-layer [route] to the layer before
+/// it, so forward() returns the raw input of every head: the tensors decode_region() / decode_yolo() take.
 class CpuBackend : public InferenceBackend {
  public:
   /// @param model      network with its weights loaded or randomized (a convolution without weights
@@ -30,19 +29,20 @@ class CpuBackend : public InferenceBackend {
 
   std::string name() const override { return "opencv-cpu"; }
   Shape input_shape() const override { return input_shape_; }
-  Shape output_shape() const override { return output_shape_; }
+  std::vector<Shape> output_shapes() const override { return output_shapes_; }
   int max_batch() const override { return max_batch_; }
   void forward(const float* input, int batch, std::vector<float>& output) override;
 
-  /// Name of the OpenCV DNN layer whose output forward() returns (for diagnostics; OpenCV's own naming).
-  const std::string& output_layer_name() const { return output_name_; }
+  /// Names of the OpenCV DNN layers whose outputs forward() returns (for diagnostics; OpenCV's naming).
+  const std::vector<std::string>& output_layer_names() const { return output_names_; }
 
  private:
   cv::dnn::Net net_;
   Shape input_shape_;
-  Shape output_shape_;
+  std::vector<Shape> output_shapes_;
   int max_batch_ = 1;
-  std::string output_name_;
+  std::vector<std::string> output_names_;
+  std::vector<cv::Mat> outs_;  ///< forward() scratch
 };
 
 }  // namespace wingman::detector

@@ -26,12 +26,12 @@ class DarknetFormatError : public std::runtime_error {
 ///   (leaky, linear, logistic).
 /// - [maxpool]: size, stride, padding (default size - 1: Darknet pads right/bottom, so size 2 stride 1
 ///   keeps the spatial size).
-/// - [region]: anchors, classes, num, coords (must be 4), softmax; training-only keys (bias_match, jitter,
-///   rescore, object_scale, noobject_scale, class_scale, coord_scale, absolute, thresh, random) are
-///   accepted but not kept (DarknetModel has no place for them; write_darknet_cfg omits them).
+/// - [region]: anchors, classes, num, coords (must be 4), softmax, and the training-only keys object_scale,
+///   noobject_scale, class_scale, coord_scale, rescore, bias_match, absolute, thresh, jitter, random (kept
+///   on the Layer, written back by write_darknet_cfg).
 /// - [route]: layers (relative negative or absolute indices); [upsample]: stride;
-///   [yolo]: mask, anchors, classes, num, and training-only keys (jitter, ignore_thresh, truth_thresh,
-///   random) accepted but not kept.
+///   [yolo]: mask, anchors, classes, num, scale_x_y (>= 1), and the training-only keys ignore_thresh,
+///   truth_thresh, jitter, random (kept and written back).
 /// Throws DarknetFormatError if the file cannot be read, on an unknown section or key, a bad value, or
 /// inconsistent shapes (e.g. a [region] whose input channels are not num * (5 + classes)).
 DarknetModel parse_darknet_cfg(const std::string& path);

@@ -63,7 +63,23 @@ struct Layer {
   std::vector<float> anchors;  ///< all anchors (w, h pairs): grid cells for [region], pixels for [yolo]
   std::vector<int> mask;       ///< [yolo]: which anchors this head uses
   int classes = 1;
-  int num = 5;  ///< anchors per cell ([region]: num; [yolo]: mask size)
+  int num = 5;             ///< anchors per cell ([region]: num; [yolo]: mask size)
+  float scale_x_y = 1.0f;  ///< [yolo]: b_x = (sigma(t_x) * s - (s - 1) / 2 + c_x) / W (1: YOLOv3)
+
+  // [region] / [yolo] training-only keys, at Darknet's defaults. Inference ignores them; they are kept so
+  // that a written .cfg trains like the one read (write_darknet_cfg writes them all).
+  float object_scale = 1.0f;    ///< [region] loss weight of objectness where an object is
+  float noobject_scale = 1.0f;  ///< [region] loss weight of objectness where none is
+  float class_scale = 1.0f;     ///< [region] loss weight of the class probabilities
+  float coord_scale = 1.0f;     ///< [region] loss weight of the box coordinates
+  int rescore = 0;              ///< [region] 1: objectness target is the IoU with the truth, 0: 1
+  int bias_match = 0;           ///< [region] 1: match truths to anchors by shape only
+  int absolute = 0;             ///< [region] Darknet's `absolute` switch (kept verbatim)
+  float thresh = 0.5f;          ///< [region] IoU above which a prediction is not pushed to "no object"
+  float ignore_thresh = 0.5f;   ///< [yolo] IoU above which a prediction is not pushed to "no object"
+  float truth_thresh = 1.0f;    ///< [yolo] IoU above which a prediction also learns that truth
+  float jitter = 0.2f;          ///< [region]/[yolo] random crop augmentation, fraction of the image
+  float random = 0.0f;          ///< [region]/[yolo] != 0: multi-scale training (Darknet resizes the network)
 };
 
 /// The [net] section: input size and the training settings (kept for the trainer).
@@ -87,6 +103,8 @@ struct DarknetModel {
 
   /// Number of float32 values a .weights file must hold after its header.
   int64_t weight_count() const;
+  /// Indices of the [region] and [yolo] layers (the detection heads), in cfg order.
+  std::vector<int> heads() const;
   /// Multiply-adds x 2 of one forward pass at the net's input size (convolutions only), FLOP.
   double flops() const;
 };

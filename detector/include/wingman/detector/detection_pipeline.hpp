@@ -36,10 +36,11 @@ struct DetectorPipelineOptions {
   std::vector<std::string> validate() const;
 };
 
-/// Algorithm 2, on one BGR image at a time, with any InferenceBackend whose network ends in [region]:
+/// Algorithm 2, on one BGR image at a time, with any InferenceBackend whose network has [region] or [yolo]
+/// heads (the thesis network: one [region]; a tiny-YOLOv3: two [yolo]):
 ///  1. region = the whole image, or with `subsquare` its centred min(w, h) square;
-///  2. stretch the region to the network input (bilinear), run the backend, decode the [region] output,
-///     keep confidence >= p_thresh;
+///  2. stretch the region to the network input (bilinear), run the backend, decode every head's output
+///     (decode_region / decode_yolo) into one candidate list, keep confidence >= p_thresh;
 ///  3. non-max suppression (Algorithm 1, o_thresh); apply `policy` and `max_detections`;
 ///  4. with `zoom_in`: for each kept detection, a network-sized crop of the full-resolution image centred
 ///     on it and clamped inside the image (zoom_crop()); all crops run as batches of up to
@@ -53,9 +54,10 @@ struct DetectorPipelineOptions {
 class DetectionPipeline {
  public:
   /// @param options  validated here (std::invalid_argument listing every problem).
-  /// @param backend  not null; its input_shape() must be the model's net size and its output_shape() the
-  ///                 [region] layer's input (std::invalid_argument otherwise).
-  /// @param model    the network the backend runs; must end in [region] (the anchors are taken from it).
+  /// @param backend  not null; its input_shape() must be the model's net size and its output_shapes() the
+  ///                 heads' inputs, in order (std::invalid_argument otherwise).
+  /// @param model    the network the backend runs; must have at least one [region] or [yolo] head (the
+  ///                 anchors are taken from them).
   DetectionPipeline(DetectorPipelineOptions options, std::unique_ptr<InferenceBackend> backend,
                     const DarknetModel& model);
 
@@ -67,13 +69,13 @@ class DetectionPipeline {
   InferenceBackend& backend() { return *backend_; }
 
  private:
-  /// Runs `count` images already in input_ through the backend and decodes image i's boxes (>= p_thresh,
-  /// network pixels) into candidates_[i].
+  /// Runs `count` images already in input_ through the backend and decodes image i's boxes from every head
+  /// (>= p_thresh, network pixels) into candidates_[i].
   void run_and_decode(int count);
 
   DetectorPipelineOptions options_;
   std::unique_ptr<InferenceBackend> backend_;
-  Layer region_;                              ///< the [region] layer (anchors, num, classes, input shape)
+  std::vector<Layer> heads_;                  ///< the [region]/[yolo] layers, in the backend's output order
   cv::Size net_size_;                         ///< network input, pixels
   int batch_capacity_ = 1;                    ///< images input_ holds: min(max_batch, max_detections), >= 1
   std::vector<float> input_;                  ///< batch_capacity_ x 3 x H x W network inputs

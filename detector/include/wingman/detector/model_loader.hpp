@@ -19,8 +19,10 @@ const char* builtin_thesis_cfg();
 DarknetModel load_model(const std::string& cfg_path, const std::string& weights_path);
 
 /// Creates the backend `kind` ("opencl", "cpu" or "auto") for `model`. auto takes OpenCL when its
-/// device is a GPU; otherwise it times both backends on the model (a few forwards each, after one
-/// warm-up) and takes the faster. `why` (if not null) receives one line saying what was chosen and why.
+/// device is a GPU; otherwise it times both backends on the model and takes the faster: OpenCL over 3
+/// forwards after a warm-up, the CPU backend over 1 after a warm-up, or 3 when that one is within 1.5x
+/// of OpenCL (docs/detector.md gives the start-up cost). `why` (if not null) receives one line saying
+/// what was chosen and why.
 /// Throws std::runtime_error when the named backend cannot be created (e.g. no OpenCL device).
 std::unique_ptr<InferenceBackend> make_backend(const std::string& kind, const DarknetModel& model,
                                                const OpenClOptions& opencl, int max_batch, std::string* why);

@@ -2,6 +2,7 @@
 // Tiny-YOLO inference on OpenCL: our own kernels on a 16-channel blocked layout (see docs/detector.md).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +12,16 @@
 #include "wingman/detector/opencl_options.hpp"
 
 namespace wingman::detector {
+
+/// Device time of one command of OpenClBackend::forward() (a layer's kernel, or moving the input or output)
+/// over the forwards profiled since OpenClBackend::set_profiling(true).
+struct KernelTiming {
+  std::string what;        ///< "layer 12 [convolutional] (cfg line 114)", "input: ...", "output: ..."
+  int layer = -1;          ///< index of the model layer, -1 for input/output commands
+  double flops = 0;        ///< per image: 2 x multiply-adds of a convolution, 0 otherwise, FLOP
+  std::vector<double> ms;  ///< device time (CL_PROFILING_COMMAND_END - START) of each profiled forward, ms
+  int64_t images = 0;      ///< images over those forwards (batch sizes summed)
+};
 
 /// Runs a DarknetModel ([convolutional] with batch normalisation folded in and bias + activation fused,
 /// [maxpool], [route], [upsample]; [region]/[yolo] heads pass their input through, decoding stays on the
@@ -31,9 +42,9 @@ class OpenClBackend : public InferenceBackend {
 
   std::string name() const override;  ///< "opencl: <device name>"
   Shape input_shape() const override;
-  Shape output_shape() const override;
+  std::vector<Shape> output_shapes() const override;
   int max_batch() const override;
-  /// input: `batch` CHW float images, contiguous; output resized to batch x output_shape().
+  /// input: `batch` CHW float images, contiguous; output: see InferenceBackend::forward().
   /// Precondition: 1 <= batch <= max_batch(). Throws std::invalid_argument otherwise.
   void forward(const float* input, int batch, std::vector<float>& output) override;
 
@@ -41,6 +52,14 @@ class OpenClBackend : public InferenceBackend {
   std::string device_name() const;
   /// True when the selected device is a GPU (CL_DEVICE_TYPE_GPU).
   bool is_gpu() const;
+
+  /// Starts (clearing what was recorded) or stops recording the device time of every command of forward().
+  /// Profiling makes forward() wait on OpenCL events it would not otherwise create; leave it off in
+  /// production. Throws std::runtime_error on an OpenCL error.
+  void set_profiling(bool on);
+  /// The commands of forward() in launch order, each with its time in every forward since
+  /// set_profiling(true); empty when profiling never ran.
+  std::vector<KernelTiming> profile() const;
 
  private:
   struct Impl;

@@ -21,6 +21,8 @@ struct BenchDetectorOptions {
   int stream_width = 1280;                ///< width of the synthetic BGR stream for the pipeline, pixels, >= 32
   int stream_height = 720;                ///< height of the synthetic BGR stream for the pipeline, pixels, >= 32
   int pipeline_max_batch = 4;             ///< backends' max_batch in the pipeline (zoom-in crops per forward), >= 1
+  bool pipeline = true;                   ///< also time DetectionPipeline::detect() (slow: zoom-in on the CPU)
+  bool layers = true;                     ///< also profile the OpenCL backend per layer (`repetitions` more runs)
 
   /// One "field = value: rule" line per problem; empty when valid.
   std::vector<std::string> validate() const;
@@ -45,6 +47,16 @@ struct ForwardResult {
   double gflop_per_s = 0;     ///< DarknetModel::flops() / median
   double speedup_vs_dnn = 0;  ///< bare OpenCV DNN median / this median at the same size and threads (0 = none)
   std::string error;          ///< non-empty when the backend could not run (then the numbers are 0)
+};
+
+/// One command of the OpenCL backend's forward (a layer's kernel, or moving the input or output), batch 1.
+struct LayerResult {
+  int size = 0;            ///< network input, pixels (square)
+  int layer = -1;          ///< model layer index, -1 for input/output commands
+  std::string what;        ///< e.g. "layer 13 [convolutional] (cfg line 123)"
+  TimingMs ms;             ///< device time (OpenCL profiling events) per forward
+  double gflop_per_s = 0;  ///< convolutions: FLOP / median
+  double share = 0;        ///< median / sum of the medians of all commands at this size
 };
 
 /// DetectionPipeline::detect() on the synthetic stream, one backend, zoom-in on or off.
@@ -81,6 +93,7 @@ struct BenchDetectorReport {
   int stream_width = 0;   ///< synthetic stream of the pipeline rows, pixels
   int stream_height = 0;  ///< likewise
   std::vector<ForwardResult> forward;
+  std::vector<LayerResult> layers;  ///< OpenCL per layer, per size (empty with options.layers off)
   std::vector<PipelineResult> pipeline;
 
   /// Readable tables with the machine details and notes.

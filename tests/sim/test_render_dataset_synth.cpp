@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: MIT
+// `wingman dataset synth`: the YOLO layout as the trainer reads it, labels that are the exact truth boxes of what the
+// metadata describes, determinism per seed, progress, and errors.
+#include "test_render_support.hpp"
+
+#include <gtest/gtest.h>
+#include <wingman/common/config.hpp>
+#include <wingman/sim/truth_box.hpp>
+#include <wingman/tools/dataset_synth.hpp>
+#include <wingman/training/yolo_dataset.hpp>
+
+#include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace wingman::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A small, quick configuration: 320x240 images, two cameras, half of the images in val.
+std::string write_config(const wingman::testing::TempDir& dir, const std::string& extra = "") {
+  const std::string path = dir.file("synth.yaml");
+  std::ofstream(path) << "synth:\n  width: 320\n  height: 240\n  cameras: 2\n  val_fraction: 0.5\n"
+                      << "  blur_fraction: 0.3\n"
+                      << extra;
+  return path;
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Every file under `root`, relative path -> bytes.
+std::map<std::string, std::string> all_files(const fs::path& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    if (entry.is_regular_file()) files[fs::relative(entry.path(), root).string()] = read_file(entry.path());
+  }
+  return files;
+}
+
+Eigen::Isometry3d pose(const YAML::Node& node) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(node["p"][0].as<double>(), node["p"][1].as<double>(), node["p"][2].as<double>());
+  T.linear() = Eigen::Quaterniond(node["q_wxyz"][0].as<double>(), node["q_wxyz"][1].as<double>(),
+                                  node["q_wxyz"][2].as<double>(), node["q_wxyz"][3].as<double>())
+                   .normalized()
+                   .toRotationMatrix();
+  return T;
+}
+
+/// A config section "drone:" holding a DroneSpec.
+struct DroneSection {
+  sim::DroneSpec drone;
+  template <class V>
+  void visit(V& v) {
+    drone.visit(v);
+  }
+  std::vector<std::string> validate() const { return drone.validate(); }
+};
+
+/// The DroneSpec written in a metadata file's target.spec, read back through the config loader.
+sim::DroneSpec spec_from(const YAML::Node& node) {
+  YAML::Node wrapped;
+  wrapped["drone"] = node;
+  YAML::Emitter emitter;
+  emitter << wrapped;
+  return common::load_options_from_string<DroneSection>(emitter.c_str(), "metadata spec").drone;
+}
+
+TEST(DatasetSynth, WritesAYoloDatasetWhoseLabelsAreTheTruthBoxesOfItsMetadata) {
+  wingman::testing::TempDir dir;
+  DatasetSynthRequest request;
+  request.out_dir = dir.file("set");
+  request.count = 6;
+  request.seed = 3;
+  request.config = write_config(dir);
+  if (sim::test::missing_shared("meshes").empty()) request.meshes = {sim::test::shared_path("meshes/dji_f450.glb")};
+  std::ostringstream progress;
+  const DatasetSynthSummary summary = run_dataset_synth(request, progress);
+  EXPECT_EQ(summary.images, 6);
+  EXPECT_EQ(summary.train + summary.val, 6);
+  EXPECT_NE(progress.str().find("6/6 images (100%)"), std::string::npos) << progress.str();
+  EXPECT_NE(summary.one_line().find("wrote 6 images"), std::string::npos);
+
+  // The trainer's reader takes it as it is.
+  size_t images = 0;
+  for (const char* split : {"train", "val"}) {
+    if ((split == std::string("val") ? summary.val : summary.train) == 0) continue;
+    const training::YoloDataset set = training::load_yolo_dataset(request.out_dir + "/data.yaml", split);
+    EXPECT_EQ(set.class_names, std::vector<std::string>{"drone"});
+    for (const training::DatasetImage& image : set.images) {
+      ++images;
+      ASSERT_EQ(image.boxes.size(), 1u) << image.image_path << ": one drone per image";
+      const cv::Mat pixels = cv::imread(image.image_path);
+      ASSERT_EQ(pixels.cols, 320);
+      ASSERT_EQ(pixels.rows, 240);
+      // The metadata: camera, poses, airframe; the label is the truth box of that scene.
+      const fs::path stem = fs::path(image.image_path).stem();
+      const YAML::Node meta = YAML::LoadFile(request.out_dir + "/meta/" + split + "/" + stem.string() + ".json");
+      const YAML::Node c = meta["camera"];
+      const std::string model = c["distortion_model"].as<std::string>();
+      const localizer::Distortion distortion =
+          model == "equidistant" ? localizer::Distortion::kEquidistant : localizer::Distortion::kRadTan;
+      const localizer::CameraModel camera(320, 240, c["fx"].as<double>(), c["fy"].as<double>(), c["cx"].as<double>(),
+                                          c["cy"].as<double>(), distortion,
+                                          c["coefficients"].as<std::vector<double>>());
+      const sim::DroneSpec spec = spec_from(meta["target"]["spec"]);
+      const sim::DroneModel drone = sim::DroneModel::from_spec(spec);
+      EXPECT_NEAR(drone.bounding_radius(), meta["target"]["bounding_radius_m"].as<double>(), 1e-6);
+      const sim::RenderedBox truth = sim::TruthBoxProjector(camera).project(
+          drone, pose(meta["T_cam_to_world"]), pose(meta["target"]["T_body_to_world"]),
+          meta["target"]["prop_angle_rad"].as<double>());
+      ASSERT_TRUE(truth.visible) << image.image_path;
+      const training::LabeledBox& label = image.boxes[0];
+      EXPECT_EQ(label.cls, 0);
+      EXPECT_NEAR(label.cx * 320.0, truth.cx, 1e-3) << image.image_path;
+      EXPECT_NEAR(label.cy * 240.0, truth.cy, 1e-3) << image.image_path;
+      EXPECT_NEAR(label.w * 320.0, truth.w, 1e-3) << image.image_path;
+      EXPECT_NEAR(label.h * 240.0, truth.h, 1e-3) << image.image_path;
+      const double range = meta["target"]["range_m"].as<double>();
+      EXPECT_GE(range, 1.0);
+      EXPECT_LE(range, 60.0);
+      EXPECT_GE(meta["box"]["visible_pixels"].as<int>(), 12);
+    }
+  }
+  EXPECT_EQ(images, 6u);
+}
+
+TEST(DatasetSynth, SameSeedSameBytesOtherSeedOtherImages) {
+  wingman::testing::TempDir dir;
+  const std::string config = write_config(dir, "  image_format: jpg\n");
+  std::ostringstream progress;
+  const auto run = [&](const std::string& name, uint64_t seed) {
+    DatasetSynthRequest request;
+    request.out_dir = dir.file(name);
+    request.count = 4;
+    request.seed = seed;
+    request.config = config;
+    run_dataset_synth(request, progress);
+    return all_files(request.out_dir);
+  };
+  const auto a = run("a", 11), b = run("b", 11), c = run("c", 12);
+  ASSERT_EQ(a.size(), 4u * 3u + 1u);  // image, label, metadata per image; data.yaml
+  EXPECT_TRUE(a == b) << "the same seed must give the same files";
+  size_t differing = 0;
+  for (const auto& [path, bytes] : a) differing += c.count(path) == 0 || c.at(path) != bytes;
+  EXPECT_GE(differing, 4u) << "another seed must give other images";
+}
+
+TEST(DatasetSynth, ErrorsNameTheKeyOrTheFolder) {
+  wingman::testing::TempDir dir;
+  DatasetSynthRequest request;
+  request.out_dir = dir.file("set");
+  request.count = 1;
+  request.config = write_config(dir, "  range_min_m: 80\n  colour: red\n");
+  std::ostringstream progress;
+  try {
+    run_dataset_synth(request, progress);
+    FAIL() << "bad config accepted";
+  } catch (const common::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("synth.colour"), std::string::npos) << what;
+    EXPECT_NE(what.find("synth.range_max_m"), std::string::npos) << what;
+  }
+  request.config = write_config(dir);
+  request.meshes = {dir.file("no_meshes_here")};
+  EXPECT_THROW(run_dataset_synth(request, progress), std::runtime_error);
+  request.meshes.clear();
+  fs::create_directories(request.out_dir + "/images/train");
+  std::ofstream(request.out_dir + "/images/train/x.png") << "x";
+  try {
+    run_dataset_synth(request, progress);
+    FAIL() << "an existing dataset was written into";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("already holds a dataset"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(DatasetSynthConfig{}.validate().empty());
+}
+
+TEST(DatasetSynth, CommandLineWritesTheDatasetWithProgressOnStderr) {
+  wingman::testing::TempDir dir;
+  const std::string wingman = WINGMAN_EXE;
+  const auto ok = wingman::testing::run({wingman, "dataset", "synth", "--out", dir.file("set"), "--count", "2",
+                                         "--seed", "4", "--config", write_config(dir)},
+                                        std::chrono::seconds(120));
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("wrote 2 images"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.err.find("wingman dataset synth: 2/2 images (100%)"), std::string::npos) << ok.err;
+  EXPECT_TRUE(fs::exists(dir.file("set/data.yaml")));
+  // A bad key: exit 2 and one line naming it.
+  std::ofstream(dir.file("bad.yaml")) << "synth:\n  widht: 640\n";
+  const auto bad = wingman::testing::run(
+      {wingman, "dataset", "synth", "--out", dir.file("other"), "--count", "1", "--config", dir.file("bad.yaml")});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("synth.widht"), std::string::npos) << bad.err;
+  const auto printed =
+      wingman::testing::run({wingman, "dataset", "synth", "--out", "x", "--count", "1", "--print-config"});
+  EXPECT_EQ(printed.exit_code, 0) << printed.err;
+  EXPECT_NE(printed.out.find("render:"), std::string::npos) << printed.out;
+  EXPECT_NE(printed.out.find("synth:"), std::string::npos) << printed.out;
+  const auto no_count = wingman::testing::run({wingman, "dataset", "synth", "--out", dir.file("third")});
+  EXPECT_EQ(no_count.exit_code, 2);
+  EXPECT_NE(no_count.err.find("--count"), std::string::npos) << no_count.err;
+}
+
+}  // namespace
+}  // namespace wingman::tools

@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: MIT
+// The `wingman` verbs train, val and import-halmstad as processes: exit codes, output, errors on stderr.
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+
+#include "hand_case.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace wingman::training {
+namespace {
+
+namespace fs = std::filesystem;
+
+testing::RunResult wingman(const std::vector<std::string>& args, int timeout_s = 60) {
+  std::vector<std::string> argv = {testing::bin_path("wingman")};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return testing::run(argv, std::chrono::seconds(timeout_s));
+}
+
+TEST(WingmanVal, JsonOfSavedPredictionsHasTheHandComputedAp) {
+  testing::TempDir dir;
+  write_hand_case(dir);
+  const auto r = wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("{\"images\": 3,", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("\"criterion\": \"iou\", \"all\": {\"truths\": 3, \"detections\": 5, \"true_positives\": 2"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("\"ap\": 0.666667"), std::string::npos) << r.out;
+  const auto table =
+      wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--conf", "0.05"});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("match centre in truth box"), std::string::npos) << table.out;
+}
+
+TEST(WingmanVal, BadOptionsAndFilesAreNamed) {
+  testing::TempDir dir;
+  write_hand_case(dir);
+  const auto none = wingman({"val", "--data", dir.file("data.yaml")});
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.err.find("give exactly one"), std::string::npos) << none.err;
+  std::ofstream(dir.file("labels/val/b.txt")) << "0 0.5 0.5 0.1 7\n";
+  const auto bad = wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred")});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("labels/val/b.txt:1: field h = 7"), std::string::npos) << bad.err;
+}
+
+TEST(WingmanImportHalmstad, MissingDatasetIsNamed) {
+  testing::TempDir dir;
+  const auto r = wingman({"import-halmstad", dir.path(), dir.file("out")});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("clips.csv: cannot read the clip list"), std::string::npos) << r.err;
+  const auto bad = wingman({"import-halmstad", dir.path(), dir.file("out"), "--frame-step", "0"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("frame_step = 0"), std::string::npos) << bad.err;
+}
+
+/// A tiny [region] network and 8 synthetic images for `wingman train`.
+void write_tiny_training_set(const testing::TempDir& dir) {
+  std::ofstream(dir.file("tiny.cfg"))
+      << "[net]\nwidth=32\nheight=32\nchannels=3\nbatch=8\nsubdivisions=1\nlearning_rate=0.01\nburn_in=2\n"
+         "max_batches=100\npolicy=constant\n[convolutional]\nbatch_normalize=1\nfilters=8\nsize=3\nstride=1\npad=1\n"
+         "activation=leaky\n[maxpool]\nsize=2\nstride=2\n[convolutional]\nbatch_normalize=1\nfilters=8\nsize=3\n"
+         "stride=1\npad=1\nactivation=leaky\n[maxpool]\nsize=2\nstride=2\n[convolutional]\nsize=1\nstride=1\npad=1\n"
+         "filters=6\nactivation=linear\n[region]\nanchors=1,1\nclasses=1\ncoords=4\nnum=1\nsoftmax=1\nobject_scale=5\n"
+         "rescore=1\n";
+  for (int i = 0; i < 8; ++i)
+    for (const char* split : {"train", "val"}) {
+      cv::Mat img(40, 48, CV_8UC3, cv::Scalar(200, 180, 150));
+      cv::circle(img, {8 + 4 * i, 20}, 4, cv::Scalar(20, 20, 20), cv::FILLED);
+      const fs::path p = fs::path(dir.file("data/images")) / split / (std::to_string(i) + ".png");
+      fs::create_directories(p.parent_path());
+      ASSERT_TRUE(cv::imwrite(p.string(), img));
+      fs::create_directories(dir.file(std::string("data/labels/") + split));
+      std::ofstream(dir.file(std::string("data/labels/") + split + "/" + std::to_string(i) + ".txt"))
+          << "0 " << (8.5 + 4 * i) / 48.0 << " " << 20.5 / 40.0 << " " << 9.0 / 48.0 << " " << 9.0 / 40.0 << "\n";
+    }
+}
+
+#if WINGMAN_TEST_HAVE_TRAINER
+TEST(WingmanTrain, TrainsWithOverridesThenResumes) {
+  testing::TempDir dir;
+  write_tiny_training_set(dir);
+  const std::vector<std::string> base = {
+      "train",   "--cfg", dir.file("tiny.cfg"), "--data", dir.file("data"), "--out", dir.file("out"),
+      "--batch", "4",     "--subdivisions",     "2",      "--threads",      "1"};
+  auto args = base;
+  args.insert(args.end(), {"--max-batches", "3"});
+  const auto r = wingman(args, 120);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("8 training images, batch 4 in 2 subdivisions, 3 iterations from 0"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("iter 3/3"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("done at iteration 3/3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("match IoU >= 0.5"), std::string::npos) << r.out;  // validated on val at the end
+  ASSERT_TRUE(fs::is_regular_file(dir.file("out/tiny_final.weights")));
+  detector::DarknetModel m = detector::parse_darknet_cfg(dir.file("tiny.cfg"));
+  detector::load_darknet_weights(m, dir.file("out/tiny_final.weights"));
+  EXPECT_EQ(m.seen, 12u);  // 3 iterations x 4 images (the --batch override)
+
+  args = base;
+  args.insert(args.end(), {"--max-batches", "5", "--resume"});
+  const auto resumed = wingman(args, 120);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("5 iterations from 3"), std::string::npos) << resumed.err;
+  std::ifstream csv(dir.file("out/progress.csv"));
+  int lines = 0;
+  for (std::string l; std::getline(csv, l);) ++lines;
+  EXPECT_EQ(lines, 1 + 5);  // header + iterations 1..5 over both runs
+
+  args = base;
+  args.insert(args.end(), {"--seed", "9", "--resume"});
+  const auto refused = wingman(args);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("made with seed 1"), std::string::npos) << refused.err;
+}
+#else
+TEST(WingmanTrain, SaysHowToGetTheTrainer) {
+  testing::TempDir dir;
+  write_tiny_training_set(dir);
+  const auto r = wingman({"train", "--cfg", dir.file("tiny.cfg"), "--data", dir.file("data")});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("WINGMAN_WITH_TRAINING"), std::string::npos) << r.err;
+}
+#endif
+
+}  // namespace
+}  // namespace wingman::training

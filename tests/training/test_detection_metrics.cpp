@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: MIT
+// Detection metrics against a hand-computed case: matching, precision, recall, mean IoU, AP, PR curve, size bins.
+#include <wingman/training/detection_metrics.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace wingman::training {
+namespace {
+
+detector::Box box(float cx, float cy, float w, float h, float conf = 0.f) {
+  detector::Box b;
+  b.cx = cx, b.cy = cy, b.w = w, b.h = h, b.confidence = conf;
+  return b;
+}
+
+// Three images worked out by hand (boxes in pixels, centre and size):
+//  A: truths T1 (50,50,20,20) and T2 (150,50,10,10);
+//     P1 (52,50,20,20) 0.9: IoU with T1 = 18*20 / (400 + 400 - 360) = 360/440 = 0.81818;
+//     P2 (150,52,30,30) 0.6: IoU with T2 = 100/900 = 0.11111 (< 0.5), but its centre is inside T2;
+//     P3 (300,300,10,10) 0.3: nothing.
+//  B: truth T3 (100,100,40,40); P5 (102,100,40,40) 0.8: IoU 38*40 / (3200 - 1520) = 0.90476;
+//     P4 (100,100,40,40) 0.1: IoU 1, but T3 is already taken by the more confident P5.
+//  C: no truth; P6 (10,10,8,8) 0.5.
+std::vector<ImageDetections> hand_case() {
+  return {{{box(50, 50, 20, 20), box(150, 50, 10, 10)},
+           {box(52, 50, 20, 20, 0.9f), box(150, 52, 30, 30, 0.6f), box(300, 300, 10, 10, 0.3f)}},
+          {{box(100, 100, 40, 40)}, {box(100, 100, 40, 40, 0.1f), box(102, 100, 40, 40, 0.8f)}},
+          {{}, {box(10, 10, 8, 8, 0.5f)}}};
+}
+
+constexpr double kIouP1 = 360.0 / 440.0;
+constexpr double kIouP5 = 1520.0 / 1680.0;
+constexpr double kIouP2 = 100.0 / 900.0;
+
+TEST(DetectionMetrics, DefaultsAreValid) { EXPECT_TRUE(MetricsOptions{}.validate().empty()); }
+
+TEST(DetectionMetrics, IouCriterionMatchesHandComputedCase) {
+  MetricsOptions o;
+  o.pr_points = 3;  // recall 0, 0.5, 1
+  const DetectionMetrics m = evaluate_detections(hand_case(), o);
+  EXPECT_EQ(m.images, 3);
+  EXPECT_EQ(m.negative_images, 1);
+  EXPECT_EQ(m.truths, 3);
+  EXPECT_EQ(m.predictions, 6);
+  const MatchStats& s = m.iou.all;
+  // At confidence >= 0.2: P1 TP, P5 TP, P2 FP, P6 FP, P3 FP (P4 is below the operating point).
+  EXPECT_EQ(s.detections, 5);
+  EXPECT_EQ(s.true_positives, 2);
+  EXPECT_EQ(s.false_positives, 3);
+  EXPECT_DOUBLE_EQ(s.precision, 0.4);
+  EXPECT_DOUBLE_EQ(s.recall, 2.0 / 3.0);
+  EXPECT_NEAR(s.f1, 2 * 0.4 * (2.0 / 3.0) / (0.4 + 2.0 / 3.0), 1e-12);
+  EXPECT_NEAR(s.mean_iou, (kIouP1 + kIouP5) / 2, 1e-6);
+  // Ranked: TP TP FP FP FP FP: recall 1/3 and 2/3 at precision 1, never more: AP = 2/3.
+  EXPECT_NEAR(s.ap, 2.0 / 3.0, 1e-12);
+  ASSERT_EQ(m.iou.pr_curve.size(), 3u);
+  EXPECT_DOUBLE_EQ(m.iou.pr_curve[0].precision, 1.0);
+  EXPECT_FLOAT_EQ(static_cast<float>(m.iou.pr_curve[0].confidence), 0.9f);
+  EXPECT_DOUBLE_EQ(m.iou.pr_curve[1].precision, 1.0);  // recall 0.5 first reached by P5 (2/3)
+  EXPECT_FLOAT_EQ(static_cast<float>(m.iou.pr_curve[1].confidence), 0.8f);
+  EXPECT_DOUBLE_EQ(m.iou.pr_curve[2].precision, 0.0);  // recall 1 is never reached
+}
+
+TEST(DetectionMetrics, CentreInBoxCriterionMatchesHandComputedCase) {
+  const DetectionMetrics m = evaluate_detections(hand_case(), MetricsOptions{});
+  const MatchStats& s = m.centre.all;
+  // P1, P5 and P2 (centre inside T2) match; P6, P3 and P4 (T3 taken) do not.
+  EXPECT_EQ(s.detections, 5);
+  EXPECT_EQ(s.true_positives, 3);
+  EXPECT_EQ(s.false_positives, 2);
+  EXPECT_DOUBLE_EQ(s.precision, 0.6);
+  EXPECT_DOUBLE_EQ(s.recall, 1.0);
+  EXPECT_NEAR(s.mean_iou, (kIouP1 + kIouP5 + kIouP2) / 3, 1e-6);
+  EXPECT_NEAR(s.ap, 1.0, 1e-12);  // the three TPs come first
+}
+
+TEST(DetectionMetrics, SizeBinsFollowTheTruthOrTheUnmatchedPrediction) {
+  const DetectionMetrics m = evaluate_detections(hand_case(), MetricsOptions{});
+  ASSERT_EQ(m.iou.by_size.size(), 4u);
+  EXPECT_EQ(m.iou.by_size[0].name, "<16px");
+  EXPECT_EQ(m.iou.by_size[3].name, ">=64px");
+  // <16: T2 (10 px) unfound; P3 (10 px) and P6 (8 px) are its false positives.
+  const MatchStats& tiny = m.iou.by_size[0].stats;
+  EXPECT_EQ(tiny.truths, 1);
+  EXPECT_EQ(tiny.true_positives, 0);
+  EXPECT_EQ(tiny.false_positives, 2);
+  EXPECT_DOUBLE_EQ(tiny.recall, 0.0);
+  EXPECT_DOUBLE_EQ(tiny.ap, 0.0);
+  // 16-32: T1 (20 px) found by P1; P2 (30 px, unmatched) is a false positive here.
+  const MatchStats& small = m.iou.by_size[1].stats;
+  EXPECT_EQ(small.truths, 1);
+  EXPECT_EQ(small.true_positives, 1);
+  EXPECT_EQ(small.false_positives, 1);
+  EXPECT_DOUBLE_EQ(small.ap, 1.0);
+  // 32-64: T3 (40 px) found by P5; P4 (below 0.2) only enters the AP, after the TP.
+  const MatchStats& medium = m.iou.by_size[2].stats;
+  EXPECT_EQ(medium.truths, 1);
+  EXPECT_EQ(medium.detections, 1);
+  EXPECT_EQ(medium.true_positives, 1);
+  EXPECT_DOUBLE_EQ(medium.precision, 1.0);
+  EXPECT_DOUBLE_EQ(medium.ap, 1.0);
+  EXPECT_EQ(m.iou.by_size[3].stats.truths, 0);
+  // Centre criterion: T2 found by P2 in its own bin.
+  EXPECT_EQ(m.centre.by_size[0].stats.true_positives, 1);
+  EXPECT_EQ(m.centre.by_size[0].stats.false_positives, 2);
+}
+
+TEST(DetectionMetrics, ConfidenceThresholdMovesTheOperatingPointNotTheAp) {
+  MetricsOptions o;
+  o.conf_thresh = 0.05;  // P4 now counts: a duplicate, so a false positive
+  const DetectionMetrics m = evaluate_detections(hand_case(), o);
+  EXPECT_EQ(m.iou.all.detections, 6);
+  EXPECT_EQ(m.iou.all.false_positives, 4);
+  EXPECT_NEAR(m.iou.all.ap, 2.0 / 3.0, 1e-12);
+}
+
+TEST(DetectionMetrics, JsonAndReportCarryTheNumbers) {
+  const DetectionMetrics m = evaluate_detections(hand_case(), MetricsOptions{});
+  const std::string j = m.json();
+  EXPECT_NE(j.find("\"criterion\": \"iou\""), std::string::npos) << j;
+  EXPECT_NE(j.find("\"criterion\": \"centre\""), std::string::npos) << j;
+  EXPECT_NE(j.find("\"ap\": 0.666667"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"max_px\": null"), std::string::npos) << j;
+  EXPECT_NE(m.report().find("16-32px"), std::string::npos);
+  EXPECT_NE(m.one_line().find("AP 0.667"), std::string::npos) << m.one_line();
+}
+
+TEST(DetectionMetrics, InvalidOptionsAreNamed) {
+  MetricsOptions o;
+  o.iou_thresh = 0;
+  o.size_edges_px = {32, 16};
+  try {
+    evaluate_detections(hand_case(), o);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("iou_thresh = 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("size_edges_px[1] = 16"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace wingman::training

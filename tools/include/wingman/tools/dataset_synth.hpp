@@ -1,0 +1,141 @@
+// SPDX-License-Identifier: MIT
+// `wingman dataset synth`: rendered, labelled training images with domain randomization, in the YOLO layout.
+#pragma once
+
+#include <wingman/sim/render_options.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace wingman::tools {
+
+/// What `wingman dataset synth` randomizes, and within which ranges (config keys under "synth."; the base scene
+/// and sensor under "render."). Every image draws its own camera pose, target airframe and pose, scene, lighting
+/// and sensor effects from these ranges.
+struct DatasetSynthConfig {
+  int width = 1280;  ///< image width, pixels
+  int height = 720;  ///< image height, pixels
+  int cameras = 4;   ///< random camera models (intrinsics and distortion) per run; each image uses one of them
+  double hfov_min_deg = 45.0;     ///< horizontal field of view of the random cameras, degrees
+  double hfov_max_deg = 100.0;    ///< (hfov_min_deg..hfov_max_deg)
+  double fisheye_fraction = 0.2;  ///< share of cameras with an equidistant (fisheye) lens; the others are radtan
+  double radtan_k1_min = -0.35;   ///< radtan k1 range (barrel < 0 < pincushion); k2 follows as about -0.3 k1
+  double radtan_k1_max = 0.1;
+  double range_min_m = 1.0;  ///< camera-to-target distance, metres, drawn log-uniformly
+  double range_max_m = 60.0;
+  double mesh_fraction = 0.5;  ///< share of targets that are meshes from --meshes (when any are given)
+  double scale_min = 0.6;      ///< procedural airframes: size relative to the F450-like default (log-uniform)
+  double scale_max = 2.0;
+  double disc_fraction = 0.3;        ///< share of procedural airframes with translucent propeller discs
+  double camera_height_min_m = 1.5;  ///< camera height above the ground, metres
+  double camera_height_max_m = 120.0;
+  double camera_pitch_min_deg = -45.0;  ///< camera pitch (positive: looking up), degrees
+  double camera_pitch_max_deg = 40.0;
+  double camera_roll_max_deg = 10.0;   ///< camera roll within +-this, degrees
+  double target_tilt_max_deg = 30.0;   ///< target roll and pitch within +-this, degrees (yaw is free)
+  double blur_fraction = 0.3;          ///< share of images with motion blur
+  double blur_exposure_max_s = 0.012;  ///< motion-blur shutter time up to this, seconds
+  double noise_std_max = 4.0;          ///< read noise std drawn in 0..this, 8-bit levels
+  double shot_noise_max = 1.0;         ///< photon noise drawn in 0..this
+  double exposure_jitter = 0.3;        ///< log-normal sigma of the per-image exposure gain
+  double val_fraction = 0.1;           ///< share of images in the val split
+  std::string image_format = "png";    ///< png (lossless) or jpg
+  int jpeg_quality = 95;               ///< jpg quality, 1..100
+  int min_visible_pixels = 12;         ///< a drone seen at fewer pixel centres is drawn again elsewhere
+  sim::RenderOptions render;           ///< base scene and sensor options (render.*)
+
+  template <class V>
+  void visit(V& v) {
+    v("synth.width", width, "image width, pixels");
+    v("synth.height", height, "image height, pixels");
+    v("synth.cameras", cameras, "random camera models per run (each image uses one)");
+    v("synth.hfov_min_deg", hfov_min_deg, "horizontal field of view, lower end, degrees");
+    v("synth.hfov_max_deg", hfov_max_deg, "horizontal field of view, upper end, degrees");
+    v("synth.fisheye_fraction", fisheye_fraction, "share of cameras with an equidistant (fisheye) lens");
+    v("synth.radtan_k1_min", radtan_k1_min, "radtan k1, lower end (barrel distortion < 0)");
+    v("synth.radtan_k1_max", radtan_k1_max, "radtan k1, upper end");
+    v("synth.range_min_m", range_min_m, "camera-to-target distance, lower end, metres (log-uniform)");
+    v("synth.range_max_m", range_max_m, "camera-to-target distance, upper end, metres");
+    v("synth.mesh_fraction", mesh_fraction, "share of targets drawn from --meshes (when given)");
+    v("synth.scale_min", scale_min, "procedural airframe size relative to an F450, lower end");
+    v("synth.scale_max", scale_max, "procedural airframe size relative to an F450, upper end");
+    v("synth.disc_fraction", disc_fraction, "share of procedural airframes with translucent propeller discs");
+    v("synth.camera_height_min_m", camera_height_min_m, "camera height above ground, lower end, metres");
+    v("synth.camera_height_max_m", camera_height_max_m, "camera height above ground, upper end, metres");
+    v("synth.camera_pitch_min_deg", camera_pitch_min_deg, "camera pitch, lower end, degrees (up > 0)");
+    v("synth.camera_pitch_max_deg", camera_pitch_max_deg, "camera pitch, upper end, degrees");
+    v("synth.camera_roll_max_deg", camera_roll_max_deg, "camera roll within +-this, degrees");
+    v("synth.target_tilt_max_deg", target_tilt_max_deg, "target roll and pitch within +-this, degrees");
+    v("synth.blur_fraction", blur_fraction, "share of images with motion blur");
+    v("synth.blur_exposure_max_s", blur_exposure_max_s, "motion-blur shutter time, upper end, seconds");
+    v("synth.noise_std_max", noise_std_max, "read noise std, upper end, 8-bit levels");
+    v("synth.shot_noise_max", shot_noise_max, "photon noise, upper end");
+    v("synth.exposure_jitter", exposure_jitter, "per-image exposure gain, log-normal sigma");
+    v("synth.val_fraction", val_fraction, "share of images in the val split");
+    v("synth.image_format", image_format, "png or jpg");
+    v("synth.jpeg_quality", jpeg_quality, "jpg quality, 1..100");
+    v("synth.min_visible_pixels", min_visible_pixels, "redraw a target seen at fewer pixel centres");
+    render.visit(v);
+  }
+  /// Every problem, as "synth.key = value: rule" (and render.*), empty when valid.
+  std::vector<std::string> validate() const;
+};
+
+/// One run of `wingman dataset synth`.
+struct DatasetSynthRequest {
+  std::string out_dir;              ///< the dataset folder; must not hold images already
+  int count = 0;                    ///< images to render (> 0)
+  uint64_t seed = 1;                ///< the same seed, config and meshes give the same bytes
+  std::string config;               ///< YAML with synth.* and render.* keys ("" = defaults)
+  std::vector<std::string> meshes;  ///< mesh files, or folders of them (.glb .gltf .obj .dae .stl .ply .fbx)
+};
+
+/// What a run wrote.
+struct DatasetSynthSummary {
+  std::string out_dir;
+  int images = 0;   ///< images written (each with exactly one drone label)
+  int train = 0;    ///< of which in images/train
+  int val = 0;      ///< of which in images/val
+  int redrawn = 0;  ///< target placements drawn again because the drone was not visible enough
+  double seconds = 0.0;
+  /// "wrote 1000 images (900 train, 100 val) to DIR in 812.3 s (1.23 images/s, 57 placements redrawn)".
+  std::string one_line() const;
+};
+
+/// Renders the dataset:
+///  - `images/{train,val}/NNNNNN.<png|jpg>`;
+///  - `labels/{train,val}/NNNNNN.txt`: one line `0 cx cy w h` (YOLO: centre and size over the image size; the box is
+///    the drone's exact projected box, sim::RenderedBox);
+///  - `meta/{train,val}/NNNNNN.json`: camera model, camera pose, target airframe (its full DroneSpec, or mesh file)
+///    and pose, position in the camera frame, range, box in pixels, exposure, blur and noise;
+///  - `data.yaml` (path, train, val, nc: 1, names: [drone]).
+/// Every image shows one drone seen at min_visible_pixels pixel centres or more: a placement where it is hidden or
+/// too small is drawn again (counted in `redrawn`), so there are no empty labels. Image i depends only on the seed,
+/// the config, the meshes and i. Progress lines go to `progress` about once a second.
+/// Throws common::ConfigError for a bad config, std::runtime_error naming the file or folder for I/O problems.
+DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress);
+
+/// Adds `dataset synth` to the CLI and runs it when chosen.
+class DatasetVerbs {
+ public:
+  /// Registers `dataset` and its subcommand `synth` with their options on `app`.
+  explicit DatasetVerbs(CLI::App& app);
+  ~DatasetVerbs();
+
+  /// After parsing: runs `dataset synth` when chosen and returns its exit code (0 ok, 1 failure, 2 bad config), or
+  /// -1 when it was not chosen. The summary goes to `out`, progress and errors to `err`.
+  int run_if_chosen(std::ostream& out, std::ostream& err);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+}  // namespace wingman::tools

@@ -1,0 +1,538 @@
+// SPDX-License-Identifier: MIT
+// `wingman dataset synth`: rendered, labelled training images with domain randomization, in the YOLO layout.
+#include "wingman/tools/dataset_synth.hpp"
+
+#include <wingman/common/config.hpp>
+#include <wingman/localizer/camera_model.hpp>
+#include <wingman/sim/drone_model.hpp>
+#include <wingman/sim/renderer.hpp>
+#include <wingman/sim/truth_box.hpp>
+#include <wingman/training/yolo_dataset.hpp>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+
+namespace wingman::tools {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+constexpr int kMaxPlacements = 50;  // attempts to place a visible target in one image
+
+// A small counter-based generator (splitmix64): the same numbers on every platform and standard library, so a seed
+// gives the same dataset everywhere.
+class Random {
+ public:
+  explicit Random(uint64_t seed) : state_(seed) {}
+  Random(uint64_t seed, uint64_t stream, uint64_t index) : state_(mix(mix(seed ^ mix(stream)) ^ mix(index + 1))) {}
+  uint64_t next() { return mix(state_ += 0x9E3779B97F4A7C15ull); }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  ///< [0, 1)
+  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+  double log_uniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
+  bool chance(double p) { return uniform() < p; }
+  size_t index(size_t n) { return static_cast<size_t>(uniform() * static_cast<double>(n)) % n; }
+  double normal() {  ///< standard normal (Box-Muller)
+    const double u1 = (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53;
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * uniform());
+  }
+  Eigen::Vector3d direction() {  ///< uniform on the unit sphere
+    const double z = uniform(-1.0, 1.0), a = uniform(0.0, 2.0 * kPi), r = std::sqrt(1.0 - z * z);
+    return {r * std::cos(a), r * std::sin(a), z};
+  }
+
+ private:
+  static uint64_t mix(uint64_t x) {
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+  }
+  uint64_t state_;
+};
+
+// Random streams: one per purpose, so that adding a draw in one place leaves the others alone.
+enum Stream : uint64_t { kCameraStream = 1, kImageStream = 2 };
+
+using Colour = std::vector<double>;
+
+Colour pick(Random& rng, const std::vector<Colour>& palette, double jitter = 0.12) {
+  Colour c = palette[rng.index(palette.size())];
+  for (double& v : c) v = std::clamp(v * rng.uniform(1.0 - jitter, 1.0 + jitter), 0.0, 1.0);
+  return c;
+}
+
+const std::vector<Colour> kZenith = {{0.25, 0.45, 0.8}, {0.2, 0.4, 0.85},  {0.15, 0.3, 0.7},
+                                     {0.45, 0.55, 0.7}, {0.6, 0.62, 0.66}, {0.5, 0.48, 0.62}};
+const std::vector<Colour> kHorizon = {
+    {0.75, 0.82, 0.9}, {0.85, 0.86, 0.88}, {0.7, 0.75, 0.8}, {0.9, 0.78, 0.62}, {0.8, 0.8, 0.78}};
+const std::vector<Colour> kGround = {{0.3, 0.42, 0.18}, {0.45, 0.4, 0.28}, {0.55, 0.5, 0.3}, {0.2, 0.3, 0.12},
+                                     {0.76, 0.7, 0.5},  {0.9, 0.9, 0.92},  {0.4, 0.4, 0.42}, {0.35, 0.3, 0.22}};
+const std::vector<Colour> kTrees = {{0.12, 0.2, 0.1}, {0.2, 0.25, 0.12}, {0.3, 0.24, 0.14}, {0.1, 0.15, 0.12}};
+const std::vector<Colour> kAirframe = {{0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}, {0.4, 0.4, 0.42},  {0.92, 0.92, 0.92},
+                                       {0.8, 0.1, 0.1},    {0.1, 0.25, 0.8},   {0.95, 0.5, 0.05}, {0.9, 0.8, 0.1},
+                                       {0.1, 0.5, 0.2},    {0.03, 0.74, 1.0}};
+
+// A random calibrated camera: field of view, principal point, and a radtan or equidistant lens.
+localizer::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, int k) {
+  const double half_fov = 0.5 * rng.uniform(c.hfov_min_deg, c.hfov_max_deg) * kDeg;
+  const double cx = 0.5 * c.width - 0.5 + rng.normal() * 0.01 * c.width;
+  const double cy = 0.5 * c.height - 0.5 + rng.normal() * 0.01 * c.height;
+  const double aspect = 1.0 + 0.003 * rng.normal();
+  const std::string name = fmt::format("synth_camera_{}", k);
+  if (rng.chance(c.fisheye_fraction)) {
+    const double f = 0.5 * c.width / half_fov;  // equidistant: r = f theta at the image edge
+    return localizer::CameraModel(
+        c.width, c.height, f, f * aspect, cx, cy, localizer::Distortion::kEquidistant,
+        {rng.uniform(-0.04, 0.04), rng.uniform(-0.01, 0.01), rng.uniform(-0.003, 0.003), rng.uniform(-0.001, 0.001)},
+        name);
+  }
+  const double k1 = rng.uniform(c.radtan_k1_min, c.radtan_k1_max);
+  // Focal length from the field of view of the distorted image edge: r_d = r (1 + k1 r^2 + k2 r^4).
+  const double r = std::tan(half_fov), k2 = -0.3 * k1 + rng.uniform(-0.02, 0.02);
+  const double f = 0.5 * c.width / (r * std::max(0.3, 1.0 + k1 * r * r + k2 * r * r * r * r));
+  return localizer::CameraModel(c.width, c.height, f, f * aspect, cx, cy, localizer::Distortion::kRadTan,
+                                {k1, k2, rng.uniform(-0.002, 0.002), rng.uniform(-0.002, 0.002), 0.0}, name);
+}
+
+// The scene, light and sensor of one image, around the configured base.
+sim::RenderOptions random_scene(const DatasetSynthConfig& c, Random& rng) {
+  sim::RenderOptions o = c.render;
+  o.seed = static_cast<int64_t>(rng.next() >> 1);
+  o.sky_zenith_colour = pick(rng, kZenith);
+  o.sky_horizon_colour = pick(rng, kHorizon);
+  o.cloud_cover = rng.chance(0.2) ? 0.0 : rng.uniform(0.05, 0.9);
+  o.cloud_scale_m = rng.log_uniform(300.0, 2000.0);
+  o.sun_azimuth_deg = rng.uniform(0.0, 360.0);
+  o.sun_elevation_deg = rng.uniform(5.0, 75.0);
+  o.sun_intensity = rng.chance(0.15) ? rng.uniform(0.0, 0.3) : rng.uniform(0.6, 1.4);  // overcast sometimes
+  o.ambient_intensity = rng.uniform(0.3, 0.7);
+  o.ground_colour_a = pick(rng, kGround);
+  o.ground_colour_b = pick(rng, kGround);
+  o.ground_texture_scale_m = rng.log_uniform(10.0, 100.0);
+  o.treeline = rng.chance(0.8);
+  o.treeline_distance_m = rng.uniform(120.0, 900.0);
+  o.treeline_height_m = rng.uniform(6.0, 30.0);
+  o.treeline_depth_m = rng.uniform(30.0, 400.0);
+  o.treeline_colour = pick(rng, kTrees);
+  o.visibility_m = rng.log_uniform(2000.0, 25000.0);
+  o.exposure_gain = c.render.exposure_gain * std::exp(c.exposure_jitter * rng.normal());
+  o.exposure_jitter = 0.0;
+  o.noise_std = rng.uniform(0.0, c.noise_std_max);
+  o.shot_noise = rng.uniform(0.0, c.shot_noise_max);
+  o.motion_blur_exposure_s = rng.chance(c.blur_fraction) ? rng.uniform(0.002, c.blur_exposure_max_s) : 0.0;
+  o.motion_blur_samples = 5;
+  return o;
+}
+
+// A random procedural multirotor: frame, size, colours, propellers, landing gear.
+sim::DroneSpec random_airframe(const DatasetSynthConfig& c, Random& rng) {
+  sim::DroneSpec s;
+  const double frame = rng.uniform();
+  s.frame = frame < 0.6 ? "quad" : frame < 0.85 ? "hex" : "octo";
+  const int n = s.arm_count();
+  const double scale = rng.log_uniform(c.scale_min, c.scale_max);
+  s.arm_length_m = 0.23 * scale * std::sqrt(n / 4.0) * rng.uniform(0.9, 1.1);
+  s.arm_width_m = 0.022 * scale * rng.uniform(0.7, 1.3);
+  s.body_size_m = 0.14 * scale * std::sqrt(n / 4.0) * rng.uniform(0.8, 1.3);
+  s.body_height_m = 0.06 * scale * rng.uniform(0.7, 1.4);
+  s.motor_radius_m = 0.014 * scale * rng.uniform(0.8, 1.3);
+  s.motor_height_m = 0.03 * scale * rng.uniform(0.7, 1.3);
+  const double max_prop = 2.0 * s.arm_length_m * std::sin(kPi / n) * 0.97;  // neighbouring props do not overlap
+  s.prop_diameter_m = std::min(0.2295 * scale * rng.uniform(0.8, 1.15), max_prop);
+  s.prop_chord_m = std::min(0.02 * scale * rng.uniform(0.8, 1.4), 0.4 * s.prop_diameter_m);
+  s.prop_blades = rng.chance(0.7) ? 2 : rng.chance(0.8) ? 3 : 4;
+  s.prop_style = rng.chance(c.disc_fraction) ? "disc" : "blades";
+  s.prop_disc_alpha = rng.uniform(0.2, 0.6);
+  s.gear_height_m = rng.chance(0.7) ? 0.12 * scale * rng.uniform(0.5, 1.5) : 0.0;
+  s.gear_width_m = 0.2 * scale * rng.uniform(0.8, 1.3);
+  s.gear_length_m = 0.18 * scale * rng.uniform(0.8, 1.3);
+  s.gear_tube_m = 0.008 * scale * rng.uniform(0.8, 1.5);
+  s.motor_radius_m = std::min(s.motor_radius_m, 0.45 * s.arm_length_m);
+  s.body_colour = pick(rng, kAirframe);
+  s.front_arm_colour = pick(rng, kAirframe);
+  s.rear_arm_colour = rng.chance(0.5) ? s.front_arm_colour : pick(rng, kAirframe);
+  s.motor_colour = pick(rng, kAirframe);
+  s.prop_colour = pick(rng, kAirframe);
+  s.gear_colour = pick(rng, kAirframe);
+  return s;
+}
+
+Eigen::Matrix3d rpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+// A camera pose: height above the ground, heading, pitch (up > 0) and roll; optical frame x right, y down, z forward.
+Eigen::Isometry3d random_camera_pose(const DatasetSynthConfig& c, Random& rng) {
+  Eigen::Matrix3d R_forward_to_optical;  // columns: optical x, y, z in the forward frame (x fwd, y left, z up)
+  R_forward_to_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  const double yaw = rng.uniform(-kPi, kPi);
+  const double pitch = rng.uniform(c.camera_pitch_min_deg, c.camera_pitch_max_deg) * kDeg;
+  const double roll = rng.uniform(-c.camera_roll_max_deg, c.camera_roll_max_deg) * kDeg;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = rpy(roll, -pitch, yaw) * R_forward_to_optical;  // pitching up turns x (forward) towards +z
+  T.translation() = Eigen::Vector3d(rng.uniform(-500.0, 500.0), rng.uniform(-500.0, 500.0),
+                                    rng.uniform(c.camera_height_min_m, c.camera_height_max_m));
+  return T;
+}
+
+std::string vec_json(const Eigen::Vector3d& v) { return fmt::format("[{:.9g}, {:.9g}, {:.9g}]", v.x(), v.y(), v.z()); }
+
+std::string quat_json(const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  return fmt::format("[{:.9g}, {:.9g}, {:.9g}, {:.9g}]", q.w(), q.x(), q.y(), q.z());
+}
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+// A DroneSpec as one JSON object (the keys of DroneSpec::visit without a prefix).
+class JsonSpecWriter {
+ public:
+  template <class T>
+  void operator()(const std::string& key, const T& value, const char* /*doc*/) {
+    fields_.push_back(quoted(key) + ": " + format(value));
+  }
+  std::string str() const { return "{" + fmt::format("{}", fmt::join(fields_, ", ")) + "}"; }
+
+ private:
+  static std::string format(bool v) { return v ? "true" : "false"; }
+  static std::string format(int v) { return std::to_string(v); }
+  static std::string format(double v) { return fmt::format("{:.9g}", v); }
+  static std::string format(const std::string& v) { return quoted(v); }
+  static std::string format(const std::vector<double>& v) { return fmt::format("[{:.9g}]", fmt::join(v, ", ")); }
+  std::vector<std::string> fields_;
+};
+
+std::string spec_json(const sim::DroneSpec& spec) {
+  JsonSpecWriter writer;
+  const_cast<sim::DroneSpec&>(spec).visit(writer, "");  // visit() only reads through a writer
+  return writer.str();
+}
+
+std::vector<std::string> mesh_files(const std::vector<std::string>& args) {
+  static const std::vector<std::string> kExtensions = {".glb", ".gltf", ".obj", ".dae", ".stl", ".ply", ".fbx"};
+  std::vector<std::string> files;
+  for (const std::string& arg : args) {
+    if (fs::is_directory(arg)) {
+      std::vector<std::string> found;
+      for (const auto& entry : fs::directory_iterator(arg)) {
+        std::string ext = entry.path().extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+        if (entry.is_regular_file() && std::find(kExtensions.begin(), kExtensions.end(), ext) != kExtensions.end()) {
+          found.push_back(entry.path().string());
+        }
+      }
+      if (found.empty())
+        throw std::runtime_error(fmt::format("--meshes {}: no mesh files (.glb .gltf .obj .dae .stl .ply .fbx)", arg));
+      std::sort(found.begin(), found.end());
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (fs::is_regular_file(arg)) {
+      files.push_back(arg);
+    } else {
+      throw std::runtime_error(fmt::format("--meshes {}: no such file or folder", arg));
+    }
+  }
+  return files;
+}
+
+std::string duration_text(double seconds) {
+  const int s = static_cast<int>(std::lround(seconds));
+  return s >= 3600 ? fmt::format("{}h{:02d}m", s / 3600, s / 60 % 60) : fmt::format("{}m{:02d}s", s / 60, s % 60);
+}
+
+// One camera of the pool.
+struct Camera {
+  localizer::CameraModel model;
+  std::unique_ptr<sim::Renderer> renderer;
+  sim::TruthBoxProjector field_of_view;
+};
+
+}  // namespace
+
+std::vector<std::string> DatasetSynthConfig::validate() const {
+  using common::problem;
+  std::vector<std::string> p = render.validate();
+  const auto range = [&](const char* lo_key, double lo, const char* hi_key, double hi, double min, double max) {
+    if (!(lo >= min && lo <= max)) p.push_back(problem(lo_key, lo, fmt::format("must be in [{}, {}]", min, max)));
+    if (!(hi >= min && hi <= max)) p.push_back(problem(hi_key, hi, fmt::format("must be in [{}, {}]", min, max)));
+    if (lo > hi) p.push_back(problem(hi_key, hi, fmt::format("must be >= {} ({})", lo_key, lo)));
+  };
+  const auto fraction = [&](const char* key, double v) {
+    if (!(v >= 0.0 && v <= 1.0)) p.push_back(problem(key, v, "must be in [0, 1]"));
+  };
+  if (width < 32 || width > 8192) p.push_back(problem("synth.width", width, "must be in 32..8192"));
+  if (height < 32 || height > 8192) p.push_back(problem("synth.height", height, "must be in 32..8192"));
+  if (cameras < 1 || cameras > 64) p.push_back(problem("synth.cameras", cameras, "must be in 1..64"));
+  range("synth.hfov_min_deg", hfov_min_deg, "synth.hfov_max_deg", hfov_max_deg, 10.0, 160.0);
+  range("synth.radtan_k1_min", radtan_k1_min, "synth.radtan_k1_max", radtan_k1_max, -0.6, 0.6);
+  range("synth.range_min_m", range_min_m, "synth.range_max_m", range_max_m, 0.3, 2000.0);
+  range("synth.scale_min", scale_min, "synth.scale_max", scale_max, 0.1, 10.0);
+  range("synth.camera_height_min_m", camera_height_min_m, "synth.camera_height_max_m", camera_height_max_m, 0.1,
+        10000.0);
+  range("synth.camera_pitch_min_deg", camera_pitch_min_deg, "synth.camera_pitch_max_deg", camera_pitch_max_deg, -90.0,
+        90.0);
+  if (!(camera_roll_max_deg >= 0.0 && camera_roll_max_deg <= 180.0)) {
+    p.push_back(problem("synth.camera_roll_max_deg", camera_roll_max_deg, "must be in [0, 180]"));
+  }
+  if (!(target_tilt_max_deg >= 0.0 && target_tilt_max_deg <= 90.0)) {
+    p.push_back(problem("synth.target_tilt_max_deg", target_tilt_max_deg, "must be in [0, 90]"));
+  }
+  fraction("synth.fisheye_fraction", fisheye_fraction);
+  fraction("synth.mesh_fraction", mesh_fraction);
+  fraction("synth.disc_fraction", disc_fraction);
+  fraction("synth.blur_fraction", blur_fraction);
+  fraction("synth.val_fraction", val_fraction);
+  if (!(blur_exposure_max_s >= 0.002 && blur_exposure_max_s <= 0.1)) {
+    p.push_back(problem("synth.blur_exposure_max_s", blur_exposure_max_s, "must be in [0.002, 0.1]"));
+  }
+  if (!(noise_std_max >= 0.0 && noise_std_max <= 50.0)) {
+    p.push_back(problem("synth.noise_std_max", noise_std_max, "must be in [0, 50]"));
+  }
+  if (!(shot_noise_max >= 0.0 && shot_noise_max <= 50.0)) {
+    p.push_back(problem("synth.shot_noise_max", shot_noise_max, "must be in [0, 50]"));
+  }
+  if (!(exposure_jitter >= 0.0 && exposure_jitter <= 2.0)) {
+    p.push_back(problem("synth.exposure_jitter", exposure_jitter, "must be in [0, 2]"));
+  }
+  if (image_format != "png" && image_format != "jpg") {
+    p.push_back(problem("synth.image_format", image_format, "must be png or jpg"));
+  }
+  if (jpeg_quality < 1 || jpeg_quality > 100)
+    p.push_back(problem("synth.jpeg_quality", jpeg_quality, "must be in 1..100"));
+  if (min_visible_pixels < 1) p.push_back(problem("synth.min_visible_pixels", min_visible_pixels, "must be >= 1"));
+  return p;
+}
+
+std::string DatasetSynthSummary::one_line() const {
+  return fmt::format("wrote {} images ({} train, {} val) to {} in {:.1f} s ({:.2f} images/s, {} placements redrawn)",
+                     images, train, val, out_dir, seconds, seconds > 0.0 ? images / seconds : 0.0, redrawn);
+}
+
+DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (request.count <= 0) throw std::invalid_argument(fmt::format("--count {}: must be > 0", request.count));
+  if (request.out_dir.empty()) throw std::invalid_argument("--out: a dataset folder is required");
+  DatasetSynthConfig config;  // the defaults are valid (tested)
+  if (!request.config.empty()) config = common::load_options<DatasetSynthConfig>(request.config);
+  const fs::path out(request.out_dir);
+  if (fs::exists(out / "images") && !fs::is_empty(out / "images")) {
+    throw std::runtime_error(
+        fmt::format("{}: already holds a dataset (images/ is not empty); choose a new --out", request.out_dir));
+  }
+  for (const char* kind : {"images", "labels", "meta"}) {
+    for (const char* split : {"train", "val"}) fs::create_directories(out / kind / split);
+  }
+
+  // Airframes from mesh files, loaded once.
+  std::vector<std::pair<sim::DroneSpec, std::shared_ptr<const sim::DroneModel>>> meshes;
+  for (const std::string& file : mesh_files(request.meshes)) {
+    sim::DroneSpec spec;
+    spec.frame = "mesh";
+    spec.mesh_path = file;
+    meshes.emplace_back(spec, std::make_shared<const sim::DroneModel>(sim::DroneModel::from_spec(spec)));
+  }
+
+  // The camera pool: random lenses, one renderer each.
+  std::vector<Camera> cameras;
+  for (int k = 0; k < config.cameras; ++k) {
+    Random rng(request.seed, kCameraStream, static_cast<uint64_t>(k));
+    localizer::CameraModel model = random_camera(config, rng, k);
+    auto renderer = std::make_unique<sim::Renderer>(model, config.render);
+    cameras.push_back(
+        Camera{model, std::move(renderer), sim::TruthBoxProjector(model, config.render.max_half_fov_deg)});
+  }
+
+  DatasetSynthSummary summary;
+  summary.out_dir = request.out_dir;
+  auto last_report = start;
+  for (int i = 0; i < request.count; ++i) {
+    Random rng(request.seed, kImageStream, static_cast<uint64_t>(i));
+    const std::string split = rng.chance(config.val_fraction) ? "val" : "train";
+    const std::string name = fmt::format("{:06d}", i);
+    bool done = false;
+    for (int attempt = 0; attempt < kMaxPlacements && !done; ++attempt) {
+      Camera& camera = cameras[rng.index(cameras.size())];
+      const sim::RenderOptions scene = random_scene(config, rng);
+      // The target airframe.
+      sim::DroneSpec spec;
+      std::shared_ptr<const sim::DroneModel> model;
+      if (!meshes.empty() && rng.chance(config.mesh_fraction)) {
+        std::tie(spec, model) = meshes[rng.index(meshes.size())];
+      } else {
+        spec = random_airframe(config, rng);
+        model = std::make_shared<const sim::DroneModel>(sim::DroneModel::procedural(spec));
+      }
+      // Camera pose, then the target somewhere in the image at a random range.
+      const Eigen::Isometry3d T_cam_to_world = random_camera_pose(config, rng);
+      const Eigen::Vector2d uv(rng.uniform(-0.5, config.width - 0.5), rng.uniform(-0.5, config.height - 0.5));
+      const double range = rng.log_uniform(config.range_min_m, config.range_max_m);
+      const Eigen::Vector3d ray = camera.model.unproject(uv);
+      sim::DroneInstance target;
+      target.vehicle_id = 1;
+      target.model = model.get();
+      const double tilt = config.target_tilt_max_deg * kDeg;
+      target.T_body_to_world.linear() = rpy(rng.uniform(-tilt, tilt), rng.uniform(-tilt, tilt), rng.uniform(-kPi, kPi));
+      target.T_body_to_world.translation() = T_cam_to_world * (ray * range);
+      target.v_body_in_world = rng.direction() * rng.uniform(0.0, 15.0);
+      target.w_body_in_body = rng.direction() * rng.uniform(0.0, 1.0);
+      target.prop_angle_rad = rng.uniform(0.0, 2.0 * kPi);
+      target.prop_rate_rad_s = rng.uniform(300.0, 900.0);
+      sim::CameraMotion motion;
+      motion.v_cam_in_world = rng.direction() * rng.uniform(0.0, 10.0);
+      motion.w_cam_in_cam = rng.direction() * rng.uniform(0.0, 0.5);
+      const uint64_t frame_seed = rng.next();
+      const bool placeable = ray.allFinite() && camera.field_of_view.in_field_of_view(ray) &&
+                             target.T_body_to_world.translation().z() > model->bounding_radius() + 0.3;
+      if (!placeable) {
+        ++summary.redrawn;
+        continue;
+      }
+      camera.renderer->set_options(scene);
+      const sim::RenderResult result = camera.renderer->render(T_cam_to_world, {target}, 0, frame_seed, motion);
+      const sim::RenderedBox& box = result.boxes[0];
+      if (!box.visible || box.visible_pixels < config.min_visible_pixels) {
+        ++summary.redrawn;
+        continue;
+      }
+
+      const std::string image_path = (out / "images" / split / (name + "." + config.image_format)).string();
+      const std::vector<int> params = config.image_format == "jpg"
+                                          ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, config.jpeg_quality}
+                                          : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 3};
+      if (!cv::imwrite(image_path, result.bgr, params))
+        throw std::runtime_error(image_path + ": cannot write the image");
+      training::LabeledBox label;
+      label.cls = 0;
+      label.cx = static_cast<float>(box.cx / config.width);
+      label.cy = static_cast<float>(box.cy / config.height);
+      label.w = static_cast<float>(box.w / config.width);
+      label.h = static_cast<float>(box.h / config.height);
+      training::write_yolo_labels((out / "labels" / split / (name + ".txt")).string(), {label});
+
+      const localizer::CameraModel& cam = camera.model;
+      const Eigen::Vector3d p_target_in_cam = T_cam_to_world.inverse() * target.T_body_to_world.translation();
+      const std::string meta_path = (out / "meta" / split / (name + ".json")).string();
+      std::ofstream meta(meta_path);
+      meta << "{\n"
+           << fmt::format("  \"image\": {},\n", quoted("images/" + split + "/" + name + "." + config.image_format))
+           << fmt::format("  \"width\": {}, \"height\": {},\n", config.width, config.height)
+           << fmt::format(
+                  "  \"camera\": {{\"name\": {}, \"distortion_model\": {}, \"fx\": {:.9g}, \"fy\": {:.9g}, "
+                  "\"cx\": {:.9g}, \"cy\": {:.9g}, \"coefficients\": [{:.9g}]}},\n",
+                  quoted(cam.name()), quoted(cam.model_name()), cam.fx(), cam.fy(), cam.cx(), cam.cy(),
+                  fmt::join(cam.coefficients(), ", "))
+           << fmt::format("  \"T_cam_to_world\": {{\"p\": {}, \"q_wxyz\": {}}},\n",
+                          vec_json(T_cam_to_world.translation()), quat_json(T_cam_to_world.linear()))
+           << fmt::format("  \"target\": {{\"airframe\": {}, \"spec\": {}, \"bounding_radius_m\": {:.9g},\n",
+                          quoted(model->name()), spec_json(spec), model->bounding_radius())
+           << fmt::format("    \"T_body_to_world\": {{\"p\": {}, \"q_wxyz\": {}}}, \"prop_angle_rad\": {:.9g},\n",
+                          vec_json(target.T_body_to_world.translation()), quat_json(target.T_body_to_world.linear()),
+                          target.prop_angle_rad)
+           << fmt::format("    \"p_target_in_cam\": {}, \"range_m\": {:.9g}}},\n", vec_json(p_target_in_cam),
+                          box.range_m)
+           << fmt::format(
+                  "  \"box\": {{\"cx\": {:.9g}, \"cy\": {:.9g}, \"w\": {:.9g}, \"h\": {:.9g}, \"truncated\": {}, "
+                  "\"visible_pixels\": {}}},\n",
+                  box.cx, box.cy, box.w, box.h, box.truncated ? "true" : "false", box.visible_pixels)
+           << fmt::format(
+                  "  \"render\": {{\"scene_seed\": {}, \"exposure_gain\": {:.9g}, \"noise_std\": {:.9g}, "
+                  "\"shot_noise\": {:.9g}, \"motion_blur_exposure_s\": {:.9g}, \"frame_seed\": {}}}\n",
+                  scene.seed, result.exposure_gain, scene.noise_std, scene.shot_noise, scene.motion_blur_exposure_s,
+                  frame_seed)
+           << "}\n";
+      meta.close();
+      if (!meta) throw std::runtime_error(meta_path + ": cannot write the metadata");
+      ++summary.images;
+      ++(split == "val" ? summary.val : summary.train);
+      done = true;
+    }
+    if (!done) {
+      throw std::runtime_error(
+          fmt::format("image {}: no visible target in {} placements; widen synth.range_* or "
+                      "lower synth.min_visible_pixels",
+                      i, kMaxPlacements));
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_report >= std::chrono::seconds(1) || i + 1 == request.count) {
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const double rate = (i + 1) / std::max(elapsed, 1e-9);
+      progress << fmt::format("wingman dataset synth: {}/{} images ({:.0f}%), {:.2f} images/s, {} left", i + 1,
+                              request.count, 100.0 * (i + 1) / request.count, rate,
+                              duration_text((request.count - i - 1) / rate))
+               << std::endl;
+      last_report = now;
+    }
+  }
+  training::write_data_yaml(
+      (out / "data.yaml").string(), {"drone"},
+      {"written by wingman dataset synth", fmt::format("seed {}, {} images", request.seed, request.count)});
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+struct DatasetVerbs::State {
+  CLI::App* synth = nullptr;
+  DatasetSynthRequest request;
+  bool print_config = false;
+};
+
+DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
+  CLI::App* dataset = app.add_subcommand("dataset", "Datasets: render synthetic training images");
+  dataset->require_subcommand(1);
+  s_->synth = dataset->add_subcommand(
+      "synth",
+      "Render labelled images of drones with domain randomization (YOLO layout, data.yaml, per-image metadata)");
+  s_->synth->add_option("--out", s_->request.out_dir, "Dataset folder to create (must not hold images yet)")
+      ->required();
+  s_->synth->add_option("--count", s_->request.count, "Number of images")->required()->check(CLI::PositiveNumber);
+  s_->synth->add_option("--seed", s_->request.seed, "Seed (default 1): the same seed gives the same dataset");
+  s_->synth->add_option("--config", s_->request.config, "YAML with synth.* and render.* keys (see --print-config)");
+  s_->synth->add_option("--meshes", s_->request.meshes,
+                        "Airframe mesh file or folder (repeatable), e.g. ../shared/meshes");
+  s_->synth->add_flag("--print-config", s_->print_config, "Print the effective configuration and exit");
+}
+
+DatasetVerbs::~DatasetVerbs() = default;
+
+int DatasetVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (!*s_->synth) return -1;
+  try {
+    if (s_->print_config) {
+      DatasetSynthConfig config;
+      if (!s_->request.config.empty()) config = common::load_options<DatasetSynthConfig>(s_->request.config);
+      out << common::print_options(config, "wingman dataset synth: effective configuration");
+      return 0;
+    }
+    const DatasetSynthSummary summary = run_dataset_synth(s_->request, err);
+    out << summary.one_line() << std::endl;
+    return 0;
+  } catch (const common::ConfigError& e) {
+    err << "wingman dataset synth: error: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    err << "wingman dataset synth: error: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::exception& e) {
+    err << "wingman dataset synth: error: " << e.what() << std::endl;
+    return 1;
+  }
+}
+
+}  // namespace wingman::tools

@@ -1,0 +1,308 @@
+// SPDX-License-Identifier: MIT
+// `wingman train`, `wingman val`, `wingman import-halmstad`: command lines over the training library.
+#include "wingman/tools/train_cli.hpp"
+
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/training/halmstad_import.hpp>
+#include <wingman/training/train_options.hpp>
+#include <wingman/training/val.hpp>
+#ifdef WINGMAN_WITH_TRAINING
+#include <wingman/training/trainer.hpp>
+#endif
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace wingman::tools {
+
+namespace {
+
+#ifdef WINGMAN_WITH_TRAINING
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_interrupt(int) {
+  if (g_stop.load()) std::_Exit(130);  // a second Ctrl-C: leave at once
+  g_stop = true;
+}
+
+/// OpenMP (libtorch's threads) and OpenBLAS read OMP_WAIT_POLICY and OPENBLAS_NUM_THREADS once, when they load:
+/// busy-waiting OpenMP threads and OpenBLAS threads inside them halve the training speed on a 2-core machine
+/// (measured: docs/training.md). When neither is set, set OMP_WAIT_POLICY=PASSIVE and OPENBLAS_NUM_THREADS=1
+/// and restart this process once with the same arguments (Linux: /proc/self/exe and /proc/self/cmdline).
+/// Returns (and trains as it is) when they are set or the restart is not possible.
+void restart_with_thread_settings(std::ostream& err) {
+  if (std::getenv("OMP_WAIT_POLICY") || std::getenv("OPENBLAS_NUM_THREADS") || std::getenv("WINGMAN_TRAIN_RESTARTED"))
+    return;
+  std::ifstream cmdline("/proc/self/cmdline", std::ios::binary);
+  std::vector<std::string> args;
+  for (std::string a; std::getline(cmdline, a, '\0');) args.push_back(a);
+  if (args.empty()) return;
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+  setenv("OPENBLAS_NUM_THREADS", "1", 1);
+  setenv("WINGMAN_TRAIN_RESTARTED", "1", 1);
+  err << "wingman train: restarting with OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1 (set them to choose)\n"
+      << std::flush;
+  execv("/proc/self/exe", argv.data());
+  err << "wingman train: note: could not restart (" << std::strerror(errno) << "); training without them\n";
+}
+#endif
+
+}  // namespace
+
+struct TrainingVerbs::State {
+  CLI::App* train = nullptr;
+  CLI::App* val = nullptr;
+  CLI::App* halmstad = nullptr;
+
+  // train: the .cfg gives the defaults; only options given on the command line override them.
+  std::string cfg, data, out_dir = "train-out", init_weights, train_split = "train", val_split = "val";
+  bool resume = false;
+  int batch = 0, subdivisions = 0, burn_in = 0, threads = 2, checkpoint_interval = 100, weights_interval = 1000,
+      log_interval = 1, val_max_images = 0;
+  int64_t max_batches = 0;
+  uint64_t seed = 1;
+  double learning_rate = 0, momentum = 0, decay = 0;
+  std::vector<int> steps;
+  std::vector<double> scales;
+  training::AugmentOptions augment;
+  std::vector<std::pair<CLI::Option*, std::function<void(training::TrainOptions&)>>> overrides;
+
+  training::ValOptions val_options;
+  bool val_json = false;
+
+  training::HalmstadImportOptions import;
+  bool no_tighten = false, no_negatives = false;
+};
+
+TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
+  State& s = *s_;
+  using training::TrainOptions;
+  // ---- train ----
+  s.train = app.add_subcommand(
+      "train", "Train a Darknet .cfg network on a YOLO dataset (libtorch); writes .weights the detector loads");
+  auto* t = s.train;
+  t->add_option("--cfg", s.cfg, "Darknet .cfg: the network and, in [net], its training settings")->required();
+  t->add_option("--data", s.data, "data.yaml or YOLO-layout folder (images/<split>, labels/<split>)")->required();
+  t->add_option("--out", s.out_dir,
+                "Output folder: checkpoint.pt, <cfg stem>_{last,final,N}.weights (default train-out)");
+  t->add_flag("--resume", s.resume, "Continue from <out>/checkpoint.pt (same cfg, data, seed and batch)");
+  t->add_option("--weights", s.init_weights, "Start from these Darknet .weights instead of random weights");
+  t->add_option("--train-split", s.train_split, "Split to train on (default train)");
+  t->add_option("--val-split", s.val_split, "Split to validate on at the end; empty: none (default val)");
+  t->add_option("--val-max-images", s.val_max_images, "Validate on at most this many images (default all)");
+  t->add_option("--seed", s.seed, "Seed of the initial weights, data order and augmentation (default 1)");
+  t->add_option("--threads", s.threads, "libtorch threads (default 2)");
+  t->add_option("--checkpoint-interval", s.checkpoint_interval, "Checkpoint every this many iterations (default 100)");
+  t->add_option("--weights-interval", s.weights_interval,
+                "Keep <stem>_<iteration>.weights every this many iterations, 0 = never (default 1000)");
+  t->add_option("--log-interval", s.log_interval, "Print progress every this many iterations (default 1)");
+  auto over = [&](CLI::Option* o, std::function<void(TrainOptions&)> apply) { s.overrides.emplace_back(o, apply); };
+  over(t->add_option("--batch", s.batch, "Images per iteration (default: [net] batch)"),
+       [&s](TrainOptions& o) { o.batch = s.batch; });
+  over(t->add_option("--subdivisions", s.subdivisions, "Passes per iteration (default: [net] subdivisions)"),
+       [&s](TrainOptions& o) { o.subdivisions = s.subdivisions; });
+  over(t->add_option("--max-batches", s.max_batches, "Iterations to train (default: [net] max_batches)"),
+       [&s](TrainOptions& o) { o.max_batches = s.max_batches; });
+  over(t->add_option("--learning-rate", s.learning_rate, "Learning rate after warm-up (default: [net] learning_rate)"),
+       [&s](TrainOptions& o) { o.lr.base = s.learning_rate; });
+  over(t->add_option("--burn-in", s.burn_in, "Warm-up iterations (default: [net] burn_in)"),
+       [&s](TrainOptions& o) { o.lr.burn_in = s.burn_in; });
+  over(t->add_option("--steps", s.steps, "Iterations of the rate steps (default: [net] steps)")->delimiter(','),
+       [&s](TrainOptions& o) { o.lr.steps = s.steps; });
+  over(t->add_option("--scales", s.scales, "Factor at each step (default: [net] scales)")->delimiter(','),
+       [&s](TrainOptions& o) { o.lr.scales = s.scales; });
+  over(t->add_option("--momentum", s.momentum, "SGD momentum (default: [net] momentum)"),
+       [&s](TrainOptions& o) { o.momentum = s.momentum; });
+  over(t->add_option("--decay", s.decay, "Weight decay (default: [net] decay)"),
+       [&s](TrainOptions& o) { o.decay = s.decay; });
+  over(t->add_option("--hue", s.augment.hue, "Hue jitter r_h (default: [net] hue)"),
+       [&s](TrainOptions& o) { o.augment.hue = s.augment.hue; });
+  over(t->add_option("--saturation", s.augment.saturation, "Saturation jitter r_s (default: [net] saturation)"),
+       [&s](TrainOptions& o) { o.augment.saturation = s.augment.saturation; });
+  over(t->add_option("--exposure", s.augment.exposure, "Value jitter r_v (default: [net] exposure)"),
+       [&s](TrainOptions& o) { o.augment.exposure = s.augment.exposure; });
+  over(t->add_option("--jitter", s.augment.jitter, "Random crop r_c (default: [net] or the head's jitter)"),
+       [&s](TrainOptions& o) { o.augment.jitter = s.augment.jitter; });
+  over(t->add_option("--flip", s.augment.flip, "Horizontal flip probability (default 0.5; [net] flip=0: 0)"),
+       [&s](TrainOptions& o) { o.augment.flip = s.augment.flip; });
+  over(t->add_option("--scale", s.augment.scale, "Extra zoom range: factor in [1/(1+s), 1+s] (default 0)"),
+       [&s](TrainOptions& o) { o.augment.scale = s.augment.scale; });
+  over(t->add_option("--translate", s.augment.translate, "Extra shift, fraction of the crop (default 0)"),
+       [&s](TrainOptions& o) { o.augment.translate = s.augment.translate; });
+  over(t->add_option("--blur", s.augment.blur, "Probability of a Gaussian blur (default 0)"),
+       [&s](TrainOptions& o) { o.augment.blur = s.augment.blur; });
+  over(t->add_option("--noise", s.augment.noise, "Probability of pixel noise (default 0)"),
+       [&s](TrainOptions& o) { o.augment.noise = s.augment.noise; });
+  over(t->add_option("--mosaic", s.augment.mosaic,
+                     "Probability of a 2x2 mosaic sample (default 0; [net] mosaic=1: 0.5)"),
+       [&s](TrainOptions& o) { o.augment.mosaic = s.augment.mosaic; });
+
+  // ---- val ----
+  s.val = app.add_subcommand(
+      "val", "Detection metrics of a detector (or saved predictions) on a labelled split: AP, PR curve, recall, IoU");
+  auto* v = s.val;
+  training::ValOptions& vo = s.val_options;
+  v->add_option("--data", vo.data, "data.yaml or YOLO-layout folder")->required();
+  v->add_option("--split", vo.split, "Split to evaluate (default val; \"\" = a folder's images/)");
+  v->add_option("--weights", vo.weights, "Darknet .weights: run the detector (Algorithm 2)");
+  v->add_option("--cfg", vo.cfg, "Darknet .cfg (default: the built-in thesis network)");
+  v->add_option("--backend", vo.backend, "Detector backend: cpu (default), opencl or auto");
+  v->add_option("--predictions", vo.predictions, "Instead of --weights: folder of `wingman predict` <stem>.txt files");
+  v->add_option("--conf", vo.metrics.conf_thresh,
+                "Operating confidence for precision / recall / mean IoU (default 0.2)");
+  v->add_option("--iou", vo.metrics.iou_thresh, "IoU match threshold (default 0.5)");
+  v->add_option("--size-edges", vo.metrics.size_edges_px, "Size-bin edges, sqrt(w h) in pixels (default 16,32,64)")
+      ->delimiter(',');
+  v->add_option("--pr-points", vo.metrics.pr_points, "Points of the PR curve in the JSON (default 101)");
+  v->add_option("--p-thresh", vo.detection.p_thresh, "Detector's confidence floor (default 0.005, for the curve)");
+  v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold (default 0.2)");
+  v->add_flag("--subsquare", vo.detection.subsquare, "Detect in the centred h x h square of a wide image");
+  v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
+  v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
+  v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
+  v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");
+  v->add_flag("--json", s.val_json, "Print one JSON object (with the PR curves) instead of the table");
+
+  // ---- import-halmstad ----
+  s.halmstad = app.add_subcommand(
+      "import-halmstad", "Sample the Halmstad drone videos into a YOLO dataset (split by clip, tightened boxes)");
+  auto* h = s.halmstad;
+  training::HalmstadImportOptions& io = s.import;
+  h->add_option("root", io.root, "The dataset folder (clips.csv, videos/, labels/), e.g. ../shared/datasets/halmstad")
+      ->required();
+  h->add_option("out", io.out_dir, "The YOLO dataset to write")->required();
+  h->add_option("--frame-step", io.frame_step, "Every n-th frame of drone clips (default 10)");
+  h->add_option("--negative-frame-step", io.negative_frame_step,
+                "Every n-th frame of airplane/bird/helicopter clips (default 30)");
+  h->add_flag("--no-negatives", s.no_negatives, "Leave out the airplane/bird/helicopter clips");
+  h->add_option("--max-frames-per-clip", io.max_frames_per_clip, "At most this many frames per clip (default all)");
+  h->add_option("--val-fraction", io.val_fraction, "Share of clips in val, per class and distance (default 0.2)");
+  h->add_option("--seed", io.seed, "Seed of the clip split (default 1)");
+  h->add_flag("--no-tighten", s.no_tighten, "Keep the loose boxes as labelled");
+  h->add_option("--clips", io.clips, "Only these clips (comma-separated names)")->delimiter(',');
+  h->add_option("--exclude", io.exclude, "Leave out these clips (default V_DRONE_005,V_DRONE_099)")->delimiter(',');
+  h->add_option("--jpeg-quality", io.jpeg_quality, "Quality of the written frames (default 95)");
+}
+
+TrainingVerbs::~TrainingVerbs() = default;
+
+int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  State& s = *s_;
+  if (*s.val) {
+    try {
+      const training::DetectionMetrics m = training::run_val(
+          s.val_options,
+          [&](size_t done, size_t total) {
+            if (done % 100 == 0 || done == total) err << fmt::format("wingman val: {}/{} images\n", done, total);
+          },
+          [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
+      out << (s.val_json ? m.json() + "\n" : m.report()) << std::flush;
+      return 0;
+    } catch (const std::invalid_argument& e) {
+      err << "wingman val: error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      err << "wingman val: error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  if (*s.halmstad) {
+    s.import.tighten = !s.no_tighten;
+    s.import.negatives = !s.no_negatives;
+    try {
+      const training::HalmstadImportSummary summary = training::import_halmstad(
+          s.import, [&](const std::string& line) { err << "wingman import-halmstad: " << line << "\n"; });
+      out << summary.report() << "wrote " << s.import.out_dir << "/data.yaml\n" << std::flush;
+      return 0;
+    } catch (const std::invalid_argument& e) {
+      err << "wingman import-halmstad: error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      err << "wingman import-halmstad: error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  if (*s.train) {
+#ifndef WINGMAN_WITH_TRAINING
+    err << "wingman train: error: this build has no trainer: install libtorch-dev (Debian) and configure with "
+           "-DWINGMAN_WITH_TRAINING=ON\n";
+    return 1;
+#else
+    training::TrainOptions o;
+    try {
+      o = training::train_options_from_model(detector::parse_darknet_cfg(s.cfg), s.cfg);
+      const std::string note = training::multi_scale_note(detector::parse_darknet_cfg(s.cfg));
+      if (!note.empty()) err << "wingman train: note: " << note << "\n";
+    } catch (const std::exception& e) {
+      err << "wingman train: error: " << e.what() << "\n";
+      return 1;
+    }
+    o.data = s.data;
+    o.out_dir = s.out_dir;
+    o.init_weights = s.init_weights;
+    o.resume = s.resume;
+    o.train_split = s.train_split;
+    o.val_split = s.val_split;
+    o.val_max_images = s.val_max_images;
+    o.seed = s.seed;
+    o.threads = s.threads;
+    o.checkpoint_interval = s.checkpoint_interval;
+    o.weights_interval = s.weights_interval;
+    o.log_interval = s.log_interval;
+    for (auto& [option, apply] : s.overrides)
+      if (option->count() > 0) apply(o);
+    restart_with_thread_settings(err);
+    try {
+      training::Trainer trainer(o);
+      err << fmt::format(
+          "wingman train: {} training images, batch {} in {} subdivisions, {} iterations from {}; "
+          "Ctrl-C writes a checkpoint and stops\n",
+          trainer.train_images(), o.batch, o.subdivisions, o.max_batches, trainer.iteration());
+      const std::string log_path = (std::filesystem::path(o.out_dir) / "progress.csv").string();
+      const bool fresh = !std::filesystem::exists(log_path);
+      std::ofstream log(log_path, std::ios::app);
+      if (fresh) log << "iteration,loss,loss_avg,coord,object,noobject,cls,mean_iou,learning_rate,images_per_s\n";
+      g_stop = false;
+      std::signal(SIGINT, on_interrupt);
+      std::signal(SIGTERM, on_interrupt);
+      const training::TrainSummary summary = trainer.run(
+          [&](const training::TrainProgress& p) {
+            err << "wingman train: " << p.one_line() << "\n" << std::flush;
+            log << fmt::format("{},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.4f},{:.6g},{:.3f}\n", p.iteration,
+                               p.loss, p.loss_avg, p.coord, p.object, p.noobject, p.cls, p.mean_iou, p.learning_rate,
+                               p.images_per_s)
+                << std::flush;
+          },
+          &g_stop);
+      std::signal(SIGINT, SIG_DFL);
+      std::signal(SIGTERM, SIG_DFL);
+      out << summary.report() << std::flush;
+      return summary.interrupted ? 130 : 0;
+    } catch (const std::invalid_argument& e) {
+      err << "wingman train: error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      err << "wingman train: error: " << e.what() << "\n";
+      return 1;
+    }
+#endif
+  }
+  return -1;
+}
+
+}  // namespace wingman::tools

@@ -1,0 +1,268 @@
+// SPDX-License-Identifier: MIT
+// Matching predictions to truths, precision / recall / AP / PR curve, size bins, reports.
+#include "wingman/training/detection_metrics.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+namespace wingman::training {
+
+const char* criterion_name(MatchCriterion c) { return c == MatchCriterion::kIou ? "iou" : "centre"; }
+
+std::vector<std::string> MetricsOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(iou_thresh > 0.0 && iou_thresh <= 1.0))
+    p.push_back(fmt::format("iou_thresh = {}: must be in (0, 1]", iou_thresh));
+  if (!(conf_thresh >= 0.0 && conf_thresh <= 1.0))
+    p.push_back(fmt::format("conf_thresh = {}: must be in 0..1", conf_thresh));
+  for (size_t i = 0; i < size_edges_px.size(); ++i)
+    if (!(size_edges_px[i] > 0.0) || (i > 0 && !(size_edges_px[i] > size_edges_px[i - 1])))
+      p.push_back(fmt::format("size_edges_px[{}] = {}: edges must be positive and increasing", i, size_edges_px[i]));
+  if (pr_points < 2) p.push_back(fmt::format("pr_points = {}: must be >= 2", pr_points));
+  return p;
+}
+
+namespace {
+
+/// A prediction after matching.
+struct Record {
+  double confidence;
+  bool tp;
+  double iou;  // with the matched truth (0 if none)
+  int bin;     // the matched truth's bin, or the prediction's own
+};
+
+bool centre_inside(const detector::Box& p, const detector::Box& t) {
+  return p.cx >= t.cx - 0.5f * t.w && p.cx <= t.cx + 0.5f * t.w && p.cy >= t.cy - 0.5f * t.h &&
+         p.cy <= t.cy + 0.5f * t.h;
+}
+
+int size_bin(const detector::Box& b, const std::vector<double>& edges) {
+  const double s = std::sqrt(std::max(0.0, static_cast<double>(b.w) * b.h));
+  int bin = 0;
+  while (bin < static_cast<int>(edges.size()) && s >= edges[static_cast<size_t>(bin)]) ++bin;
+  return bin;
+}
+
+/// Matches every image's predictions; returns records in image order, each image's in decreasing confidence.
+std::vector<Record> match_all(const std::vector<ImageDetections>& images, MatchCriterion criterion,
+                              const MetricsOptions& o) {
+  std::vector<Record> out;
+  for (const ImageDetections& img : images) {
+    std::vector<size_t> order(img.predictions.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return img.predictions[a].confidence > img.predictions[b].confidence; });
+    std::vector<bool> taken(img.truths.size(), false);
+    for (size_t pi : order) {
+      const detector::Box& p = img.predictions[pi];
+      int best = -1;
+      double best_score = 0.0;
+      for (size_t ti = 0; ti < img.truths.size(); ++ti) {
+        if (taken[ti]) continue;
+        const detector::Box& t = img.truths[ti];
+        double score;
+        if (criterion == MatchCriterion::kIou) {
+          score = detector::iou(p, t);
+          if (score < o.iou_thresh) continue;
+        } else {
+          if (!centre_inside(p, t)) continue;
+          score = -std::hypot(static_cast<double>(p.cx - t.cx), static_cast<double>(p.cy - t.cy));
+        }
+        if (best < 0 || score > best_score) best = static_cast<int>(ti), best_score = score;
+      }
+      Record r{p.confidence, best >= 0, 0.0, size_bin(p, o.size_edges_px)};
+      if (best >= 0) {
+        taken[static_cast<size_t>(best)] = true;
+        r.iou = detector::iou(p, img.truths[static_cast<size_t>(best)]);
+        r.bin = size_bin(img.truths[static_cast<size_t>(best)], o.size_edges_px);
+      }
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
+/// Stats and PR curve over `records` (the ones of one bin, or all) against `truths` truth boxes.
+MatchStats stats_of(std::vector<Record> records, int64_t truths, const MetricsOptions& o, std::vector<PrPoint>* curve) {
+  MatchStats s;
+  s.truths = truths;
+  double iou_sum = 0.0;
+  for (const Record& r : records) {
+    if (r.confidence < o.conf_thresh) continue;
+    ++s.detections;
+    if (r.tp) {
+      ++s.true_positives;
+      iou_sum += r.iou;
+    } else {
+      ++s.false_positives;
+    }
+  }
+  s.precision = s.detections > 0 ? static_cast<double>(s.true_positives) / s.detections : 0.0;
+  s.recall = truths > 0 ? static_cast<double>(s.true_positives) / truths : 0.0;
+  s.f1 = s.precision + s.recall > 0 ? 2 * s.precision * s.recall / (s.precision + s.recall) : 0.0;
+  s.mean_iou = s.true_positives > 0 ? iou_sum / s.true_positives : 0.0;
+
+  std::stable_sort(records.begin(), records.end(),
+                   [](const Record& a, const Record& b) { return a.confidence > b.confidence; });
+  const size_t m = records.size();
+  std::vector<double> rec(m), prec(m);
+  int64_t tp = 0;
+  for (size_t i = 0; i < m; ++i) {
+    tp += records[i].tp ? 1 : 0;
+    rec[i] = truths > 0 ? static_cast<double>(tp) / truths : 0.0;
+    prec[i] = static_cast<double>(tp) / static_cast<double>(i + 1);
+  }
+  for (size_t i = m; i-- > 1;) prec[i - 1] = std::max(prec[i - 1], prec[i]);  // precision envelope
+  double prev = 0.0;
+  for (size_t i = 0; i < m; ++i) {
+    s.ap += (rec[i] - prev) * prec[i];
+    prev = rec[i];
+  }
+  if (curve) {
+    curve->clear();
+    for (int k = 0; k < o.pr_points; ++k) {
+      const double r = static_cast<double>(k) / (o.pr_points - 1);
+      PrPoint p;
+      p.recall = r;
+      const auto it = std::lower_bound(rec.begin(), rec.end(), r - 1e-12);  // rec is non-decreasing
+      if (truths > 0 && it != rec.end()) {
+        const size_t j = static_cast<size_t>(it - rec.begin());
+        p.precision = prec[j];
+        p.confidence = records[j].confidence;
+      }
+      curve->push_back(p);
+    }
+  }
+  return s;
+}
+
+std::string bin_name(double lo, double hi) {
+  if (lo <= 0.0) return fmt::format("<{}px", hi);
+  if (std::isinf(hi)) return fmt::format(">={}px", lo);
+  return fmt::format("{}-{}px", lo, hi);
+}
+
+CriterionMetrics evaluate(const std::vector<ImageDetections>& images, MatchCriterion criterion,
+                          const MetricsOptions& o) {
+  CriterionMetrics c;
+  c.criterion = criterion;
+  const std::vector<Record> records = match_all(images, criterion, o);
+  const int bins = static_cast<int>(o.size_edges_px.size()) + 1;
+  std::vector<int64_t> truths_per_bin(static_cast<size_t>(bins), 0);
+  int64_t truths = 0;
+  for (const ImageDetections& img : images)
+    for (const detector::Box& t : img.truths) {
+      ++truths;
+      ++truths_per_bin[static_cast<size_t>(size_bin(t, o.size_edges_px))];
+    }
+  c.all = stats_of(records, truths, o, &c.pr_curve);
+  for (int b = 0; b < bins; ++b) {
+    SizeBinStats bs;
+    bs.min_px = b == 0 ? 0.0 : o.size_edges_px[static_cast<size_t>(b - 1)];
+    bs.max_px = b == bins - 1 ? std::numeric_limits<double>::infinity() : o.size_edges_px[static_cast<size_t>(b)];
+    bs.name = bin_name(bs.min_px, bs.max_px);
+    std::vector<Record> in_bin;
+    for (const Record& r : records)
+      if (r.bin == b) in_bin.push_back(r);
+    bs.stats = stats_of(in_bin, truths_per_bin[static_cast<size_t>(b)], o, nullptr);
+    c.by_size.push_back(bs);
+  }
+  return c;
+}
+
+std::string stats_json(const MatchStats& s) {
+  return fmt::format(
+      "{{\"truths\": {}, \"detections\": {}, \"true_positives\": {}, \"false_positives\": {}, \"precision\": {:.6f}, "
+      "\"recall\": {:.6f}, \"f1\": {:.6f}, \"mean_iou\": {:.6f}, \"ap\": {:.6f}}}",
+      s.truths, s.detections, s.true_positives, s.false_positives, s.precision, s.recall, s.f1, s.mean_iou, s.ap);
+}
+
+std::string criterion_json(const CriterionMetrics& c) {
+  std::string bins;
+  for (size_t i = 0; i < c.by_size.size(); ++i) {
+    const SizeBinStats& b = c.by_size[i];
+    bins += fmt::format("{}{{\"name\": \"{}\", \"min_px\": {}, \"max_px\": {}, \"stats\": {}}}", i ? ", " : "", b.name,
+                        b.min_px, std::isinf(b.max_px) ? std::string("null") : fmt::format("{}", b.max_px),
+                        stats_json(b.stats));
+  }
+  std::string curve;
+  for (size_t i = 0; i < c.pr_curve.size(); ++i)
+    curve += fmt::format("{}[{:.4f}, {:.6f}, {:.6f}]", i ? ", " : "", c.pr_curve[i].recall, c.pr_curve[i].precision,
+                         c.pr_curve[i].confidence);
+  return fmt::format(
+      "{{\"criterion\": \"{}\", \"all\": {}, \"by_size\": [{}], \"pr_curve_columns\": [\"recall\", \"precision\", "
+      "\"confidence\"], \"pr_curve\": [{}]}}",
+      criterion_name(c.criterion), stats_json(c.all), bins, curve);
+}
+
+std::string report_rows(const CriterionMetrics& c) {
+  std::string s;
+  auto row = [&](const std::string& name, const MatchStats& m) {
+    s += fmt::format("  {:<9} {:>7} {:>7} {:>7} {:>7} {:>9.3f} {:>7.3f} {:>9.3f} {:>7.3f}\n", name, m.truths,
+                     m.detections, m.true_positives, m.false_positives, m.precision, m.recall, m.mean_iou, m.ap);
+  };
+  row("all", c.all);
+  for (const SizeBinStats& b : c.by_size) row(b.name, b.stats);
+  return s;
+}
+
+}  // namespace
+
+DetectionMetrics evaluate_detections(const std::vector<ImageDetections>& images, const MetricsOptions& options) {
+  const std::vector<std::string> problems = options.validate();
+  if (!problems.empty()) {
+    std::string msg = "evaluate_detections: invalid options:";
+    for (const auto& p : problems) msg += " " + p + ";";
+    throw std::invalid_argument(msg);
+  }
+  DetectionMetrics m;
+  m.options = options;
+  m.images = static_cast<int64_t>(images.size());
+  for (const ImageDetections& img : images) {
+    m.truths += static_cast<int64_t>(img.truths.size());
+    m.predictions += static_cast<int64_t>(img.predictions.size());
+    m.negative_images += img.truths.empty() ? 1 : 0;
+  }
+  m.iou = evaluate(images, MatchCriterion::kIou, options);
+  m.centre = evaluate(images, MatchCriterion::kCentreInBox, options);
+  return m;
+}
+
+std::string DetectionMetrics::one_line() const {
+  return fmt::format(
+      "{} images, {} truths: IoU>={}: AP {:.3f}, recall {:.3f}, precision {:.3f}, mean IoU {:.3f} @conf {}; "
+      "centre-in-box: AP {:.3f}, recall {:.3f}, precision {:.3f}",
+      images, truths, options.iou_thresh, iou.all.ap, iou.all.recall, iou.all.precision, iou.all.mean_iou,
+      options.conf_thresh, centre.all.ap, centre.all.recall, centre.all.precision);
+}
+
+std::string DetectionMetrics::report() const {
+  std::string s = fmt::format("{} images ({} without a drone), {} truth boxes, {} predictions\n", images,
+                              negative_images, truths, predictions);
+  const std::string header = fmt::format("  {:<9} {:>7} {:>7} {:>7} {:>7} {:>9} {:>7} {:>9} {:>7}\n", "size", "truths",
+                                         "dets", "TP", "FP", "precision", "recall", "mean IoU", "AP");
+  s += fmt::format("match IoU >= {} (counts at confidence >= {}; AP over all confidences):\n", options.iou_thresh,
+                   options.conf_thresh);
+  s += header + report_rows(iou);
+  s += "match centre in truth box:\n" + header + report_rows(centre);
+  return s;
+}
+
+std::string DetectionMetrics::json() const {
+  std::string edges;
+  for (size_t i = 0; i < options.size_edges_px.size(); ++i)
+    edges += fmt::format("{}{}", i ? ", " : "", options.size_edges_px[i]);
+  return fmt::format(
+      "{{\"images\": {}, \"negative_images\": {}, \"truths\": {}, \"predictions\": {}, \"iou_thresh\": {}, "
+      "\"conf_thresh\": {}, \"size_edges_px\": [{}], \"iou\": {}, \"centre\": {}}}",
+      images, negative_images, truths, predictions, options.iou_thresh, options.conf_thresh, edges, criterion_json(iou),
+      criterion_json(centre));
+}
+
+}  // namespace wingman::training
