@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy (lcm-spy with our types), localize (one box
-// to 3D), predict (detector on images), bench detector (detector timings), train / val / import-halmstad (training).
+// `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy, loginfo, make-video, localize, predict,
+// bench detector, eval (flight errors against ground truth), dataset synth, train / val / import-halmstad (training).
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
 #include "wingman/tools/localize.hpp"
