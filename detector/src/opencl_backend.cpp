@@ -50,11 +50,11 @@ std::string layer_name(const Layer& l, size_t index) {
   return s.str();
 }
 
-/// Tile width for an output width `w`, with `kbw` output blocks per work-item (and even for a fused
-/// pooling): of 8..13 (KBW x TW <= 26 accumulators: wider tiles spill registers, docs/pocl-performance.md)
-/// the one with the most useful FMAs per load, TW KBW / (TW + KBW) (broadcast inputs plus weight vectors),
-/// times the share of computed columns that are real, w / (tiles x TW). 416-input widths give 13 (12 when
-/// even).
+/// Tile width for an output width `w`, with `kbw` output blocks per work-item (even for a fused pooling):
+/// of 8..13 (KBW x TW <= 26 accumulators; wider tiles spill registers, docs/pocl-performance.md) the one
+/// with the highest (FMAs per load: TW KBW / (TW + KBW), broadcast inputs plus weight vectors) x (share of
+/// computed columns that are real: w / (tiles x TW)); ties go to the wider tile. A model, not a
+/// measurement: e.g. 13 for 13, 26, 52, ..., 416; 12 for an even 416 or 208; 10 for an even 26.
 int tile_width(int w, int kbw, bool even) {
   int best = 8;
   double best_score = -1;
@@ -138,9 +138,10 @@ std::vector<float> pack_winograd(const Layer& l, const std::vector<float>& folde
   return packed;
 }
 
-/// Whether convolution `l` runs as Winograd F(2x2, 3x3): 3x3, stride 1, padding 1, a blocked input of at
-/// least kWinogradMinChannels channels (below that the transforms cost more than the 2.25x fewer
-/// multiplications save; measured, docs/benchmarks.md), no fused pooling.
+/// Whether convolution `l` runs as Winograd F(2x2, 3x3): 3x3, stride 1, padding 1, a blocked input, no
+/// fused pooling, and at least kWinogradMinChannels input channels. 256 is the smallest depth measured
+/// (the thesis network's layer 10, 256 -> 512 at 13 x 13: faster as Winograd, transforms included;
+/// docs/benchmarks.md); shallower 3x3 layers of that network are pooling-fused and were not compared.
 constexpr int kWinogradMinChannels = 256;
 bool use_winograd(const Layer& l, bool planar_input, bool pooled) {
   return l.size == 3 && l.stride == 1 && l.padding == 1 && !planar_input && !pooled &&
@@ -658,6 +659,17 @@ void OpenClBackend::set_profiling(bool on) {
     m.start_profiling();
   else
     m.events.clear();
+}
+
+std::vector<std::string> OpenClBackend::commands() const {
+  const Impl& m = *impl_;
+  std::vector<std::string> c;
+  c.push_back(m.planar_input ? "input: host to device (planar, bordered)" : "input: host to device (staging)");
+  if (!m.planar_input) c.push_back("input: pack_nchw_to_blocked");
+  for (const Step& s : m.steps) c.push_back(s.what);
+  for (size_t i = 0; i < m.unpacks.size(); ++i) c.push_back("output " + std::to_string(i) + ": unpack_blocked_to_nchw");
+  c.push_back("output: device to host");
+  return c;
 }
 
 std::vector<KernelTiming> OpenClBackend::profile() const {

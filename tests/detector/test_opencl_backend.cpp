@@ -299,6 +299,31 @@ TEST(OpenClConvolution, MatchesReferenceAndOpenCvOnOddShapes) {
   }
 }
 
+TEST(OpenClConvolution, WinogradLayersMatchReferenceAndOpenCvOnOddShapes) {
+  REQUIRE_OPENCL();
+  // 3x3 stride-1 convolutions on many input channels run as Winograd F(2x2, 3x3) (asserted below, so these
+  // cases keep covering it): odd sizes give partial 2x2 tiles on the right and bottom.
+  const ConvCase cases[] = {
+      {256, 11, 9, 40, 3, 1, true, "leaky"},      // 6 x 5 tiles, 3 output blocks (second pair half empty)
+      {300, 7, 13, 17, 3, 1, false, "logistic"},  // last input block partly filled, 2 output blocks
+      {272, 2, 3, 16, 3, 1, true, "linear"},      // one output block, 2 x 3 image
+      {256, 1, 1, 5, 3, 1, true, "leaky"},        // a single pixel: one tile, three quarters outside
+  };
+  for (const auto& k : cases) {
+    std::ostringstream d;
+    d << "conv " << k.c << "x" << k.h << "x" << k.w << " -> " << k.filters << (k.bn ? " bn " : " ") << k.activation;
+    const std::string cfg = net_section(k.c, k.h, k.w) + conv_section(k.filters, k.size, k.stride, k.bn, k.activation);
+    DarknetModel model = parse_darknet_cfg_string(cfg, d.str());
+    randomize_weights(model, 3);
+    const std::vector<std::string> commands = OpenClBackend(model, options_for_batch(1)).commands();
+    EXPECT_TRUE(std::any_of(commands.begin(), commands.end(),
+                            [](const std::string& c) { return c.find("winograd: 16 products") != std::string::npos; }))
+        << d.str() << " does not run as Winograd";
+    check_network(cfg, d.str(), 1);
+    check_network(cfg, d.str(), 3);
+  }
+}
+
 TEST(OpenClMaxpool, MatchesReferenceAndOpenCvOnOddShapes) {
   REQUIRE_OPENCL();
   const int cases[][5] = {

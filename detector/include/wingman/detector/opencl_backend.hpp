@@ -24,8 +24,9 @@ struct KernelTiming {
 };
 
 /// Runs a DarknetModel ([convolutional] with batch normalisation folded in and bias + activation fused,
-/// [maxpool], [route], [upsample]; [region]/[yolo] heads pass their input through, decoding stays on the
-/// host) on one OpenCL 1.2 device.
+/// a following 2x2 stride-2 [maxpool] fused in, 3x3 stride-1 layers on many channels as Winograd
+/// F(2x2, 3x3); [maxpool], [route], [upsample]; [region]/[yolo] heads pass their input through, decoding
+/// stays on the host) on one OpenCL 1.2 device. docs/detector.md describes the kernels.
 ///
 /// Everything is prepared in the constructor: device selection, program builds (PoCL caches binaries
 /// under POCL_CACHE_DIR), weight folding and packing, every buffer for `max_batch` images and every
@@ -53,9 +54,13 @@ class OpenClBackend : public InferenceBackend {
   /// True when the selected device is a GPU (CL_DEVICE_TYPE_GPU).
   bool is_gpu() const;
 
+  /// What forward() enqueues, in order, one line per command: "input: ...", "layer 12 [convolutional] (cfg
+  /// line 114) winograd: 16 products ...", "output 0: ..." (the names profile() uses).
+  std::vector<std::string> commands() const;
+
   /// Starts (clearing what was recorded) or stops recording the device time of every command of forward().
-  /// Profiling makes forward() wait on OpenCL events it would not otherwise create; leave it off in
-  /// production. Throws std::runtime_error on an OpenCL error.
+  /// Profiling gives every command an OpenCL event and reads its timestamps after each forward; leave it
+  /// off in production. Throws std::runtime_error on an OpenCL error.
   void set_profiling(bool on);
   /// The commands of forward() in launch order, each with its time in every forward since
   /// set_profiling(true); empty when profiling never ran.
