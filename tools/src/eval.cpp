@@ -2,6 +2,8 @@
 // `wingman eval`: matches localized targets to simulator ground truth by utime and measures the errors.
 #include "wingman/tools/eval.hpp"
 
+#include "lcm_fingerprint.hpp"
+
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/ground_truth_t.hpp>
@@ -21,18 +23,10 @@
 namespace wingman::tools {
 namespace {
 
-uint64_t fingerprint(const void* data, int size) {
-  if (size < 8) return 0;
-  const auto* p = static_cast<const uint8_t*>(data);
-  uint64_t h = 0;
-  for (int i = 0; i < 8; ++i) h = (h << 8) | p[i];
-  return h;
-}
-
 /// Decodes and validates `ev` as Msg; false (counted by the caller) when it is not one or is malformed.
 template <class Msg>
 bool decode(const lcm::LogEvent& ev, Msg* m) {
-  if (fingerprint(ev.data, ev.datalen) != static_cast<uint64_t>(Msg::getHash())) return false;
+  if (lcm_fingerprint(ev.data, ev.datalen) != static_cast<uint64_t>(Msg::getHash())) return false;
   if (m->decode(ev.data, 0, ev.datalen) < 0) return false;
   return common::validate_message(*m).empty();
 }

@@ -2,6 +2,8 @@
 // Summary of an LCM log: channels, types (by fingerprint), counts, utime spans, statuses, a snapshot.
 #include "wingman/tools/log_info.hpp"
 
+#include "lcm_fingerprint.hpp"
+
 #include <wingman/common/message_validation.hpp>
 
 #include <fmt/format.h>
@@ -14,14 +16,6 @@
 
 namespace wingman::tools {
 namespace {
-
-uint64_t fingerprint(const void* data, int size) {
-  if (size < 8) return 0;
-  const auto* p = static_cast<const uint8_t*>(data);
-  uint64_t h = 0;
-  for (int i = 0; i < 8; ++i) h = (h << 8) | p[i];
-  return h;
-}
 
 /// Decodes and validates one message of a known type; returns its utime or -1.
 using Decoder = std::function<int64_t(const void*, int, std::string*)>;
@@ -85,7 +79,7 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
     ChannelSummary& c = summary.channels[it->second];
     ++c.count;
     c.bytes += ev->datalen;
-    const uint64_t fp = fingerprint(ev->data, ev->datalen);
+    const uint64_t fp = lcm_fingerprint(ev->data, ev->datalen);
     const auto t = types.find(fp);
     if (t == types.end()) continue;
     c.type = t->second.first;
