@@ -347,6 +347,32 @@ TEST(OpenClMaxpool, MatchesReferenceAndOpenCvOnOddShapes) {
                 "maxpool 2/2 first on 5x13x11, then conv ->7", 2);
 }
 
+TEST(OpenClMaxpool, FusedIntoTheConvolutionOnOddShapes) {
+  REQUIRE_OPENCL();
+  // 2x2 stride-2 pooling after a convolution whose width an even tile covers with little waste is fused
+  // (asserted, so these cases keep covering it); odd sizes leave a last pooled row and column of one.
+  const int cases[][4] = {
+      // input channels, h, w, filters
+      {3, 13, 23, 5},   // planar input, one output block, 12 x 7 pooled
+      {20, 9, 47, 19},  // two output blocks (the second partly filled), 24 x 5 pooled
+      {16, 7, 24, 40},  // three output blocks (second pair half empty), even width
+  };
+  for (const auto& k : cases) {
+    std::ostringstream d;
+    d << "conv " << k[0] << "x" << k[1] << "x" << k[2] << " -> " << k[3] << " leaky, maxpool 2/2 fused";
+    const std::string cfg =
+        net_section(k[0], k[1], k[2]) + conv_section(k[3], 3, 1, true, "leaky") + maxpool_section(2, 2);
+    DarknetModel model = parse_darknet_cfg_string(cfg, d.str());
+    randomize_weights(model, 4);
+    const std::vector<std::string> commands = OpenClBackend(model, options_for_batch(1)).commands();
+    EXPECT_TRUE(std::any_of(commands.begin(), commands.end(),
+                            [](const std::string& c) { return c.find("fused") != std::string::npos; }))
+        << d.str() << " is not fused";
+    check_network(cfg, d.str(), 1);
+    check_network(cfg, d.str(), 3);
+  }
+}
+
 TEST(OpenClRoute, ConcatenatesChannelsAtUnalignedOffsets) {
   REQUIRE_OPENCL();
   // Every layer feeds the next (OpenCV DNN wants a single unconnected output).
