@@ -122,7 +122,7 @@ trap - EXIT
 # Formation target of this flight, from the follower's effective config.
 follower_cfg=$("$bin/wingman-follower-ctrl" $(flight_cfg follower_ctrl) --print-config)
 mode=$(echo "$follower_cfg" | awk '/^controller:/{c=1} c && /mode:/{gsub(/"/,"",$2); print $2; exit}')
-eval_args=("$log" --report "$out/report.html" --json "$out/eval.json" --title "Wingman flight: $name")
+eval_args=("$log" --report "$out/report.html" --json "$out/eval.json" --csv "$out/targets.csv" --title "Wingman flight: $name")
 if [ "$mode" = formation ]; then
   offset=$(echo "$follower_cfg" | awk '/^formation:/{f=1} f && /offset_m:/{sub(/.*offset_m:/,""); gsub(/[][ ]/,""); print; exit}')
   eval_args+=(--formation-offset "$offset")

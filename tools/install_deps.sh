@@ -25,6 +25,8 @@ packages=(
   util-linux iproute2
   # lcm-spy screenshot check under a virtual X server
   xvfb xauth x11-apps netpbm
+  # `wingman report` opened in a headless browser (tests/tools/report_chromium_test.sh)
+  chromium
 )
 
 missing=()

@@ -1,14 +1,18 @@
 // SPDX-License-Identifier: MIT
-// Tests of `wingman eval`: errors against hand-computed values from a synthetic log, false targets, formation error.
+// Tests of `wingman eval` and `wingman report`: every metric against hand-computed values from synthetic logs.
 #include "test_support.hpp"
 
 #include <wingman/tools/eval.hpp>
+#include <wingman/tools/report.hpp>
 
 #include <wingman/detections_t.hpp>
 #include <wingman/ground_truth_t.hpp>
+#include <wingman/image_t.hpp>
 #include <wingman/targets_t.hpp>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -145,6 +149,7 @@ TEST(Eval, FormationErrorIsFollowerMinusLeaderPlusOffsetAfterSettling) {
   EXPECT_NE(s.str().find("<svg id=\"topdown\""), std::string::npos);
   EXPECT_NE(s.str().find("<polyline"), std::string::npos);
   EXPECT_NE(s.str().find("Detections came from simulator ground truth"), std::string::npos);
+  EXPECT_NE(s.str().find("id=\"no-images\""), std::string::npos);  // the log has no IMAGE_CAM0
   std::ifstream js(o.json_path);
   std::stringstream j;
   j << js.rdbuf();
@@ -172,6 +177,358 @@ TEST(Eval, MissingLogOrTruthIsAClearError) {
   }
   o.settle_s = -1;
   EXPECT_THROW(evaluate_log(o), std::invalid_argument);
+}
+
+ground_truth_t truth_frame(int k, int64_t u, const std::vector<vehicle_truth_t>& vehicles) {
+  ground_truth_t g{};
+  g.utime = u;
+  g.image_seq = k;
+  g.vehicles = vehicles;
+  g.num_vehicles = static_cast<int32_t>(vehicles.size());
+  return g;
+}
+
+targets_t targets_msg(int64_t u, const std::vector<target_t>& targets) {
+  targets_t ts{};
+  ts.utime = u;
+  ts.targets = targets;
+  ts.num_targets = static_cast<int32_t>(targets.size());
+  return ts;
+}
+
+/// Follower fixed at (0, 0, 5); at frame k the leader is at (0, d_k, 5), d = 3, 7, 12, 25, 40 m, and its estimate is
+/// off by 0.1 (k + 1) m along x.
+std::string write_ranges(const testing::TempDir& dir) {
+  const double d[] = {3, 7, 12, 25, 40};
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 5; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event("GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, d[k], 5)}), u));
+    events.push_back(make_event("TARGETS", targets_msg(u, {world_target(7, 0.1 * (k + 1), d[k], 5, u)}), u));
+  }
+  const std::string path = dir.file("ranges.lcmlog");
+  testing::write_log(path, events);
+  return path;
+}
+
+TEST(Eval, LocalizationErrorIsBinnedByTrueRange) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_ranges(dir);
+  const EvalResult r = evaluate_log(o);
+  // Default bins 0-5, 5-10, 10-15, 15-20, 20-30, 30+: 3 m, 7 m, 12 m, none, 25 m, 40 m.
+  ASSERT_EQ(r.localization_by_range.size(), 6u);
+  const double expected[] = {0.1, 0.2, 0.3, 0.0, 0.4, 0.5};
+  for (size_t i = 0; i < 6; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(r.localization_by_range[i].error.n, i == 3 ? 0 : 1);
+    EXPECT_NEAR(r.localization_by_range[i].error.rms, expected[i], 1e-9);
+  }
+  EXPECT_EQ(r.localization_by_range[0].lo_m, 0.0);
+  EXPECT_EQ(r.localization_by_range[4].hi_m, 30.0);
+  EXPECT_TRUE(std::isinf(r.localization_by_range[5].hi_m));
+
+  o.range_bins_m = {10};  // [0, 10): 0.1, 0.2; [10, inf): 0.3, 0.4, 0.5
+  const EvalResult r2 = evaluate_log(o);
+  ASSERT_EQ(r2.localization_by_range.size(), 2u);
+  EXPECT_EQ(r2.localization_by_range[0].error.n, 2);
+  EXPECT_NEAR(r2.localization_by_range[0].error.rms, std::sqrt((0.01 + 0.04) / 2), 1e-9);
+  EXPECT_EQ(r2.localization_by_range[1].error.n, 3);
+  EXPECT_NEAR(r2.localization_by_range[1].error.mean, 0.4, 1e-9);
+  EXPECT_NE(r2.report().find("range 10+ m"), std::string::npos) << r2.report();
+  EXPECT_NE(r2.json().find("\"localization_by_range\": [{\"lo_m\": 0, \"hi_m\": 10, \"error\": {\"n\": 2"),
+            std::string::npos)
+      << r2.json();
+}
+
+TEST(Eval, RangeBinsMustIncrease) {
+  EvalOptions o;
+  o.log = "x.lcmlog";
+  o.range_bins_m = {5, 5};
+  ASSERT_EQ(o.validate().size(), 1u);
+  EXPECT_NE(o.validate()[0].find("--range-bins"), std::string::npos);
+  o.range_bins_m = {-1};
+  EXPECT_FALSE(o.validate().empty());
+  EvalOptions defaults;
+  defaults.log = "x.lcmlog";
+  EXPECT_TRUE(defaults.validate().empty()) << defaults.validate()[0];  // the defaults are valid
+}
+
+/// Leader fixed at (0, 10, 5), ten frames. Leader track ids by frame: 7 7 7 9 9 7 7 7 7 7 (two switches); frame 4
+/// also has track 12 on the leader, 1 m off (farther than 9, so not a switch). False targets: track 20 on frames 2
+/// and 3, track 21 on frame 6.
+std::string write_switches(const testing::TempDir& dir) {
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event("GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5)}), u));
+    std::vector<target_t> ts = {world_target(k == 3 || k == 4 ? 9 : 7, 0, 10, 5, u)};
+    if (k == 4) ts.push_back(world_target(12, 1, 10, 5, u));
+    if (k == 2 || k == 3) ts.push_back(world_target(20, 50, 50, 50, u));
+    if (k == 6) ts.push_back(world_target(21, -50, 50, 50, u));
+    events.push_back(make_event("TARGETS", targets_msg(u, ts), u));
+  }
+  const std::string path = dir.file("switches.lcmlog");
+  testing::write_log(path, events);
+  return path;
+}
+
+TEST(Eval, CountsLeaderIdSwitchesAndFalseTracks) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_switches(dir);
+  o.csv_path = dir.file("targets.csv");
+  const EvalResult r = evaluate_log(o);
+  EXPECT_EQ(r.leader_id_switches, 2);
+  EXPECT_EQ(r.track_ids_on_leader, 3);  // 7, 9, 12
+  EXPECT_EQ(r.false_targets, 3);
+  EXPECT_EQ(r.false_track_ids, 2);
+  EXPECT_NEAR(r.duration_s, 0.9, 1e-12);
+  EXPECT_NEAR(r.false_targets_per_s, 3 / 0.9, 1e-9);
+  EXPECT_NE(r.report().find("2 id switch(es)"), std::string::npos) << r.report();
+  // CSV: a header and one row per world target (10 + 1 + 3); a false target has no truth.
+  std::ifstream csv(o.csv_path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(csv, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 15u);
+  EXPECT_EQ(lines[0], "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m");
+  EXPECT_EQ(lines[1], "0.000000,7,1,10.0000,0.0000,10.0000,5.0000,0.0000,10.0000,5.0000,0.0000");
+  EXPECT_NE(std::find(lines.begin(), lines.end(), "0.200000,20,-1,1.0000,50.0000,50.0000,50.0000,,,,"), lines.end());
+}
+
+/// Ten frames; the logger saw ground truth k at W_k = 5e12 + k s and the targets from it (L_k = k + 1 ms) later. Frame
+/// 0 also has an image logged 2 ms before its ground truth: the image is the exposure, so L_0 = 3 ms. A last targets_t
+/// refers to an exposure that is not in the log (no sample). inference_latency_us = 2 (k + 1) ms.
+std::string write_latency(const testing::TempDir& dir) {
+  constexpr int64_t kW = 5000000000000;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t u = kT0 + k * 100000, w = kW + k * 1000000;
+    if (k == 0) {
+      image_t img{};
+      img.utime = u;
+      img.width = 4;
+      img.height = 2;
+      img.stride = 4;
+      img.pixel_format = image_t::GRAY8;
+      img.data.assign(8, 128);
+      img.size = 8;
+      events.push_back(make_event("IMAGE_CAM0", img, w - 2000));
+    }
+    events.push_back(make_event("GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5)}), w));
+    detections_t d{};
+    d.utime = u;
+    d.seq = k;
+    d.image_width = 640;
+    d.image_height = 480;
+    d.inference_latency_us = 2000 * (k + 1);
+    events.push_back(make_event("DETECTIONS_CAM0", d, w + 500));
+    events.push_back(make_event("TARGETS", targets_msg(u, {world_target(7, 0, 10, 5, u)}), w + 1000 * (k + 1)));
+  }
+  const int64_t u_missing = kT0 + 5 * 100000 + 1;
+  events.push_back(
+      make_event("TARGETS", targets_msg(u_missing, {world_target(7, 0, 10, 5, u_missing)}), kW + 20000000));
+  const std::string path = dir.file("latency.lcmlog");
+  testing::write_log(path, events);
+  return path;
+}
+
+TEST(Eval, LatencyPercentilesFromLogEventTimestamps) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_latency(dir);
+  const EvalResult r = evaluate_log(o);
+  // Samples {3, 2, 3, 4, ..., 10} ms; nearest rank: p50 = 5th = 5, p90 = 9th = 9, p99 = 10th = 10.
+  ASSERT_EQ(r.latency_ms.n, 10);
+  ASSERT_EQ(r.latency_samples_ms.size(), 10u);
+  EXPECT_NEAR(r.latency_samples_ms[0], 3.0, 1e-9);
+  EXPECT_NEAR(r.latency_ms.p50, 5.0, 1e-9);
+  EXPECT_NEAR(r.latency_ms.p90, 9.0, 1e-9);
+  EXPECT_NEAR(r.latency_ms.p99, 10.0, 1e-9);
+  EXPECT_NEAR(r.latency_ms.max, 10.0, 1e-9);
+  // Inference 2, 4, ..., 20 ms: p50 = 10, p90 = 18, p99 = 20.
+  EXPECT_EQ(r.inference_latency_ms.n, 10);
+  EXPECT_NEAR(r.inference_latency_ms.p50, 10.0, 1e-9);
+  EXPECT_NEAR(r.inference_latency_ms.p90, 18.0, 1e-9);
+  EXPECT_NEAR(r.inference_latency_ms.p99, 20.0, 1e-9);
+  EXPECT_EQ(r.image_utimes, std::vector<int64_t>{kT0});
+  EXPECT_NE(r.json().find("\"latency\": {\"n\": 10, \"p50_ms\": 5.000"), std::string::npos) << r.json();
+}
+
+detection_t box(float cx, float cy, float w, bool zoom) {
+  detection_t d{};
+  d.cx = cx;
+  d.cy = cy;
+  d.w = d.h = w;
+  d.confidence = 0.9f;
+  d.zoom_refined = zoom;
+  return d;
+}
+
+/// Leader truth box centred at (100, 100), 20 x 20 px, range 8 m (frames 0, 1) and 25 m (frames 2, 3), 640 px wide
+/// images. Detections (w in px): frame 0: single 26 (error 6) and one far outside the box; frame 1: single 18 at
+/// cx 105 (2), zoom 21 (1); frame 2: zoom 19.5 (0.5) and a single centred outside the box; frame 3: singles 30 at
+/// cx 104 and 22 at cx 101 (the nearer: 2).
+std::string write_box_widths(const testing::TempDir& dir) {
+  const std::vector<std::vector<detection_t>> dets = {
+      {box(100, 100, 26, false), box(300, 100, 5, false)},
+      {box(105, 100, 18, false), box(100, 101, 21, true)},
+      {box(100, 100, 19.5f, true), box(111, 100, 20, false)},
+      {box(104, 100, 30, false), box(101, 100, 22, false)},
+  };
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 4; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    ground_truth_t g = truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, k < 2 ? 8 : 25, 5)});
+    truth_box_t b{};
+    b.vehicle_id = 1;
+    b.cx = b.cy = 100;
+    b.w = b.h = 20;
+    b.visible = true;
+    b.range = k < 2 ? 8 : 25;
+    g.boxes = {b};
+    g.num_boxes = 1;
+    detections_t d{};
+    d.utime = u;
+    d.seq = k;
+    d.image_width = 640;
+    d.image_height = 480;
+    d.detections = dets[static_cast<size_t>(k)];
+    d.num_detections = static_cast<int32_t>(d.detections.size());
+    events.push_back(make_event("DETECTIONS_CAM0", d, u));  // before its ground truth: order must not matter
+    events.push_back(make_event("GROUND_TRUTH", g, u));
+  }
+  const std::string path = dir.file("widths.lcmlog");
+  testing::write_log(path, events);
+  return path;
+}
+
+TEST(Eval, BoxWidthErrorSingleAndZoomAgainstTruthBox) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_box_widths(dir);
+  const EvalResult r = evaluate_log(o);
+  // Single: 6, 2, 2 px of 640; zoom: 1, 0.5 px.
+  EXPECT_EQ(r.box_width_single.n, 3);
+  EXPECT_NEAR(r.box_width_single.mean, 10.0 / 3 / 640, 1e-9);
+  EXPECT_NEAR(r.box_width_single.max, 6.0 / 640, 1e-9);
+  EXPECT_EQ(r.box_width_zoom.n, 2);
+  EXPECT_NEAR(r.box_width_zoom.mean, 0.75 / 640, 1e-9);
+  // By truth range: 8 m is in 5-10, 25 m in 20-30.
+  EXPECT_EQ(r.box_width_single_by_range[1].error.n, 2);
+  EXPECT_NEAR(r.box_width_single_by_range[1].error.mean, 4.0 / 640, 1e-9);
+  EXPECT_EQ(r.box_width_single_by_range[4].error.n, 1);
+  EXPECT_NEAR(r.box_width_single_by_range[4].error.mean, 2.0 / 640, 1e-9);
+  EXPECT_NEAR(r.box_width_zoom_by_range[1].error.mean, 1.0 / 640, 1e-9);
+  EXPECT_NEAR(r.box_width_zoom_by_range[4].error.mean, 0.5 / 640, 1e-9);
+  ASSERT_EQ(r.box_widths.size(), 5u);
+  EXPECT_NEAR(r.box_widths[0].w_det_frac, 26.0 / 640, 1e-7);
+  EXPECT_NEAR(r.box_widths[0].w_truth_frac, 20.0 / 640, 1e-7);
+  EXPECT_NE(r.report().find("zoom-in"), std::string::npos);
+}
+
+/// An image_t of a 64 x 48 grey frame in `format`.
+image_t test_image(int64_t u, int8_t format) {
+  cv::Mat bgr(48, 64, CV_8UC3, cv::Scalar(90, 120, 150));
+  image_t img{};
+  img.utime = u;
+  img.width = 64;
+  img.height = 48;
+  img.pixel_format = format;
+  cv::Mat m;
+  if (format == image_t::BGR8) {
+    m = bgr;
+  } else if (format == image_t::GRAY8) {
+    cv::cvtColor(bgr, m, cv::COLOR_BGR2GRAY);
+  } else if (format == image_t::YUYV) {
+    m = cv::Mat(48, 64, CV_8UC2, cv::Scalar(128, 128));
+  }
+  if (format == image_t::MJPEG) {
+    cv::imencode(".jpg", bgr, img.data);
+    img.stride = 0;
+  } else {
+    img.stride = static_cast<int32_t>(m.step[0]);
+    img.data.assign(m.data, m.data + m.total() * m.elemSize());
+  }
+  img.size = static_cast<int32_t>(img.data.size());
+  return img;
+}
+
+TEST(Report, DrawsFramesOfEveryPixelFormatAndEveryChart) {
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  const int8_t formats[] = {image_t::BGR8, image_t::GRAY8, image_t::YUYV, image_t::MJPEG};
+  for (int k = 0; k < 8; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event("IMAGE_CAM0", test_image(u, formats[k % 4]), u));
+    ground_truth_t g = truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0.2 * k, 10, 5)});
+    truth_box_t b{};
+    b.vehicle_id = 1;
+    b.cx = 32;
+    b.cy = 24;
+    b.w = b.h = 10;
+    b.visible = true;
+    b.range = 10;
+    g.boxes = {b};
+    g.num_boxes = 1;
+    events.push_back(make_event("GROUND_TRUTH", g, u));
+    detections_t d{};
+    d.utime = u;
+    d.seq = k;
+    d.image_width = 64;
+    d.image_height = 48;
+    d.detections = {box(32, 24, 11, k % 2 == 1)};
+    d.num_detections = 1;
+    events.push_back(make_event("DETECTIONS_CAM0", d, u + 1000));
+    events.push_back(make_event("TARGETS", targets_msg(u, {world_target(7, 0.2 * k + 0.1, 10, 5, u)}), u + 2000));
+  }
+  const std::string log = dir.file("images.lcmlog");
+  testing::write_log(log, events);
+  EvalOptions o;
+  o.log = log;
+  o.report_frames = 4;
+  const EvalResult r = evaluate_log(o);
+  ASSERT_EQ(r.image_utimes.size(), 8u);
+  const auto frames = draw_report_frames(r, o);
+  ASSERT_EQ(frames.size(), 4u);  // images 0, 2, 5, 7 of 8: BGR8, YUYV, GRAY8, MJPEG
+  EXPECT_EQ(frames.front().utime, kT0);
+  EXPECT_EQ(frames.back().utime, kT0 + 7 * 100000);
+  for (const auto& f : frames) {
+    EXPECT_EQ(f.width, 64);
+    EXPECT_FALSE(f.jpeg_b64.empty());
+  }
+  const std::string html = html_report(r, o, frames);
+  size_t uris = 0;
+  for (size_t p = html.find("data:image/jpeg;base64,"); p != std::string::npos;
+       p = html.find("data:image/jpeg;base64,", p + 1))
+    ++uris;
+  EXPECT_EQ(uris, 4u);
+  for (const char* id : {"topdown", "errors", "error-by-range", "box-width", "latency"}) {
+    const size_t at = html.find(std::string("<svg id=\"") + id + "\"");
+    ASSERT_NE(at, std::string::npos) << id;
+    const size_t end = html.find("</svg>", at);
+    EXPECT_NE(html.substr(at, end - at).find("class=\"data\""), std::string::npos) << id << " has no data";
+  }
+  for (const char* remote : {"src=\"http", "href=\"http", "<link", "<script src", "url(http"}) {
+    EXPECT_EQ(html.find(remote), std::string::npos) << remote;  // nothing is fetched: the page opens offline
+  }
+  EXPECT_EQ(html.find("no-images"), std::string::npos);
+}
+
+TEST(Report, UnwritableOutputNamesTheFile) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_ranges(dir);
+  o.report_path = dir.file("no/such/dir/report.html");
+  try {
+    evaluate_log(o);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no/such/dir/report.html"), std::string::npos) << e.what();
+  }
+  o.report_path.clear();
+  o.log = dir.path();
+  EXPECT_THROW(evaluate_log(o), std::runtime_error);  // a directory
 }
 
 }  // namespace

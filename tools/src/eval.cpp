@@ -3,18 +3,25 @@
 #include "wingman/tools/eval.hpp"
 
 #include "lcm_fingerprint.hpp"
+#include "log_progress.hpp"
+#include "wingman/tools/report.hpp"
 
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/ground_truth_t.hpp>
+#include <wingman/image_t.hpp>
 #include <wingman/targets_t.hpp>
 
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -22,6 +29,9 @@
 
 namespace wingman::tools {
 namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Decodes and validates `ev` as Msg; false (counted by the caller) when it is not one or is malformed.
 template <class Msg>
@@ -73,10 +83,45 @@ struct Acc {
   }
 };
 
-std::string stats_line(const char* name, const ErrorStats& s) {
+/// Accumulators per range bin (upper edges `edges`; the last bin is open).
+struct BinnedAcc {
+  std::vector<double> edges;
+  std::vector<Acc> acc;
+  explicit BinnedAcc(std::vector<double> e) : edges(std::move(e)), acc(edges.size() + 1) {}
+  void add(double range, double e) {
+    const size_t i = static_cast<size_t>(std::upper_bound(edges.begin(), edges.end(), range) - edges.begin());
+    acc[i].add(e);
+  }
+  std::vector<RangeBin> bins() const {
+    std::vector<RangeBin> out;
+    for (size_t i = 0; i < acc.size(); ++i) {
+      out.push_back({i == 0 ? 0.0 : edges[i - 1], i < edges.size() ? edges[i] : kInf, acc[i].stats()});
+    }
+    return out;
+  }
+};
+
+/// Nearest-rank percentiles of `v` (sorted here).
+Percentiles percentiles(std::vector<double> v) {
+  Percentiles p;
+  p.n = static_cast<int64_t>(v.size());
+  if (v.empty()) return p;
+  std::sort(v.begin(), v.end());
+  const auto rank = [&](double q) {
+    const auto k = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size())));
+    return v[std::clamp<size_t>(k, 1, v.size()) - 1];
+  };
+  p.p50 = rank(0.50);
+  p.p90 = rank(0.90);
+  p.p99 = rank(0.99);
+  p.max = v.back();
+  return p;
+}
+
+std::string stats_line(const std::string& name, const ErrorStats& s, const char* unit = "m", double scale = 1.0) {
   if (s.n == 0) return fmt::format("  {:<34} no samples\n", name);
-  return fmt::format("  {:<34} RMS {:7.3f} m   mean {:7.3f} m   max {:7.3f} m   (n = {})\n", name, s.rms, s.mean, s.max,
-                     s.n);
+  return fmt::format("  {:<34} RMS {:7.3f} {u}   mean {:7.3f} {u}   max {:7.3f} {u}   (n = {})\n", name, s.rms * scale,
+                     s.mean * scale, s.max * scale, s.n, fmt::arg("u", unit));
 }
 
 std::string stats_json(const ErrorStats& s) {
@@ -84,27 +129,27 @@ std::string stats_json(const ErrorStats& s) {
                      s.max);
 }
 
-std::string escape_html(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
+std::string fraction_json(const ErrorStats& s) {
+  return fmt::format("{{\"n\": {}, \"rms\": {:.6f}, \"mean\": {:.6f}, \"max\": {:.6f}}}", s.n, s.rms, s.mean, s.max);
+}
+
+std::string percentiles_json(const Percentiles& p) {
+  return fmt::format("{{\"n\": {}, \"p50_ms\": {:.3f}, \"p90_ms\": {:.3f}, \"p99_ms\": {:.3f}, \"max_ms\": {:.3f}}}",
+                     p.n, p.p50, p.p90, p.p99, p.max);
+}
+
+std::string bin_name(const RangeBin& b) {
+  return std::isinf(b.hi_m) ? fmt::format("{:g}+ m", b.lo_m) : fmt::format("{:g}-{:g} m", b.lo_m, b.hi_m);
+}
+
+std::string bins_json(const std::vector<RangeBin>& bins, bool fraction) {
+  std::string s = "[";
+  for (const auto& b : bins) {
+    s += fmt::format("{}{{\"lo_m\": {:g}, \"hi_m\": {}, \"error\": {}}}", s.size() > 1 ? ", " : "", b.lo_m,
+                     std::isinf(b.hi_m) ? std::string("null") : fmt::format("{:g}", b.hi_m),
+                     fraction ? fraction_json(b.error) : stats_json(b.error));
   }
-  return o;
+  return s + "]";
 }
 
 }  // namespace
@@ -118,6 +163,15 @@ std::vector<std::string> EvalOptions::validate() const {
   if (!(match_radius_m > 0.0)) p.push_back(fmt::format("--match-radius: {} must be > 0 metres", match_radius_m));
   if (follower_id == leader_id) p.push_back(fmt::format("--leader-id: {} must differ from --follower-id", leader_id));
   if (!formation_offset_in_world.allFinite()) p.push_back("--formation-offset: must be three finite numbers");
+  for (size_t i = 0; i < range_bins_m.size(); ++i) {
+    const double e = range_bins_m[i];
+    if (!std::isfinite(e) || e <= 0.0 || (i > 0 && e <= range_bins_m[i - 1])) {
+      p.push_back(
+          fmt::format("--range-bins: {} (entry {}) must be finite, > 0 and greater than the one before it", e, i + 1));
+      break;
+    }
+  }
+  if (report_frames < 0) p.push_back(fmt::format("--frames: {} must be >= 0", report_frames));
   return p;
 }
 
@@ -127,20 +181,41 @@ EvalResult evaluate_log(const EvalOptions& o) {
     for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
     throw std::invalid_argument("wingman eval: " + all);
   }
+  if (std::filesystem::is_directory(o.log))
+    throw std::runtime_error("wingman eval: the log '" + o.log + "' is a directory");
   std::ifstream probe(o.log, std::ios::binary);
   if (!probe) throw std::runtime_error("wingman eval: cannot read the log '" + o.log + "'");
   probe.close();
   lcm::LogFile file(o.log, "r");
   if (!file.good()) throw std::runtime_error("wingman eval: cannot open the LCM log '" + o.log + "'");
 
-  std::map<int, Track> truth;                                    // vehicle id -> positions
-  std::map<int64_t, bool> leader_visible;                        // truth utime -> leader box visible
-  std::map<int64_t, int> detections_at;                          // detections utime -> number of boxes
-  std::vector<std::pair<int64_t, wingman::target_t>> estimates;  // (predicted utime, target)
+  struct Estimate {
+    int64_t utime;   // predicted_utime
+    size_t message;  // index of its targets_t
+    wingman::target_t target;
+  };
+  struct Detections {
+    int64_t utime;
+    int camera_id;
+    int image_width;
+    std::vector<wingman::detection_t> boxes;
+  };
+  std::map<int, Track> truth;                                           // vehicle id -> positions
+  std::map<int64_t, bool> leader_visible;                               // truth utime -> leader box visible
+  std::map<int64_t, int> detections_at;                                 // detections utime -> number of boxes
+  std::map<int64_t, std::vector<wingman::truth_box_t>> truth_boxes_at;  // truth utime -> boxes
+  std::map<int64_t, int64_t> truth_event_at, image_event_at;            // utime -> first log-event timestamp, us
+  std::vector<Estimate> estimates;
+  std::vector<std::pair<int64_t, int64_t>> published;  // (targets_t event timestamp, newest source_utime)
+  std::vector<Detections> detections;
+  std::vector<double> inference_ms;
   std::set<int> sources;
+  size_t targets_messages = 0;
   EvalResult r;
 
+  LogProgress progress(o.progress, o.log, file.getFilePtr());
   while (const lcm::LogEvent* ev = file.readNextEvent()) {
+    progress.tick();
     if (ev->channel == o.truth_channel) {
       wingman::ground_truth_t g;
       if (!decode(*ev, &g)) continue;
@@ -154,19 +229,37 @@ EvalResult evaluate_log(const EvalOptions& o) {
       bool visible = false;
       for (const auto& b : g.boxes) visible = visible || (b.vehicle_id == o.leader_id && b.visible);
       leader_visible[g.utime] = visible;
+      truth_boxes_at[g.utime] = g.boxes;
+      truth_event_at.emplace(g.utime, ev->timestamp);
     } else if (ev->channel == o.targets_channel) {
       wingman::targets_t ts;
       if (!decode(*ev, &ts)) continue;
+      const size_t index = targets_messages++;
+      int64_t newest = INT64_MIN;
       for (const auto& t : ts.targets) {
-        if (t.world_valid) estimates.emplace_back(t.predicted_utime, t);
+        newest = std::max(newest, t.source_utime);
+        if (t.world_valid) estimates.push_back({t.predicted_utime, index, t});
       }
+      if (!ts.targets.empty()) published.emplace_back(ev->timestamp, newest);
     } else if (ev->channel == o.detections_channel) {
       wingman::detections_t d;
       if (!decode(*ev, &d)) continue;
       sources.insert(d.source);
       detections_at[d.utime] += d.num_detections;
+      inference_ms.push_back(d.inference_latency_us * 1e-3);
+      detections.push_back({d.utime, d.camera_id, d.image_width, d.detections});
+    } else if (ev->channel == o.image_channel &&
+               lcm_fingerprint(ev->data, ev->datalen) == static_cast<uint64_t>(wingman::image_t::getHash()) &&
+               ev->datalen >= 16) {
+      // Only the utime (right after the fingerprint, big-endian); the pixels are read by the report when needed.
+      const auto* p = static_cast<const uint8_t*>(ev->data) + 8;
+      uint64_t u = 0;
+      for (int i = 0; i < 8; ++i) u = (u << 8) | p[i];
+      r.image_utimes.push_back(static_cast<int64_t>(u));
+      image_event_at.emplace(static_cast<int64_t>(u), ev->timestamp);
     }
   }
+  progress.done();
   if (truth.empty()) {
     throw std::runtime_error("wingman eval: '" + o.log + "' holds no ground_truth_t on channel " + o.truth_channel);
   }
@@ -183,6 +276,7 @@ EvalResult evaluate_log(const EvalOptions& o) {
     t0 = std::min(t0, t.utime.front());
     t1 = std::max(t1, t.utime.back());
   }
+  r.first_truth_utime = t0;
   r.duration_s = static_cast<double>(t1 - t0) * 1e-6;
   const auto secs = [t0](int64_t u) { return static_cast<double>(u - t0) * 1e-6; };
 
@@ -196,9 +290,11 @@ EvalResult evaluate_log(const EvalOptions& o) {
   // Localization: each world target against the nearest truth vehicle (not the follower) at its time.
   Acc all, los_along, los_across;
   std::array<Acc, 3> axis;
-  std::set<int> leader_tracks;
+  BinnedAcc by_range(o.range_bins_m);
+  std::set<int> leader_tracks, false_tracks;
+  std::map<size_t, std::pair<double, int>> leader_in_message;  // targets_t index -> (distance, track id)
   const Track* follower = truth.count(o.follower_id) ? &truth.at(o.follower_id) : nullptr;
-  for (const auto& [u, t] : estimates) {
+  for (const auto& [u, message, t] : estimates) {
     const Eigen::Vector3d p_est(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);
     int best_id = -1;
     double best = o.match_radius_m;
@@ -214,16 +310,22 @@ EvalResult evaluate_log(const EvalOptions& o) {
         best_p = p;
       }
     }
+    Eigen::Vector3d p_f;
+    const bool have_follower = follower && follower->at(u, &p_f);
     if (best_id < 0) {
       ++r.false_targets;
+      false_tracks.insert(t.track_id);
+      r.targets.push_back({secs(u), t.track_id, -1, t.range, p_est, Eigen::Vector3d::Constant(kNaN), kNaN});
       continue;
     }
     ++r.target_estimates;
     const Eigen::Vector3d e = p_est - best_p;
     all.add(e.norm());
     for (int k = 0; k < 3; ++k) axis[k].add(e[k]);
-    Eigen::Vector3d p_f;
-    if (follower && follower->at(u, &p_f) && (best_p - p_f).norm() > 1e-6) {
+    const double range = have_follower ? (best_p - p_f).norm() : t.range;
+    by_range.add(range, e.norm());
+    r.targets.push_back({secs(u), t.track_id, best_id, range, p_est, best_p, e.norm()});
+    if (have_follower && (best_p - p_f).norm() > 1e-6) {
       const Eigen::Vector3d los = (best_p - p_f).normalized();
       const double along = e.dot(los);
       los_along.add(along);
@@ -233,13 +335,76 @@ EvalResult evaluate_log(const EvalOptions& o) {
       leader_tracks.insert(t.track_id);
       r.leader_estimate.push_back({secs(u), p_est});
       r.localization_error_over_time.emplace_back(secs(u), e.norm());
+      auto [it, fresh] = leader_in_message.emplace(message, std::make_pair(best, t.track_id));
+      if (!fresh && best < it->second.first) it->second = {best, t.track_id};
+      r.frames[t.source_utime].leader_track_id = t.track_id;
     }
   }
   r.localization = all.stats();
   for (int k = 0; k < 3; ++k) r.localization_axis[k] = axis[k].stats();
   r.along_line_of_sight = los_along.stats();
   r.across_line_of_sight = los_across.stats();
+  r.localization_by_range = by_range.bins();
   r.track_ids_on_leader = static_cast<int64_t>(leader_tracks.size());
+  r.false_track_ids = static_cast<int64_t>(false_tracks.size());
+  r.false_targets_per_s = r.duration_s > 0.0 ? static_cast<double>(r.false_targets) / r.duration_s : 0.0;
+  int previous_id = -1;
+  for (const auto& [message, match] : leader_in_message) {
+    if (previous_id >= 0 && match.second != previous_id) ++r.leader_id_switches;
+    previous_id = match.second;
+  }
+
+  // Latency, from the exposure (the earlier of the image and the ground truth of that step, as the logger saw
+  // them: a large image can reach the logger after the targets computed from its ground-truth detections) to the
+  // published targets.
+  for (const auto& [stamp, source_utime] : published) {
+    int64_t exposure = INT64_MAX;
+    if (const auto it = image_event_at.find(source_utime); it != image_event_at.end()) exposure = it->second;
+    if (const auto it = truth_event_at.find(source_utime); it != truth_event_at.end())
+      exposure = std::min(exposure, it->second);
+    if (exposure == INT64_MAX) continue;
+    r.latency_samples_ms.push_back(static_cast<double>(stamp - exposure) * 1e-3);
+  }
+  r.latency_ms = percentiles(r.latency_samples_ms);
+  r.inference_latency_ms = percentiles(inference_ms);
+
+  // Box widths: the detection nearest the leader's truth box centre, among those centred inside it.
+  Acc width_single, width_zoom;
+  BinnedAcc width_single_bins(o.range_bins_m), width_zoom_bins(o.range_bins_m);
+  for (const auto& d : detections) {
+    auto& frame = r.frames[d.utime];
+    for (const auto& b : d.boxes) frame.detections.push_back({b.cx, b.cy, b.w, b.h, d.camera_id, b.zoom_refined != 0});
+    const auto boxes = truth_boxes_at.find(d.utime);
+    if (boxes == truth_boxes_at.end() || d.image_width <= 0) continue;
+    for (const auto& tb : boxes->second) {
+      if (tb.vehicle_id != o.leader_id || tb.camera_id != d.camera_id || !tb.visible) continue;
+      for (const bool zoom : {false, true}) {
+        const wingman::detection_t* nearest = nullptr;
+        double nearest_d = kInf;
+        for (const auto& b : d.boxes) {
+          if ((b.zoom_refined != 0) != zoom) continue;
+          if (std::abs(b.cx - tb.cx) > 0.5 * tb.w || std::abs(b.cy - tb.cy) > 0.5 * tb.h) continue;
+          const double dist = std::hypot(b.cx - tb.cx, b.cy - tb.cy);
+          if (dist < nearest_d) nearest_d = dist, nearest = &b;
+        }
+        if (!nearest) continue;
+        const double w = static_cast<double>(d.image_width);
+        const double err = std::abs(static_cast<double>(nearest->w) - tb.w) / w;
+        (zoom ? width_zoom : width_single).add(err);
+        (zoom ? width_zoom_bins : width_single_bins).add(tb.range, err);
+        r.box_widths.push_back({tb.range, nearest->w / w, tb.w / w, zoom});
+      }
+    }
+  }
+  r.box_width_single = width_single.stats();
+  r.box_width_zoom = width_zoom.stats();
+  r.box_width_single_by_range = width_single_bins.bins();
+  r.box_width_zoom_by_range = width_zoom_bins.bins();
+  for (const auto& [u, boxes] : truth_boxes_at) {
+    auto& frame = r.frames[u];
+    for (const auto& b : boxes)
+      frame.truth_boxes.push_back({b.cx, b.cy, b.w, b.h, b.camera_id, b.visible != 0, b.vehicle_id});
+  }
 
   // Paths and formation error at every ground-truth time.
   const Track* leader = truth.count(o.leader_id) ? &truth.at(o.leader_id) : nullptr;
@@ -263,16 +428,14 @@ EvalResult evaluate_log(const EvalOptions& o) {
   r.formation_horizontal = fh.stats();
   r.formation_vertical = fv.stats();
 
-  if (!o.json_path.empty()) {
-    std::ofstream f(o.json_path);
-    f << r.json() << "\n";
-    if (!f) throw std::runtime_error("wingman eval: cannot write '" + o.json_path + "'");
-  }
-  if (!o.report_path.empty()) {
-    std::ofstream f(o.report_path);
-    f << eval_html_report(r, o);
-    if (!f) throw std::runtime_error("wingman eval: cannot write '" + o.report_path + "'");
-  }
+  const auto write = [](const std::string& path, const std::string& text) {
+    std::ofstream f(path);
+    f << text;
+    if (!f) throw std::runtime_error("wingman eval: cannot write '" + path + "'");
+  };
+  if (!o.json_path.empty()) write(o.json_path, r.json() + "\n");
+  if (!o.csv_path.empty()) write(o.csv_path, r.csv());
+  if (!o.report_path.empty()) write_html_report(r, o, o.report_path);
   return r;
 }
 
@@ -286,8 +449,10 @@ std::string EvalResult::report() const {
                    frames_leader_visible ? 100.0 * static_cast<double>(frames_leader_detected) /
                                                static_cast<double>(frames_leader_visible)
                                          : 0.0);
-  s += fmt::format("world targets: {} matched, {} false; {} track id(s) on the leader\n", target_estimates,
-                   false_targets, track_ids_on_leader);
+  s += fmt::format("world targets: {} matched, {} false; {} track id(s) on the leader, {} id switch(es)\n",
+                   target_estimates, false_targets, track_ids_on_leader, leader_id_switches);
+  s += fmt::format("false tracks: {:.3f} false targets per second, {} distinct false track id(s)\n",
+                   false_targets_per_s, false_track_ids);
   s += "localization error (estimate - truth):\n";
   s += stats_line("3-D", localization);
   s += stats_line("x (east)", localization_axis[0]);
@@ -295,129 +460,60 @@ std::string EvalResult::report() const {
   s += stats_line("z (up)", localization_axis[2]);
   s += stats_line("along the line of sight", along_line_of_sight);
   s += stats_line("across the line of sight", across_line_of_sight);
+  s += "localization error by true range:\n";
+  for (const auto& b : localization_by_range) s += stats_line("range " + bin_name(b), b.error);
   if (formation_horizontal.n > 0) {
     s += "formation error (follower - desired position):\n";
     s += stats_line("horizontal", formation_horizontal);
     s += stats_line("vertical", formation_vertical);
   }
+  const auto pct = [](const char* name, const Percentiles& p) {
+    if (p.n == 0) return fmt::format("  {:<34} no samples\n", name);
+    return fmt::format("  {:<34} p50 {:7.2f} ms   p90 {:7.2f} ms   p99 {:7.2f} ms   max {:7.2f} ms   (n = {})\n", name,
+                       p.p50, p.p90, p.p99, p.max, p.n);
+  };
+  s += "latency (log-event timestamps, wall clock):\n";
+  s += pct("exposure to published target", latency_ms);
+  s += pct("detector inference", inference_latency_ms);
+  s += "box-width error |w_det - w_truth| / image width, in % of the width:\n";
+  s += stats_line("single pass", box_width_single, "%", 100.0);
+  for (const auto& b : box_width_single_by_range)
+    if (b.error.n > 0) s += stats_line("  range " + bin_name(b), b.error, "%", 100.0);
+  s += stats_line("zoom-in", box_width_zoom, "%", 100.0);
+  for (const auto& b : box_width_zoom_by_range)
+    if (b.error.n > 0) s += stats_line("  range " + bin_name(b), b.error, "%", 100.0);
   return s;
 }
 
 std::string EvalResult::json() const {
   return fmt::format(
       "{{\"detection_source\": \"{}\", \"duration_s\": {:.3f}, \"truth_frames\": {}, \"frames_leader_visible\": {}, "
-      "\"frames_leader_detected\": {}, \"target_estimates\": {}, \"false_targets\": {}, \"track_ids_on_leader\": {}, "
+      "\"frames_leader_detected\": {}, \"target_estimates\": {}, \"false_targets\": {}, \"false_targets_per_s\": "
+      "{:.6f}, \"false_track_ids\": {}, \"track_ids_on_leader\": {}, \"leader_id_switches\": {}, "
       "\"localization\": {}, \"localization_x\": {}, \"localization_y\": {}, \"localization_z\": {}, "
-      "\"along_line_of_sight\": {}, \"across_line_of_sight\": {}, \"formation_horizontal\": {}, "
-      "\"formation_vertical\": {}}}",
+      "\"along_line_of_sight\": {}, \"across_line_of_sight\": {}, \"localization_by_range\": {}, "
+      "\"formation_horizontal\": {}, \"formation_vertical\": {}, \"latency\": {}, \"inference_latency\": {}, "
+      "\"box_width_single\": {}, \"box_width_zoom\": {}, \"box_width_single_by_range\": {}, "
+      "\"box_width_zoom_by_range\": {}}}",
       detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected, target_estimates,
-      false_targets, track_ids_on_leader, stats_json(localization), stats_json(localization_axis[0]),
-      stats_json(localization_axis[1]), stats_json(localization_axis[2]), stats_json(along_line_of_sight),
-      stats_json(across_line_of_sight), stats_json(formation_horizontal), stats_json(formation_vertical));
+      false_targets, false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches,
+      stats_json(localization), stats_json(localization_axis[0]), stats_json(localization_axis[1]),
+      stats_json(localization_axis[2]), stats_json(along_line_of_sight), stats_json(across_line_of_sight),
+      bins_json(localization_by_range, false), stats_json(formation_horizontal), stats_json(formation_vertical),
+      percentiles_json(latency_ms), percentiles_json(inference_latency_ms), fraction_json(box_width_single),
+      fraction_json(box_width_zoom), bins_json(box_width_single_by_range, true),
+      bins_json(box_width_zoom_by_range, true));
 }
 
-namespace {
-
-/// A chart area mapping data coordinates to SVG pixels.
-struct Frame {
-  double x0, x1, y0, y1;  // data range
-  double w, h, pad;       // pixels
-  double sx(double x) const { return pad + (x - x0) / (x1 - x0) * (w - 2 * pad); }
-  double sy(double y) const { return h - pad - (y - y0) / (y1 - y0) * (h - 2 * pad); }
-};
-
-std::string polyline(const Frame& f, const std::vector<std::pair<double, double>>& pts, const char* colour,
-                     double width, const char* dash = "") {
-  if (pts.empty()) return "";
-  std::string s = fmt::format(R"(<polyline fill="none" stroke="{}" stroke-width="{}" stroke-dasharray="{}" points=")",
-                              colour, width, dash);
-  for (const auto& [x, y] : pts) s += fmt::format("{:.1f},{:.1f} ", f.sx(x), f.sy(y));
-  return s + "\"/>\n";
-}
-
-std::string axes(const Frame& f, const std::string& xlabel, const std::string& ylabel) {
-  std::string s = fmt::format(R"(<rect x="{}" y="{}" width="{}" height="{}" fill="#fbfbfb" stroke="#999"/>)", f.pad,
-                              f.pad, f.w - 2 * f.pad, f.h - 2 * f.pad);
-  for (int i = 0; i <= 4; ++i) {
-    const double x = f.x0 + (f.x1 - f.x0) * i / 4.0, y = f.y0 + (f.y1 - f.y0) * i / 4.0;
-    s += fmt::format(R"(<text x="{:.1f}" y="{:.1f}" font-size="11" text-anchor="middle">{:.1f}</text>)", f.sx(x),
-                     f.h - f.pad + 14, x);
-    s += fmt::format(R"(<text x="{:.1f}" y="{:.1f}" font-size="11" text-anchor="end">{:.1f}</text>)", f.pad - 4,
-                     f.sy(y) + 4, y);
+std::string EvalResult::csv() const {
+  std::string s = "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m\n";
+  const auto num = [](double v) { return std::isnan(v) ? std::string() : fmt::format("{:.4f}", v); };
+  for (const auto& t : targets) {
+    s += fmt::format("{:.6f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{}\n", t.t_s, t.track_id, t.vehicle_id,
+                     t.range_m, t.p_est.x(), t.p_est.y(), t.p_est.z(), num(t.p_truth.x()), num(t.p_truth.y()),
+                     num(t.p_truth.z()), num(t.error_m));
   }
-  s += fmt::format(R"(<text x="{:.1f}" y="{:.1f}" font-size="12" text-anchor="middle">{}</text>)", f.w / 2, f.h - 4,
-                   xlabel);
-  s += fmt::format(R"svg(<text x="12" y="{:.1f}" font-size="12" transform="rotate(-90 12 {:.1f})" )svg"
-                   R"(text-anchor="middle">{}</text>)",
-                   f.h / 2, f.h / 2, ylabel);
-  return s + "\n";
-}
-
-}  // namespace
-
-std::string eval_html_report(const EvalResult& r, const EvalOptions& o) {
-  // Top-down view with equal axis scales.
-  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-  for (const auto* v : {&r.leader_truth, &r.leader_estimate, &r.follower_truth}) {
-    for (const auto& s : *v) {
-      x0 = std::min(x0, s.p.x());
-      x1 = std::max(x1, s.p.x());
-      y0 = std::min(y0, s.p.y());
-      y1 = std::max(y1, s.p.y());
-    }
-  }
-  if (x0 > x1) x0 = -1, x1 = 1, y0 = -1, y1 = 1;
-  const double span = std::max({x1 - x0, y1 - y0, 2.0}) * 1.1;
-  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
-  const Frame top{cx - span / 2, cx + span / 2, cy - span / 2, cy + span / 2, 560, 560, 48};
-  const auto xy = [](const std::vector<EvalResult::Sample>& v) {
-    std::vector<std::pair<double, double>> o;
-    for (const auto& s : v) o.emplace_back(s.p.x(), s.p.y());
-    return o;
-  };
-  std::string svg_top =
-      fmt::format(R"(<svg id="topdown" xmlns="http://www.w3.org/2000/svg" width="{}" height="{}">)", top.w, top.h);
-  svg_top += axes(top, "x (east), m", "y (north), m");
-  svg_top += polyline(top, xy(r.leader_truth), "#1f77b4", 2.0);
-  svg_top += polyline(top, xy(r.follower_truth), "#2ca02c", 2.0);
-  for (const auto& s : r.leader_estimate) {
-    svg_top += fmt::format(R"(<circle cx="{:.1f}" cy="{:.1f}" r="1.6" fill="#d62728" fill-opacity="0.5"/>)",
-                           top.sx(s.p.x()), top.sy(s.p.y()));
-  }
-  svg_top += "</svg>";
-
-  double tmax = std::max(r.duration_s, 1.0), emax = 0.5;
-  for (const auto& [t, e] : r.localization_error_over_time) emax = std::max(emax, e);
-  for (const auto& [t, e] : r.formation_error_over_time) emax = std::max(emax, e);
-  const Frame ef{0.0, tmax, 0.0, emax * 1.1, 720, 300, 48};
-  std::string svg_err =
-      fmt::format(R"(<svg id="errors" xmlns="http://www.w3.org/2000/svg" width="{}" height="{}">)", ef.w, ef.h);
-  svg_err += axes(ef, "time, s", "error, m");
-  svg_err += polyline(ef, r.localization_error_over_time, "#d62728", 1.2);
-  svg_err += polyline(ef, r.formation_error_over_time, "#2ca02c", 1.5);
-  svg_err += "</svg>";
-
-  std::string html = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + escape_html(o.title) +
-                     "</title>\n<style>body{font-family:sans-serif;margin:24px;color:#222} pre{background:#f4f4f4;"
-                     "padding:12px} .k{display:inline-block;width:14px;height:4px;margin:0 6px 3px 12px}</style>"
-                     "</head><body>\n";
-  html += "<h1>" + escape_html(o.title) + "</h1>\n";
-  if (r.detection_source == "ground_truth") {
-    html +=
-        "<p><b>Detections came from simulator ground truth</b> (no trained detector model was used): these "
-        "numbers measure localization, tracking and control, not detection.</p>\n";
-  }
-  html += "<p>Log: <code>" + escape_html(o.log) + "</code></p>\n<pre>" + escape_html(r.report()) + "</pre>\n";
-  html +=
-      "<h2>Top-down view</h2><p><span class=\"k\" style=\"background:#1f77b4\"></span>leader truth"
-      "<span class=\"k\" style=\"background:#d62728\"></span>leader estimate"
-      "<span class=\"k\" style=\"background:#2ca02c\"></span>follower</p>\n" +
-      svg_top + "\n";
-  html +=
-      "<h2>Errors over time</h2><p><span class=\"k\" style=\"background:#d62728\"></span>localization |e|"
-      "<span class=\"k\" style=\"background:#2ca02c\"></span>formation, horizontal</p>\n" +
-      svg_err + "\n</body></html>\n";
-  return html;
+  return s;
 }
 
 }  // namespace wingman::tools

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy, loginfo, make-video, localize, predict,
-// bench detector, eval (flight errors against ground truth), dataset synth, train / val / import-halmstad (training).
+// bench detector, eval (flight errors against ground truth), report (its HTML page), dataset synth, train / val /
+// import-halmstad (training).
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
 #include "wingman/tools/localize.hpp"
@@ -19,6 +20,7 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <tuple>
 
 int main(int argc, char** argv) {
   using namespace wingman::tools;
@@ -107,27 +109,44 @@ int main(int argc, char** argv) {
   pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
   pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
 
-  EvalOptions eval;
-  std::vector<double> eval_offset;
-  bool eval_json_stdout = false;
+  // `eval` and `report` read a flight's log the same way; both take the matching options.
+  EvalOptions eval, report;
+  std::vector<double> eval_offset, report_offset;
+  bool eval_json_stdout = false, eval_quiet = false, report_quiet = false;
+  const auto add_eval_options = [](CLI::App* c, EvalOptions& o, std::vector<double>& offset, bool& quiet) {
+    c->add_option("log", o.log, "LCM log with GROUND_TRUTH and TARGETS (and DETECTIONS_CAM0, IMAGE_CAM0)")->required();
+    c->add_option("--formation-offset", offset, "Desired follower minus leader position x,y,z (ENU), metres")
+        ->expected(3)
+        ->delimiter(',');
+    c->add_option("--formation-height", o.formation_height_m, "The follower's constant height, metres");
+    c->add_option("--settle", o.settle_s, "Skip this many seconds before measuring formation error (default 5)");
+    c->add_option("--leader-id", o.leader_id, "vehicle_id of the leader in ground truth (default 1)");
+    c->add_option("--follower-id", o.follower_id, "vehicle_id of the camera vehicle (default 0)");
+    c->add_option("--match-radius", o.match_radius_m, "Farther targets are false targets, metres (default 3)");
+    c->add_option("--range-bins", o.range_bins_m,
+                  "Upper edges of the range bins, metres, increasing (default 5,10,15,20,30: 0-5, ..., 30+)")
+        ->delimiter(',');
+    c->add_option("--truth-channel", o.truth_channel, "ground_truth_t channel (default GROUND_TRUTH)");
+    c->add_option("--targets-channel", o.targets_channel, "targets_t channel (default TARGETS)");
+    c->add_option("--detections-channel", o.detections_channel, "detections_t channel (default DETECTIONS_CAM0)");
+    c->add_option("--image-channel", o.image_channel, "image_t channel (default IMAGE_CAM0)");
+    c->add_option("--title", o.title, "Report title");
+    c->add_option("--frames", o.report_frames, "Camera frames shown in the report (default 6)");
+    c->add_flag("--quiet", quiet, "No progress on stderr");
+  };
   auto* ev = app.add_subcommand(
-      "eval", "Localization and formation errors of a simulated flight's log against its ground truth");
-  ev->add_option("log", eval.log, "LCM log with GROUND_TRUTH and TARGETS (and DETECTIONS_CAM0)")->required();
-  ev->add_option("--formation-offset", eval_offset, "Desired follower minus leader position x,y,z (ENU), metres")
-      ->expected(3)
-      ->delimiter(',');
-  ev->add_option("--formation-height", eval.formation_height_m, "The follower's constant height, metres");
-  ev->add_option("--settle", eval.settle_s, "Skip this many seconds before measuring formation error (default 5)");
-  ev->add_option("--leader-id", eval.leader_id, "vehicle_id of the leader in ground truth (default 1)");
-  ev->add_option("--follower-id", eval.follower_id, "vehicle_id of the camera vehicle (default 0)");
-  ev->add_option("--match-radius", eval.match_radius_m, "Farther targets are false targets, metres (default 3)");
-  ev->add_option("--truth-channel", eval.truth_channel, "ground_truth_t channel (default GROUND_TRUTH)");
-  ev->add_option("--targets-channel", eval.targets_channel, "targets_t channel (default TARGETS)");
-  ev->add_option("--detections-channel", eval.detections_channel, "detections_t channel (default DETECTIONS_CAM0)");
+      "eval", "Localization, tracking, latency and box errors of a simulated flight's log against its ground truth");
+  add_eval_options(ev, eval, eval_offset, eval_quiet);
   ev->add_option("--json", eval.json_path, "Also write the result as JSON to this file");
   ev->add_flag("--json-stdout", eval_json_stdout, "Print JSON instead of the table");
+  ev->add_option("--csv", eval.csv_path, "Write the per-target time series (t, track, range, estimate, truth, error)");
   ev->add_option("--report", eval.report_path, "Write a self-contained HTML report to this file");
-  ev->add_option("--title", eval.title, "Report title");
+  auto* rp = app.add_subcommand(
+      "report", "One self-contained HTML page about a simulated flight: charts and camera frames (opens offline)");
+  add_eval_options(rp, report, report_offset, report_quiet);
+  rp->add_option("-o,--output", report.report_path, "HTML file to write")->required();
+  rp->add_option("--json", report.json_path, "Also write the result as JSON to this file");
+  rp->add_option("--csv", report.csv_path, "Also write the per-target time series as CSV to this file");
 
   BenchDetectorOptions bench_detector;
   auto* be = app.add_subcommand("bench", "Benchmarks (numbers, not tests)");
@@ -177,14 +196,17 @@ int main(int argc, char** argv) {
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);
     if (*bd) return run_bench_detector_verb(bench_detector, std::cout, std::cerr);
-    if (*ev) {
-      if (!eval_offset.empty()) {
-        eval.formation_offset_in_world = {eval_offset[0], eval_offset[1], eval_offset[2]};
-        eval.has_formation = true;
+    for (auto [cmd, o, offset, quiet] : {std::make_tuple(ev, &eval, &eval_offset, eval_quiet),
+                                         std::make_tuple(rp, &report, &report_offset, report_quiet)}) {
+      if (!*cmd) continue;
+      if (!offset->empty()) {
+        o->formation_offset_in_world = {(*offset)[0], (*offset)[1], (*offset)[2]};
+        o->has_formation = true;
       }
-      const EvalResult result = evaluate_log(eval);
-      std::cout << (eval_json_stdout ? result.json() + "\n" : result.report()) << std::flush;
-      if (!eval.report_path.empty()) std::cerr << "report written to " << eval.report_path << std::endl;
+      if (!quiet) o->progress = &std::cerr;
+      const EvalResult result = evaluate_log(*o);
+      if (cmd == ev) std::cout << (eval_json_stdout ? result.json() + "\n" : result.report()) << std::flush;
+      if (!o->report_path.empty()) std::cerr << "report written to " << o->report_path << std::endl;
     }
     if (*mv) {
       make_video(video);

@@ -1,22 +1,29 @@
 // SPDX-License-Identifier: MIT
-// `wingman eval`: localization and formation errors of a recorded flight against the simulator's ground truth.
+// `wingman eval`: localization, tracking, latency and box errors of a recorded flight against the simulator's truth.
 #pragma once
 
 #include <Eigen/Core>
 
 #include <array>
 #include <cstdint>
+#include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
 namespace wingman::tools {
 
 /// What `wingman eval` reads and how it matches.
+///
+/// Every metric is computed from message utimes (simulated time), so it is the same on every run of the same log;
+/// the only exception is latency, which is by nature wall-clock: it uses the log events' timestamps (the logger's
+/// receive time).
 struct EvalOptions {
-  std::string log;  ///< LCM log with ground_truth_t and targets_t (and detections_t, setpoint_t)
+  std::string log;  ///< LCM log with ground_truth_t and targets_t (and detections_t, image_t)
   std::string truth_channel = "GROUND_TRUTH";          ///< ground_truth_t channel
   std::string targets_channel = "TARGETS";             ///< targets_t channel
   std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t channel
+  std::string image_channel = "IMAGE_CAM0";            ///< image_t channel (latency reference, report frames)
   int follower_id = 0;  ///< vehicle_truth_t.vehicle_id of the camera vehicle (the follower)
   int leader_id = 1;    ///< vehicle_truth_t.vehicle_id of the vehicle the formation is kept on
   /// Desired follower position minus leader position, world frame (ENU), metres; the z component is ignored when
@@ -26,14 +33,21 @@ struct EvalOptions {
   double formation_height_m = -1.0;  ///< the follower's commanded constant height, metres; < 0: use the offset's z
   double settle_s = 5.0;             ///< formation metrics skip this long after the first ground truth, seconds
   double match_radius_m = 3.0;       ///< a world target farther than this from every truth vehicle is a false target
-  std::string json_path;             ///< write the result as JSON here ("" = no)
-  std::string report_path;           ///< write a self-contained HTML report here ("" = no)
+  /// Upper edges of the range bins, metres, strictly increasing and > 0: {5, 10} gives [0, 5), [5, 10), [10, inf).
+  std::vector<double> range_bins_m = {5, 10, 15, 20, 30};
+  std::string json_path;                 ///< write the result as JSON here ("" = no)
+  std::string csv_path;                  ///< write the per-target time series as CSV here ("" = no)
+  std::string report_path;               ///< write a self-contained HTML report here ("" = no)
   std::string title = "Wingman flight";  ///< report title
+  int report_frames = 6;                 ///< the report shows up to this many camera frames (0 = none)
+  /// Progress (percent of the log read, every few seconds) goes here; nullptr = quiet.
+  std::ostream* progress = nullptr;
   /// Checks the options; one line per problem naming the option.
   std::vector<std::string> validate() const;
 };
 
-/// RMS, mean of the magnitude and maximum of a set of errors (metres); n = number of samples.
+/// RMS, mean of the magnitude and maximum of a set of errors (metres, or the unit stated where used);
+/// n = number of samples.
 struct ErrorStats {
   int64_t n = 0;
   double rms = 0.0;
@@ -41,42 +55,105 @@ struct ErrorStats {
   double max = 0.0;
 };
 
+/// Nearest-rank percentiles of a set of durations, milliseconds: pXX is the ceil(XX/100 * n)-th smallest value.
+struct Percentiles {
+  int64_t n = 0;
+  double p50 = 0.0, p90 = 0.0, p99 = 0.0, max = 0.0;
+};
+
+/// Errors of the samples whose truth range lies in [lo_m, hi_m) (hi_m is infinity for the last bin).
+struct RangeBin {
+  double lo_m = 0.0;
+  double hi_m = 0.0;
+  ErrorStats error;
+};
+
 /// The measured errors of one flight.
 struct EvalResult {
-  std::string detection_source;                 ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
-  int64_t truth_frames = 0;                     ///< ground_truth_t messages
-  int64_t frames_leader_visible = 0;            ///< of those, frames in which the leader's truth box is visible
-  int64_t frames_leader_detected = 0;           ///< of those, frames with at least one detection at the same utime
-  int64_t target_estimates = 0;                 ///< world-valid targets matched to a truth vehicle
-  int64_t false_targets = 0;                    ///< world-valid targets farther than match_radius_m from every vehicle
-  int64_t track_ids_on_leader = 0;              ///< distinct track ids matched to the leader
-  ErrorStats localization;                      ///< |p_est - p_truth|, 3-D
+  std::string detection_source;        ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
+  int64_t truth_frames = 0;            ///< ground_truth_t messages
+  int64_t frames_leader_visible = 0;   ///< of those, frames in which the leader's truth box is visible
+  int64_t frames_leader_detected = 0;  ///< of those, frames with at least one detection at the same utime
+  int64_t target_estimates = 0;        ///< world-valid targets matched to a truth vehicle
+  /// World-valid targets farther than match_radius_m from every truth vehicle but the follower (target samples).
+  int64_t false_targets = 0;
+  double false_targets_per_s = 0.0;  ///< false_targets / duration_s
+  int64_t false_track_ids = 0;       ///< distinct track ids among the false targets
+  int64_t track_ids_on_leader = 0;   ///< distinct track ids matched to the leader
+  /// Changes of the leader's track id: in each targets_t (log order) the target matched to the leader nearest to
+  /// it gives the id; every change from one message with a leader target to the next one with one counts.
+  int64_t leader_id_switches = 0;
+  ErrorStats localization;                      ///< |p_est - p_truth|, 3-D, metres
   std::array<ErrorStats, 3> localization_axis;  ///< per world axis (x, y, z): RMS, mean |e|, max |e|
   ErrorStats along_line_of_sight;               ///< error component along the follower-to-target line
   ErrorStats across_line_of_sight;              ///< error perpendicular to that line
+  /// |p_est - p_truth| binned by the true distance from the follower's centre to the matched vehicle's centre at the
+  /// target's predicted_utime (EvalOptions::range_bins_m).
+  std::vector<RangeBin> localization_by_range;
   ErrorStats formation_horizontal;  ///< follower position minus desired position, horizontal, after settle_s
   ErrorStats formation_vertical;    ///< the same, vertical
   double duration_s = 0.0;          ///< ground-truth time span, seconds
+  /// Exposure to published target, ms: for each targets_t with targets, its log-event timestamp minus the earlier
+  /// log-event timestamp of the image_t and the ground_truth_t whose utime is the newest source_utime among its
+  /// targets (either one alone when the other is not in the log; no sample when neither is).
+  Percentiles latency_ms;
+  Percentiles inference_latency_ms;  ///< detections_t.inference_latency_us, ms
+  /// Box-width error |w_det - w_truth| / image_width (a fraction of the image width): each detection matched to the
+  /// leader's visible truth box at the same utime and camera (of the detections whose centre lies inside the truth
+  /// box, the one with the nearest centre). Single-pass boxes (zoom_refined false) and zoom-in boxes apart.
+  ErrorStats box_width_single, box_width_zoom;
+  std::vector<RangeBin> box_width_single_by_range, box_width_zoom_by_range;  ///< the same, binned by truth box range
 
-  /// Time series for the report (seconds since the first ground truth).
+  /// Time series (seconds since the first ground truth).
   struct Sample {
     double t_s;
     Eigen::Vector3d p;
   };
   std::vector<Sample> leader_truth, leader_estimate, follower_truth;
-  std::vector<std::pair<double, double>> localization_error_over_time;  ///< (t_s, |e| m)
+  std::vector<std::pair<double, double>> localization_error_over_time;  ///< (t_s, |e| m), leader only
   std::vector<std::pair<double, double>> formation_error_over_time;     ///< (t_s, horizontal |e| m)
+  /// One world-valid target of one targets_t (the CSV rows).
+  struct TargetSample {
+    double t_s;  ///< predicted_utime, seconds since the first ground truth
+    int track_id;
+    int vehicle_id;                  ///< matched truth vehicle, -1 = false target
+    double range_m;                  ///< true follower-to-vehicle distance (matched), else target_t.range
+    Eigen::Vector3d p_est, p_truth;  ///< world frame, metres; p_truth is NaN for a false target
+    double error_m;                  ///< |p_est - p_truth|, NaN for a false target
+  };
+  std::vector<TargetSample> targets;
+  /// One matched detection's box width (the report's scatter).
+  struct BoxWidthSample {
+    double range_m;       ///< truth box range, metres
+    double w_det_frac;    ///< detected width / image width
+    double w_truth_frac;  ///< truth width / image width
+    bool zoom_refined;
+  };
+  std::vector<BoxWidthSample> box_widths;
+  std::vector<double> latency_samples_ms;  ///< every latency sample (the report's histogram)
+  /// What one camera frame (by utime) showed, for drawing the report's frames.
+  struct FrameInfo {
+    struct Box {
+      float cx, cy, w, h;  ///< pixels of the source image
+      int camera_id;
+      bool flag;            ///< truth: visible; detection: zoom_refined
+      int vehicle_id = -1;  ///< truth: vehicle id; detection: -1
+    };
+    std::vector<Box> truth_boxes, detections;
+    int leader_track_id = -1;  ///< track id of the leader's matched target with this source_utime, -1 none
+  };
+  std::map<int64_t, FrameInfo> frames;  ///< by utime (ground truth and detections of camera 0)
+  std::vector<int64_t> image_utimes;    ///< utimes of the image_t events on image_channel, log order
+  int64_t first_truth_utime = 0;        ///< t = 0 of the time series
 
   std::string report() const;  ///< lines for people
   std::string json() const;    ///< one JSON object
+  std::string csv() const;     ///< per-target time series with a header line
 };
 
-/// Reads the log and computes the errors. Throws std::runtime_error naming the file when it cannot be read or holds
-/// no ground truth.
+/// Reads the log and computes the errors; writes json_path, csv_path and report_path when set. Throws
+/// std::invalid_argument naming the option for bad options, std::runtime_error naming the file when it cannot be
+/// read or written or holds no ground truth.
 EvalResult evaluate_log(const EvalOptions& options);
-
-/// A self-contained HTML page (inline SVG, no scripts, opens offline): top-down paths of leader truth, leader
-/// estimate and follower, and the errors over time.
-std::string eval_html_report(const EvalResult& result, const EvalOptions& options);
 
 }  // namespace wingman::tools
