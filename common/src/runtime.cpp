@@ -20,8 +20,15 @@ namespace wingman::common {
 namespace {
 
 std::atomic<int> g_signal{0};
+/// True until the process first waits for input: start-up (config, model loading, OpenCL kernel builds) may take
+/// seconds in calls that cannot be interrupted, and nothing has been published that needs a final status yet.
+std::atomic<bool> g_starting{true};
 
-extern "C" void on_signal(int sig) { g_signal.store(sig); }
+extern "C" void on_signal(int sig) {
+  // A stop asked for during start-up ends the process at once (exit 0 within the 1 s the supervisor is promised).
+  if (g_starting.load()) _exit(0);
+  g_signal.store(sig);
+}
 
 void install_signal_handlers() {
   struct sigaction sa {};
@@ -136,6 +143,7 @@ lcm::LCM& Runtime::input() {
 }
 
 bool Runtime::spin_once(int timeout_ms) {
+  g_starting.store(false);
   if (stop_requested() || end_of_input_) return false;
   lcm::LCM& in = input();
   if (status_.state() == wingman::status_t::STATE_STARTING) status_.set_state(wingman::status_t::STATE_OK, "");
@@ -156,6 +164,7 @@ bool Runtime::spin_once(int timeout_ms) {
 }
 
 int Runtime::drain(int max_messages) {
+  g_starting.store(false);
   if (input_is_file_) return 0;
   int n = 0;
   lcm::LCM& in = input();

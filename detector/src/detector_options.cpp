@@ -16,6 +16,8 @@ std::vector<std::string> DetectorOptions::validate() const {
   if (mode != "realtime" && mode != "replay") p.push_back(problem("input.mode", mode, "must be realtime or replay"));
   if (backend != "auto" && backend != "opencl" && backend != "cpu")
     p.push_back(problem("model.backend", backend, "must be auto, opencl or cpu"));
+  if (cfg.empty())
+    p.push_back(problem("model.cfg", cfg, "must be a .cfg path, builtin:wingman-small or builtin:tiny-yolo-thesis"));
   for (const auto& part : {detection.validate(), opencl.validate()}) p.insert(p.end(), part.begin(), part.end());
   return p;
 }

@@ -38,11 +38,47 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-DarknetModel load_model(const std::string& cfg_path, const std::string& weights_path) {
-  DarknetModel model = cfg_path.empty()
-                           ? parse_darknet_cfg_string(builtin_thesis_cfg(), "<built-in tiny-yolo-thesis.cfg>")
-                           : parse_darknet_cfg(cfg_path);
-  load_darknet_weights(model, weights_path);
+std::vector<std::string> builtin_cfg_names() { return {"wingman-small", "tiny-yolo-thesis"}; }
+std::vector<std::string> builtin_weights_names() { return {"wingman-small"}; }
+
+DarknetModel load_model(const std::string& cfg, const std::string& weights) {
+  const std::string prefix = kBuiltinPrefix;
+  const auto builtin = [&prefix](const std::string& s) { return s.rfind(prefix, 0) == 0 ? s.substr(prefix.size()) : ""; };
+  const auto known = [&prefix](const std::vector<std::string>& names) {
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + prefix + n;
+    return s;
+  };
+  DarknetModel model;
+  const std::string cfg_name = builtin(cfg);
+  if (cfg.empty()) {
+    throw std::runtime_error("model.cfg is empty: expected a Darknet .cfg path or one of " +
+                             known(builtin_cfg_names()));
+  } else if (cfg_name == "wingman-small") {
+    model = parse_darknet_cfg_string(builtin_small_cfg(), "<built-in wingman-small.cfg>");
+  } else if (cfg_name == "tiny-yolo-thesis") {
+    model = parse_darknet_cfg_string(builtin_thesis_cfg(), "<built-in tiny-yolo-thesis.cfg>");
+  } else if (!cfg_name.empty()) {
+    throw std::runtime_error("model.cfg = '" + cfg + "': no such built-in network; expected one of " +
+                             known(builtin_cfg_names()) + " or a .cfg path");
+  } else {
+    model = parse_darknet_cfg(cfg);
+  }
+  const std::string weights_name = builtin(weights);
+  if (weights_name == "wingman-small") {
+    const std::vector<char> bytes = builtin_small_weights();
+    if (bytes.empty()) {
+      throw std::runtime_error(
+          "model.weights = 'builtin:wingman-small': this build has no built-in weights (models/wingman-small.weights "
+          "was absent when it was built); give a .weights path");
+    }
+    load_darknet_weights_from_buffer(model, bytes, "<built-in wingman-small.weights>");
+  } else if (!weights_name.empty()) {
+    throw std::runtime_error("model.weights = '" + weights + "': no such built-in model; expected " +
+                             known(builtin_weights_names()) + " or a .weights path");
+  } else {
+    load_darknet_weights(model, weights);
+  }
   return model;
 }
 

@@ -73,7 +73,7 @@ struct DetectorRun {
 DetectorRun run_detector(const TempDir& dir, const std::string& in, const std::string& weights,
                          const std::string& backend, const std::string& name) {
   const std::string cfg = dir.file(name + ".yaml");
-  std::ofstream(cfg) << "model: {weights: " << weights << ", backend: " << backend << "}\ninput: {mode: replay}\n";
+  std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << weights << ", backend: " << backend << "}\ninput: {mode: replay}\n";
   const std::string out = dir.file(name + ".lcmlog");
   const auto r = run({bin_path("wingman-detector"), "--config", cfg, "--lcm-in", "file://" + in + "?speed=0",
                       "--lcm-out", "file://" + out + "?mode=w"},
@@ -137,7 +137,7 @@ TEST(DetectorProcess, CpuBackendHandlesTheSameStream) {
 TEST(DetectorProcess, MissingWeightsFileIsAOneLineErrorNamingIt) {
   TempDir dir;
   const std::string cfg = dir.file("d.yaml");
-  std::ofstream(cfg) << "model: {weights: /nonexistent/x.weights, backend: cpu}\n";
+  std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: /nonexistent/x.weights, backend: cpu}\n";
   const auto r = run({bin_path("wingman-detector"), "--config", cfg, "--lcm-url", "memq://"}, 30s);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("wingman-detector: error:"), std::string::npos) << r.err;

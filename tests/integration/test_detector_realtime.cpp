@@ -47,7 +47,7 @@ TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
   wingman::detector::randomize_weights(model, 7);
   wingman::detector::save_darknet_weights(model, dir.file("random.weights"));
   const std::string cfg = dir.file("detector.yaml");
-  std::ofstream(cfg) << "model: {weights: " << dir.file("random.weights")
+  std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << dir.file("random.weights")
                      << ", backend: cpu}\ninput: {mode: realtime}\n";
 
   const std::string url = wingman::testing::netns_lcm_url();

@@ -126,7 +126,7 @@ std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const s
     wingman::detector::randomize_weights(model, 7);
     wingman::detector::save_darknet_weights(model, dir.file("random.weights"));
     std::ofstream(detector_cfg)
-        << "model: {weights: " << dir.file("random.weights")
+        << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << dir.file("random.weights")
         << ", backend: opencl}\ninput: {mode: replay}\noutput: {channel: DETECTIONS_NET_CAM0}\n";
   }
   stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-detector"), "--lcm-url", url,

@@ -96,9 +96,9 @@ int main(int argc, char** argv) {
   auto* pr = app.add_subcommand(
       "predict", "Run the detector on image files or folders; write YOLO-format labels (and drawn images)");
   pr->add_option("inputs", predict.inputs, "Image files and/or folders of images")->required();
-  pr->add_option("--cfg", predict.cfg,
-                 "Darknet .cfg (default: the built-in thesis network, models/tiny-yolo-thesis.cfg)");
-  pr->add_option("--weights", predict.weights, "Darknet .weights")->required();
+  pr->add_option("--cfg", predict.cfg, "Darknet .cfg, or builtin:wingman-small (default) or builtin:tiny-yolo-thesis");
+  pr->add_option("--weights", predict.weights,
+                 "Darknet .weights, or builtin:wingman-small (default: the shipped model, models/wingman-small.md)");
   pr->add_option("--backend", predict.backend, "Inference backend: auto (default), opencl or cpu");
   pr->add_option("--out", predict.out_dir, "Output folder for <stem>.txt (default predictions)");
   pr->add_flag("--draw", predict.draw, "Also write <stem>.pred.jpg with the boxes drawn");

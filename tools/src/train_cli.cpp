@@ -159,8 +159,9 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   training::ValOptions& vo = s.val_options;
   v->add_option("--data", vo.data, "data.yaml or YOLO-layout folder")->required();
   v->add_option("--split", vo.split, "Split to evaluate (default val; \"\" = a folder's images/)");
-  v->add_option("--weights", vo.weights, "Darknet .weights: run the detector (Algorithm 2)");
-  v->add_option("--cfg", vo.cfg, "Darknet .cfg (default: the built-in thesis network)");
+  v->add_option("--weights", vo.weights,
+                "Darknet .weights or builtin:wingman-small (the shipped model): run the detector (Algorithm 2)");
+  v->add_option("--cfg", vo.cfg, "Darknet .cfg, or builtin:wingman-small (default) or builtin:tiny-yolo-thesis");
   v->add_option("--backend", vo.backend, "Detector backend: cpu (default), opencl or auto");
   v->add_option("--predictions", vo.predictions, "Instead of --weights: folder of `wingman predict` <stem>.txt files");
   v->add_option("--conf", vo.metrics.conf_thresh,

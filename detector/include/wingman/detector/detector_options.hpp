@@ -19,8 +19,12 @@ struct DetectorOptions {
   /// realtime: when busy, keep only the newest frame (older ones are dropped and counted);
   /// replay: process every frame in order (deterministic; for logs and lockstep replays).
   std::string mode = "realtime";
-  std::string cfg;      ///< Darknet .cfg; "" = the built-in thesis network (models/tiny-yolo-thesis.cfg)
-  std::string weights;  ///< Darknet .weights; "" = no model: images are checked and counted, nothing is detected
+  /// Darknet .cfg path, or builtin:wingman-small (the shipped model, models/wingman-small.cfg) or
+  /// builtin:tiny-yolo-thesis (the thesis network, models/tiny-yolo-thesis.cfg), both built into the binary.
+  std::string cfg = "builtin:wingman-small";
+  /// Darknet .weights path, or builtin:wingman-small (the shipped trained model, built in; card:
+  /// models/wingman-small.md); "" = no model: images are checked and counted, nothing is detected.
+  std::string weights = "builtin:wingman-small";
   std::string backend = "auto";  ///< auto | opencl | cpu
   DetectorPipelineOptions detection;
   OpenClOptions opencl;
@@ -32,8 +36,10 @@ struct DetectorOptions {
     v("input.max_image_height", max_image_height, "taller images are dropped and counted, pixels");
     v("input.mode", mode, "realtime (newest frame when busy, drops counted) or replay (every frame, deterministic)");
     v("output.channel", output_channel, "detections_t channel to publish detections on");
-    v("model.cfg", cfg, "Darknet .cfg; \"\" = built-in thesis network (models/tiny-yolo-thesis.cfg)");
-    v("model.weights", weights, "Darknet .weights; \"\" = no model (images are checked and counted only)");
+    v("model.cfg", cfg, "Darknet .cfg path, or builtin:wingman-small (shipped) or builtin:tiny-yolo-thesis");
+    v("model.weights", weights,
+      "Darknet .weights path, or builtin:wingman-small (shipped, models/wingman-small.md); \"\" = no model "
+      "(images are checked and counted only)");
     v("model.backend", backend, "auto (OpenCL GPU if any, else the faster of opencl/cpu here), opencl or cpu");
     detection.visit(v);
     opencl.visit(v);

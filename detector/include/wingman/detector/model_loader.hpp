@@ -8,15 +8,33 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace wingman::detector {
 
 /// The thesis network's .cfg (models/tiny-yolo-thesis.cfg), embedded at build time.
 const char* builtin_thesis_cfg();
 
-/// Parses `cfg_path` ("" = the built-in thesis network) and loads `weights_path` into it. Throws
-/// std::runtime_error naming the file, line and key (see parse_darknet_cfg, load_darknet_weights).
-DarknetModel load_model(const std::string& cfg_path, const std::string& weights_path);
+/// The shipped model's .cfg (models/wingman-small.cfg), embedded at build time.
+const char* builtin_small_cfg();
+
+/// The shipped model's Darknet .weights (models/wingman-small.weights) as built in; empty when the source tree had
+/// no such file at build time.
+std::vector<char> builtin_small_weights();
+
+/// Prefix of a built-in model name in model.cfg / model.weights, e.g. "builtin:wingman-small".
+inline constexpr const char* kBuiltinPrefix = "builtin:";
+
+/// The names after "builtin:" that model.cfg accepts (wingman-small, tiny-yolo-thesis) and model.weights accepts
+/// (wingman-small).
+std::vector<std::string> builtin_cfg_names();
+std::vector<std::string> builtin_weights_names();
+
+/// Loads a network: `cfg` is a .cfg path or "builtin:<name>" (builtin_cfg_names()); `weights` is a .weights path or
+/// "builtin:wingman-small" (the shipped model; its .cfg must be builtin:wingman-small or a copy of it). Throws
+/// std::runtime_error naming the file, line and key (see parse_darknet_cfg, load_darknet_weights), or the unknown
+/// built-in name and the known ones.
+DarknetModel load_model(const std::string& cfg, const std::string& weights);
 
 /// Creates the backend `kind` ("opencl", "cpu" or "auto") for `model`. auto takes OpenCL when its
 /// device is a GPU; otherwise it times both backends on the model and takes the faster: OpenCL over 3

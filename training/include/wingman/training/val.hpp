@@ -16,7 +16,7 @@ namespace wingman::training {
 struct ValOptions {
   std::string data;             ///< data.yaml or YOLO-layout folder (required)
   std::string split = "val";    ///< the split to evaluate ("" = a folder's images/ without splits)
-  std::string cfg;              ///< Darknet .cfg; "" = the built-in thesis network
+  std::string cfg = "builtin:wingman-small";  ///< Darknet .cfg path or builtin:<name> (detector::load_model)
   std::string weights;          ///< run the detector with these .weights (exactly one of weights / predictions)
   std::string predictions;      ///< or read `wingman predict` output: <predictions>/<image stem>.txt per image
   std::string backend = "cpu";  ///< detector backend: auto, opencl or cpu
