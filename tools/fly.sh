@@ -5,29 +5,32 @@
 # namespace, in lockstep (deterministic). Records the bus, prints the localization and formation errors and writes an
 # HTML report. Needs a build (tools/build.sh); the README's main command (tools/demo.sh) builds first.
 #
-# Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--render|--no-render] [--record-images]
-#                     [--truth-box sphere|silhouette]
+# Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
+#                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
-#   --render         render the camera images (1280x720, ~0.5 s a frame on llvmpipe here); the default with a model
-#   --no-render      no images (ground-truth detections need none); the default without a model
+#   --detections     cnn: the detector process finds the leader in the rendered images with the shipped model
+#                    (default; WINGMAN_MODEL_CFG / WINGMAN_MODEL_WEIGHTS choose another); truth: the simulator
+#                    publishes boxes projected from ground truth (flagged as such in every message down to the
+#                    setpoints) and the detector runs without a model: measures localization and control alone
+#   --render         render the camera images (1280x720, 0.1-0.5 s a frame on llvmpipe here); always with cnn
+#   --no-render      no images (ground-truth detections need none); the default with truth
 #   --record-images  also record the camera images in the log (2.7 MB per 1280x720 frame)
 #   --truth-box      ground-truth detections: the bounding sphere's exact box, the localizer's model (default), or
 #                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
-# The detector uses the shipped trained model when models/ holds one (WINGMAN_MODEL_WEIGHTS overrides); without one,
-# the simulator publishes detections projected from ground truth, flagged as such in every message, and says so.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
-scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere
+scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --duration) duration="$2"; shift 2 ;;
+    --detections) detections="$2"; shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
     --record-images) record_images=true; shift ;;
@@ -39,6 +42,7 @@ done
 if [ -f "$scenario" ]; then scenario_file=$(realpath "$scenario"); name=$(basename "$scenario" .yaml)
 else scenario_file="$src/config/scenarios/$scenario.yaml"; name="$scenario"; fi
 case "$truth_box" in sphere|silhouette) ;; *) echo "fly: --truth-box '$truth_box': expected sphere or silhouette" >&2; exit 2 ;; esac
+case "$detections" in cnn|truth) ;; *) echo "fly: --detections '$detections': expected cnn or truth" >&2; exit 2 ;; esac
 [ -r "$scenario_file" ] || { echo "fly: no scenario '$scenario' (looked for $scenario_file)" >&2; exit 2; }
 out="${out:-$src/build/flights/$name}"
 for exe in wingman-sim wingman-detector wingman-localizer wingman-follower-ctrl wingman; do
@@ -46,7 +50,7 @@ for exe in wingman-sim wingman-detector wingman-localizer wingman-follower-ctrl 
 done
 
 if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
-  exec tools/netns_run.sh "$0" --scenario "$scenario_file" --out "$out" ${duration:+--duration "$duration"} \
+  exec tools/netns_run.sh "$0" --scenario "$scenario_file" --out "$out" ${duration:+--duration "$duration"} --detections "$detections" \
     $([ "$render" = true ] && echo --render) $([ "$render" = false ] && echo --no-render) $([ "$record_images" = true ] && echo --record-images) --truth-box "$truth_box"
 fi
 
@@ -56,21 +60,21 @@ url="$WINGMAN_LCM_URL"
 log="$out/flight.lcmlog"
 rm -f "$log"
 
-# A shipped model (issue 6 puts one in models/) makes the detector real; otherwise ground-truth detections.
-weights="${WINGMAN_MODEL_WEIGHTS:-}"
-if [ -z "$weights" ]; then weights=$(ls "$src"/models/*.weights 2>/dev/null | head -n 1 || true); fi
-if [ -n "$weights" ]; then
-  cfg="${weights%.weights}.cfg"
-  [ -r "$cfg" ] || { echo "fly: model $weights has no $cfg beside it" >&2; exit 2; }
+# The CNN: the detector's built-in shipped model (models/wingman-small.md) unless WINGMAN_MODEL_* name another.
+model_cfg="${WINGMAN_MODEL_CFG:-builtin:wingman-small}" model_weights="${WINGMAN_MODEL_WEIGHTS:-builtin:wingman-small}"
+if [ -n "${WINGMAN_MODEL_WEIGHTS:-}" ] && [ -z "${WINGMAN_MODEL_CFG:-}" ]; then
+  model_cfg="${model_weights%.weights}.cfg"
+  [ -r "$model_cfg" ] || { echo "fly: WINGMAN_MODEL_WEIGHTS=$model_weights has no $model_cfg beside it (set WINGMAN_MODEL_CFG)" >&2; exit 2; }
+fi
+if [ "$detections" = cnn ]; then
   truth_detections=false
-  [ "$render" = false ] && { echo "fly: a detector model needs images: drop --no-render" >&2; exit 2; }
+  [ "$render" = false ] && { echo "fly: --detections cnn needs images: drop --no-render" >&2; exit 2; }
   render=true
-  echo "fly: detections from the CNN: $weights"
+  echo "fly: detections from the CNN ($model_cfg, $model_weights) in rendered 1280x720 images"
 else
   truth_detections=true
-  echo "fly: no trained model in models/: detections come from the SIMULATOR'S GROUND TRUTH ($truth_box boxes," \
-       "1 px edge noise; flagged source=SOURCE_GROUND_TRUTH in detections, targets and setpoints); the detector" \
-       "process runs without weights"
+  echo "fly: detections come from the SIMULATOR'S GROUND TRUTH ($truth_box boxes, 1 px edge noise; flagged" \
+       "source=SOURCE_GROUND_TRUTH in detections, targets and setpoints); the detector process runs without a model"
   [ "$render" = auto ] && render=false
   [ "$render" = false ] && echo "fly: images are not rendered (ground-truth detections need none; --render renders them)"
 fi
@@ -84,11 +88,11 @@ sync: {mode: lockstep, timeout_s: 10.0, wait_for: [detector, localizer, follower
 detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0}
 render: {enabled: $render}
 YAML
-if [ -n "$weights" ]; then
+if [ "$detections" = cnn ]; then
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\n' \
-    "$cfg" "$weights" > "$out/detector.yaml"
+    "$model_cfg" "$model_weights" > "$out/detector.yaml"
 else
-  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\n' > "$out/detector.yaml"
+  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {weights: ""}\n' > "$out/detector.yaml"
 fi
 
 pids=() logger_pid=""

@@ -425,6 +425,21 @@ TEST(Eval, BoxWidthErrorSingleAndZoomAgainstTruthBox) {
   EXPECT_NEAR(r.box_widths[0].w_det_frac, 26.0 / 640, 1e-7);
   EXPECT_NEAR(r.box_widths[0].w_truth_frac, 20.0 / 640, 1e-7);
   EXPECT_NE(r.report().find("zoom-in"), std::string::npos);
+  // Detection by range: every frame has a box centred in the truth box; (300, 100) and (111, 100) are not in it.
+  ASSERT_EQ(r.detection_by_range.size(), 6u);
+  EXPECT_EQ(r.detection_by_range[1].visible, 2);
+  EXPECT_EQ(r.detection_by_range[1].detected, 2);
+  EXPECT_EQ(r.detection_by_range[4].visible, 2);
+  EXPECT_EQ(r.detection_by_range[4].detected, 2);
+  EXPECT_EQ(r.detection_by_range[0].visible + r.detection_by_range[2].visible + r.detection_by_range[3].visible +
+                r.detection_by_range[5].visible,
+            0);
+  EXPECT_EQ(r.detections_total, 8);
+  EXPECT_EQ(r.detections_outside_truth, 2);
+  EXPECT_NE(r.json().find("\"detection_by_range\": [{\"lo_m\": 0, \"hi_m\": 5, \"visible\": 0, \"detected\": 0}, "
+                          "{\"lo_m\": 5, \"hi_m\": 10, \"visible\": 2, \"detected\": 2}"),
+            std::string::npos)
+      << r.json();
 }
 
 /// An image_t of a 64 x 48 grey frame in `format`.

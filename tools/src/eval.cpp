@@ -152,6 +152,16 @@ std::string bins_json(const std::vector<RangeBin>& bins, bool fraction) {
   return s + "]";
 }
 
+std::string detection_bins_json(const std::vector<DetectionBin>& bins) {
+  std::string s = "[";
+  for (const auto& b : bins) {
+    s += fmt::format("{}{{\"lo_m\": {:g}, \"hi_m\": {}, \"visible\": {}, \"detected\": {}}}", s.size() > 1 ? ", " : "",
+                     b.lo_m, std::isinf(b.hi_m) ? std::string("null") : fmt::format("{:g}", b.hi_m), b.visible,
+                     b.detected);
+  }
+  return s + "]";
+}
+
 }  // namespace
 
 std::vector<std::string> EvalOptions::validate() const {
@@ -371,13 +381,37 @@ EvalResult evaluate_log(const EvalOptions& o) {
   // Box widths: the detection nearest the leader's truth box centre, among those centred inside it.
   Acc width_single, width_zoom;
   BinnedAcc width_single_bins(o.range_bins_m), width_zoom_bins(o.range_bins_m);
+  for (size_t i = 0; i <= o.range_bins_m.size(); ++i) {
+    r.detection_by_range.push_back({i == 0 ? 0.0 : o.range_bins_m[i - 1],
+                                    i < o.range_bins_m.size() ? o.range_bins_m[i] : kInf, 0, 0});
+  }
+  const auto inside = [](const wingman::detection_t& b, const wingman::truth_box_t& tb) {
+    return std::abs(b.cx - tb.cx) <= 0.5 * tb.w && std::abs(b.cy - tb.cy) <= 0.5 * tb.h;
+  };
   for (const auto& d : detections) {
     auto& frame = r.frames[d.utime];
     for (const auto& b : d.boxes) frame.detections.push_back({b.cx, b.cy, b.w, b.h, d.camera_id, b.zoom_refined != 0});
+    r.detections_total += static_cast<int64_t>(d.boxes.size());
     const auto boxes = truth_boxes_at.find(d.utime);
-    if (boxes == truth_boxes_at.end() || d.image_width <= 0) continue;
+    if (boxes == truth_boxes_at.end()) {
+      r.detections_outside_truth += static_cast<int64_t>(d.boxes.size());
+      continue;
+    }
+    for (const auto& b : d.boxes) {
+      bool in_any = false;
+      for (const auto& tb : boxes->second) in_any = in_any || (tb.visible && tb.camera_id == d.camera_id && inside(b, tb));
+      if (!in_any) ++r.detections_outside_truth;
+    }
+    if (d.image_width <= 0) continue;
     for (const auto& tb : boxes->second) {
       if (tb.vehicle_id != o.leader_id || tb.camera_id != d.camera_id || !tb.visible) continue;
+      {
+        size_t k = 0;
+        while (k < o.range_bins_m.size() && tb.range >= o.range_bins_m[k]) ++k;
+        ++r.detection_by_range[k].visible;
+        if (std::any_of(d.boxes.begin(), d.boxes.end(), [&](const auto& b) { return inside(b, tb); }))
+          ++r.detection_by_range[k].detected;
+      }
       for (const bool zoom : {false, true}) {
         const wingman::detection_t* nearest = nullptr;
         double nearest_d = kInf;
@@ -449,6 +483,14 @@ std::string EvalResult::report() const {
                    frames_leader_visible ? 100.0 * static_cast<double>(frames_leader_detected) /
                                                static_cast<double>(frames_leader_visible)
                                          : 0.0);
+  s += fmt::format("detected boxes: {}, of them {} centred in no visible truth box (false detections)\n",
+                   detections_total, detections_outside_truth);
+  for (const auto& b : detection_by_range) {
+    if (b.visible == 0) continue;
+    s += fmt::format("  leader detected at range {:<12} {:6.1f} % of {} frames\n",
+                     bin_name(RangeBin{b.lo_m, b.hi_m, {}}),
+                     100.0 * static_cast<double>(b.detected) / static_cast<double>(b.visible), b.visible);
+  }
   s += fmt::format("world targets: {} matched, {} false; {} track id(s) on the leader, {} id switch(es)\n",
                    target_estimates, false_targets, track_ids_on_leader, leader_id_switches);
   s += fmt::format("false tracks: {:.3f} false targets per second, {} distinct false track id(s)\n",
@@ -494,7 +536,8 @@ std::string EvalResult::json() const {
       "\"along_line_of_sight\": {}, \"across_line_of_sight\": {}, \"localization_by_range\": {}, "
       "\"formation_horizontal\": {}, \"formation_vertical\": {}, \"latency\": {}, \"inference_latency\": {}, "
       "\"box_width_single\": {}, \"box_width_zoom\": {}, \"box_width_single_by_range\": {}, "
-      "\"box_width_zoom_by_range\": {}}}",
+      "\"box_width_zoom_by_range\": {}, \"detection_by_range\": {}, \"detections_total\": {}, "
+      "\"detections_outside_truth\": {}}}",
       detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected, target_estimates,
       false_targets, false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches,
       stats_json(localization), stats_json(localization_axis[0]), stats_json(localization_axis[1]),
@@ -502,7 +545,8 @@ std::string EvalResult::json() const {
       bins_json(localization_by_range, false), stats_json(formation_horizontal), stats_json(formation_vertical),
       percentiles_json(latency_ms), percentiles_json(inference_latency_ms), fraction_json(box_width_single),
       fraction_json(box_width_zoom), bins_json(box_width_single_by_range, true),
-      bins_json(box_width_zoom_by_range, true));
+      bins_json(box_width_zoom_by_range, true), detection_bins_json(detection_by_range), detections_total,
+      detections_outside_truth);
 }
 
 std::string EvalResult::csv() const {

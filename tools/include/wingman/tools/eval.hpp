@@ -68,6 +68,15 @@ struct RangeBin {
   ErrorStats error;
 };
 
+/// Detection of the leader in the frames whose truth box range lies in [lo_m, hi_m): frames with a detections_t in
+/// which the leader's truth box is visible, and of those, frames with a detection centred inside that box.
+struct DetectionBin {
+  double lo_m = 0.0;
+  double hi_m = 0.0;
+  int64_t visible = 0;
+  int64_t detected = 0;
+};
+
 /// The measured errors of one flight.
 struct EvalResult {
   std::string detection_source;        ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
@@ -102,6 +111,9 @@ struct EvalResult {
   /// leader's visible truth box at the same utime and camera (of the detections whose centre lies inside the truth
   /// box, the one with the nearest centre). Single-pass boxes (zoom_refined false) and zoom-in boxes apart.
   ErrorStats box_width_single, box_width_zoom;
+  std::vector<DetectionBin> detection_by_range;  ///< leader detection rate by truth range (range_bins_m edges)
+  int64_t detections_outside_truth = 0;          ///< detected boxes whose centre lies in no visible truth box
+  int64_t detections_total = 0;                  ///< detected boxes in all detections_t
   std::vector<RangeBin> box_width_single_by_range, box_width_zoom_by_range;  ///< the same, binned by truth box range
 
   /// Time series (seconds since the first ground truth).
