@@ -6,7 +6,8 @@
 # HTML report. Needs a build (tools/build.sh); the README's main command (tools/demo.sh) builds first.
 #
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
-#                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette]
+#                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
+#                     [--localizer-config FILE] [--quiet-eval]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -19,23 +20,28 @@
 #   --record-images  also record the camera images in the log (2.7 MB per 1280x720 frame)
 #   --truth-box      ground-truth detections: the bounding sphere's exact box, the localizer's model (default), or
 #                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
+#   --zoom-in        the detector re-detects each box in a full-resolution crop (Algorithm 2's zoom-in)
+#   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any, else defaults)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
+zoom_in=false localizer_config=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --duration) duration="$2"; shift 2 ;;
     --detections) detections="$2"; shift 2 ;;
+    --zoom-in) zoom_in=true; shift ;;
+    --localizer-config) localizer_config=$(realpath "$2"); shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
     --record-images) record_images=true; shift ;;
     --truth-box) truth_box="$2"; shift 2 ;;
-    -h|--help) sed -n 3,19p "$0"; exit 0 ;;
+    -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "fly: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -51,8 +57,10 @@ done
 
 if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   exec tools/netns_run.sh "$0" --scenario "$scenario_file" --out "$out" ${duration:+--duration "$duration"} --detections "$detections" \
-    $([ "$render" = true ] && echo --render) $([ "$render" = false ] && echo --no-render) $([ "$record_images" = true ] && echo --record-images) --truth-box "$truth_box"
+    $([ "$render" = true ] && echo --render) $([ "$render" = false ] && echo --no-render) $([ "$record_images" = true ] && echo --record-images) --truth-box "$truth_box" \
+    $([ "$zoom_in" = true ] && echo --zoom-in) ${localizer_config:+--localizer-config "$localizer_config"}
 fi
+[ -z "$localizer_config" ] || [ -r "$localizer_config" ] || { echo "fly: --localizer-config $localizer_config: cannot read it" >&2; exit 2; }
 
 mkdir -p "$out"
 out=$(realpath "$out")
@@ -89,8 +97,8 @@ detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.
 render: {enabled: $render}
 YAML
 if [ "$detections" = cnn ]; then
-  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\n' \
-    "$model_cfg" "$model_weights" > "$out/detector.yaml"
+  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s}\n' \
+    "$model_cfg" "$model_weights" "$zoom_in" > "$out/detector.yaml"
 else
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {weights: ""}\n' > "$out/detector.yaml"
 fi
@@ -110,7 +118,7 @@ logger_args=(--lcm-url="$url" --force --quiet)
 lcm-logger "${logger_args[@]}" "$log" & logger_pid=$!
 "$bin/wingman-detector" --lcm-url "$url" --config "$out/detector.yaml" --log-level warn & pids+=($!)
 # shellcheck disable=SC2046
-"$bin/wingman-localizer" --lcm-url "$url" $(flight_cfg localizer) --log-level warn & pids+=($!)
+"$bin/wingman-localizer" --lcm-url "$url" $( [ -n "$localizer_config" ] && echo "--config $localizer_config" || flight_cfg localizer) --log-level warn & pids+=($!)
 # shellcheck disable=SC2046
 "$bin/wingman-follower-ctrl" --lcm-url "$url" $(flight_cfg follower_ctrl) --log-level warn & pids+=($!)
 

@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# The thesis's experiments, reproduced in simulation with the shipped detector model and the real processes (each
+# flight is tools/fly.sh: wingman-sim renders 1280x720 images; wingman-detector, -localizer and -follower-ctrl run as
+# separate processes on LCM in a private network namespace, in lockstep). Each experiment writes its flights (log,
+# eval.json, report.html), a results.json and a results.md table with the thesis's figures beside ours, in
+# build/experiments/NAME/ (docs/results.md collects them).
+#
+# Usage: tools/experiment.sh NAME [--quick] [--out DIR]
+#   NAME           static_sweep  box width error over distance, single pass vs zoom-in (thesis Fig. 13)
+#                  distance      distance error on a fast-moving leader: single, zoom-in, zoom-in filtered (Table 3)
+#                  follow_1d     the 1-D PID follow (thesis section 5.3)
+#                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
+#                  max_range     the farthest range at which the detector still finds an F450-sized drone at 1280x720
+#                  all           all of them, one after the other
+#   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
+#   --out DIR      output folder (default build/experiments)
+# Lengths (rendering takes 0.1-0.2 s a frame here): static_sweep 2 x 1190 frames, distance 3 x 30 s, follow_1d 60 s,
+# formation_2d 3 x 40 s, max_range 1010 frames; about 25 min in all on the 2-core development VM.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+src=$(pwd)
+bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
+name="${1:-}"
+[ -n "$name" ] || { sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 2; }
+shift
+quick=false out_root="$src/build/experiments"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) quick=true; shift ;;
+    --out) out_root="$2"; shift 2 ;;
+    -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
+    *) echo "experiment: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+export PYENV_VERSION=system WINGMAN_BIN_DIR="$bin"
+py() { python3 "$src/tools/experiment_summary.py" "$@"; }
+
+# A copy of a scenario with some top-level or motion keys replaced (sed expressions), named like the original so that
+# fly.sh finds its config/flights/NAME.* files.
+scenario_variant() {  # dir scenario sed-expression...
+  local dir="$1" scn="$2"; shift 2
+  mkdir -p "$dir"
+  local args=()
+  for e in "$@"; do args+=(-e "$e"); done
+  sed "${args[@]}" "$src/config/scenarios/$scn.yaml" > "$dir/$scn.yaml"
+  echo "$dir/$scn.yaml"
+}
+
+fly() {  # out-dir fly.sh-arguments...
+  local dir="$1"; shift
+  echo "experiment: flying $(basename "$dir") ..." >&2
+  if ! WINGMAN_BIN_DIR="$bin" tools/fly.sh --out "$dir" "$@" > "$dir.log" 2>&1; then
+    tail -20 "$dir.log" >&2
+    echo "experiment: the flight $(basename "$dir") failed (log: $dir.log)" >&2
+    exit 1
+  fi
+}
+
+static_sweep() {
+  local out="$out_root/static_sweep" fps=10; $quick && fps=2
+  rm -rf "$out"; mkdir -p "$out"
+  # The thesis: a hovering drone seen from the side from 0.5 to 30 m; 10 frames per 0.25 m step.
+  local scn; scn=$(scenario_variant "$out/scenario" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/")
+  fly "$out/single" --scenario "$scn"
+  fly "$out/zoom" --scenario "$scn" --zoom-in
+  py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json"
+}
+
+distance() {
+  local out="$out_root/distance" dur=30; $quick && dur=4
+  rm -rf "$out"; mkdir -p "$out"
+  # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
+  printf 'tracker: {mode: sliding_window, window_size: 1}\n' > "$out/raw.localizer.yaml"
+  printf 'tracker: {mode: sliding_window, window_size: 5}\n' > "$out/window5.localizer.yaml"
+  fly "$out/single" --scenario fast_target --duration "$dur" --localizer-config "$out/raw.localizer.yaml"
+  fly "$out/zoom" --scenario fast_target --duration "$dur" --zoom-in --localizer-config "$out/raw.localizer.yaml"
+  fly "$out/zoom_window5" --scenario fast_target --duration "$dur" --zoom-in \
+    --localizer-config "$out/window5.localizer.yaml"
+  fly "$out/zoom_kalman" --scenario fast_target --duration "$dur" --zoom-in
+  py distance "$out" "$out/single/eval.json" "$out/zoom/eval.json" "$out/zoom_window5/eval.json" \
+    "$out/zoom_kalman/eval.json"
+}
+
+follow_1d() {
+  local out="$out_root/follow_1d" dur=60; $quick && dur=4
+  rm -rf "$out"; mkdir -p "$out"
+  fly "$out/run" --scenario follow_1d --duration "$dur"
+  py follow_1d "$out" "$out/run/eval.json"
+}
+
+formation_2d() {
+  local out="$out_root/formation_2d" dur=40; $quick && dur=4
+  rm -rf "$out"; mkdir -p "$out"
+  local runs=()
+  for seed in 1 2 3; do
+    local scn; scn=$(scenario_variant "$out/scenario$seed" formation_2d "s/^seed: .*/seed: $seed/")
+    fly "$out/run$seed" --scenario "$scn" --duration "$dur"
+    runs+=("$out/run$seed/eval.json")
+  done
+  py formation_2d "$out" "${runs[@]}"
+}
+
+max_range() {
+  local out="$out_root/max_range" fps=10; $quick && fps=2
+  rm -rf "$out"; mkdir -p "$out"
+  # The static sweep carried on to 60 m in 0.5 m steps from 10 m, an F450-sized quad (the default airframe).
+  local scn; scn=$(scenario_variant "$out/scenario" static_sweep \
+    "s/frames_per_step: 100/frames_per_step: $fps/" "s/position: \[0, -0.5, 5\]/position: [0, -10, 5]/" \
+    "s/step: \[0, -0.25, 0\]/step: [0, -0.5, 0]/" "s/steps: 119 /steps: 100 /")
+  fly "$out/single" --scenario "$scn"
+  py max_range "$out" "$out/single/eval.json"
+}
+
+case "$name" in
+  static_sweep|distance|follow_1d|formation_2d|max_range) "$name" ;;
+  all) static_sweep; distance; follow_1d; formation_2d; max_range ;;
+  *) echo "experiment: unknown experiment '$name' (see --help)" >&2; exit 2 ;;
+esac
+echo "experiment: results in $out_root" >&2

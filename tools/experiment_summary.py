@@ -1,0 +1,165 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Summaries of tools/experiment.sh: reads the flights' eval.json (wingman eval) and writes results.json and
+results.md (a table with the thesis's figures beside ours) in the experiment's folder. Standard library only.
+
+Usage: experiment_summary.py KIND OUT_DIR EVAL_JSON...   (KIND: static_sweep, distance, follow_1d, formation_2d,
+max_range). The thesis's figures are quoted from its text (Fig. 13, Tables 3 and 4, sections 5.3 and 5.5)."""
+import json
+import os
+import subprocess
+import sys
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        sys.exit(f"experiment_summary: cannot read {path}: {e}")
+
+
+def write(out, kind, data, lines):
+    data = {"experiment": kind, **data}
+    with open(os.path.join(out, "results.json"), "w") as f:
+        json.dump(data, f, indent=2)
+    with open(os.path.join(out, "results.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def rate(r):
+    v = r["frames_leader_visible"]
+    return r["frames_leader_detected"] / v if v else 0.0
+
+
+def common_row(r):
+    """Detection and latency figures every flight has."""
+    return {
+        "detection_rate": rate(r),
+        "false_detections": r.get("detections_outside_truth", 0),
+        "detections": r.get("detections_total", 0),
+        "track_ids_on_leader": r["track_ids_on_leader"],
+        "false_targets": r["false_targets"],
+        "latency_p50_ms": r["latency"]["p50_ms"],
+        "latency_p90_ms": r["latency"]["p90_ms"],
+        "inference_p50_ms": r["inference_latency"]["p50_ms"],
+        "duration_s": r["duration_s"],
+        "detection_source": r["detection_source"],
+    }
+
+
+def static_sweep(out, single, zoom):
+    s, z = load(single), load(zoom)
+    bins = []
+    for bs, bz in zip(s["box_width_single_by_range"], z["box_width_zoom_by_range"]):
+        bins.append({"lo_m": bs["lo_m"], "hi_m": bs["hi_m"], "single": bs["error"], "zoom": bz["error"]})
+    data = {"single": {"box_width_error": s["box_width_single"], **common_row(s)},
+            "zoom": {"box_width_error": z["box_width_zoom"], **common_row(z)}, "by_range": bins,
+            "thesis": {"single_mean": 0.026, "zoom_mean": 0.007}}
+    f = lambda e: f"{e['mean']:.4f} (n = {e['n']})" if e["n"] else "no detections"
+    lines = ["| box width error, mean abs., fraction of image width | thesis (Fig. 13) | ours |", "|---|---|---|",
+             f"| single detection | 0.026 | {f(s['box_width_single'])} |",
+             f"| zoom-in re-detection | 0.007 | {f(z['box_width_zoom'])} |",
+             f"| reduction | −73 % | {pct_reduction(s['box_width_single'], z['box_width_zoom'])} |",
+             "", "| truth range | single | zoom-in |", "|---|---|---|"]
+    for b in bins:
+        hi = "+" if b["hi_m"] is None else f"–{b['hi_m']:g}"
+        lines.append(f"| {b['lo_m']:g}{hi} m | {f(b['single'])} | {f(b['zoom'])} |")
+    lines += ["", f"Leader detected in {100 * rate(s):.1f} % (single) and {100 * rate(z):.1f} % (zoom-in) of the "
+              f"frames; median inference {s['inference_latency']['p50_ms']:.1f} ms single, "
+              f"{z['inference_latency']['p50_ms']:.1f} ms with zoom-in."]
+    write(out, "static_sweep", data, lines)
+
+
+def pct_reduction(a, b):
+    if not a["n"] or not b["n"] or a["mean"] <= 0:
+        return "—"
+    return f"{100 * (b['mean'] - a['mean']) / a['mean']:+.0f} %"
+
+
+def distance(out, single, zoom, window5, kalman):
+    runs = [("single detection, unfiltered", load(single), "1.59 / 19.77"),
+            ("zoom-in, unfiltered", load(zoom), "1.49 / 11.18"),
+            ("zoom-in, filtered (sliding window of 5, the thesis's filter)", load(window5), "1.43 / 11.19"),
+            ("zoom-in, Kalman tracker (ours, default)", load(kalman), "—")]
+    data = {"runs": {}}
+    lines = ["| distance error along the line of sight, mean abs. / max (m) | thesis (Table 3, recorded data) | ours "
+             "(simulated, fast leader) | leader detected | 3-D RMS (m) |", "|---|---|---|---|---|"]
+    for label, r, thesis in runs:
+        a = r["along_line_of_sight"]
+        data["runs"][label] = {"along_line_of_sight": a, "localization": r["localization"], **common_row(r)}
+        ours = f"{a['mean_m']:.2f} / {a['max_m']:.2f}" if a["n"] else "no targets"
+        lines.append(f"| {label} | {thesis} | {ours} | {100 * rate(r):.0f} % | {r['localization']['rms_m']:.2f} |")
+    write(out, "distance", data, lines)
+
+
+def follow_1d(out, run):
+    r = load(run)
+    fh = r["formation_horizontal"]
+    data = {"error_along_x": fh, **common_row(r), "thesis": {"mean_abs_m": 1.12, "max_m": 4.34, "lost_after_s": 180}}
+    lost = "never lost" if r["track_ids_on_leader"] == 1 and rate(r) > 0.95 else \
+        f"{r['track_ids_on_leader']} track ids, detected in {100 * rate(r):.0f} % of frames"
+    lines = ["| 1-D follow | thesis (real flight) | ours (simulation) |", "|---|---|---|",
+             f"| mean absolute X error | 1.12 m | {fh['mean_m']:.3f} m |",
+             f"| maximum X error | 4.34 m | {fh['max_m']:.3f} m |",
+             f"| leader kept | lost after 180 s | {lost} over {r['duration_s']:.0f} s |",
+             f"| localization RMS | — | {r['localization']['rms_m']:.3f} m |",
+             f"| latency exposure → target, median | ≈ 0.7 s | {r['latency']['p50_ms']:.0f} ms |"]
+    write(out, "follow_1d", data, lines)
+
+
+def formation_2d(out, *runs):
+    rs = [load(p) for p in runs]
+    thesis = [3.88, 2.02, 2.80]
+    data = {"runs": [], "thesis_rms_m": thesis}
+    lines = ["| run | thesis RMS localization error (m) | ours: RMS localization (m) | x / y / z RMS (m) | along / "
+             "across line of sight RMS (m) | formation RMS (m) | leader detected | latency p50 (ms) |",
+             "|---|---|---|---|---|---|---|---|"]
+    for i, r in enumerate(rs):
+        loc = r["localization"]
+        data["runs"].append({"localization": loc, "formation_horizontal": r["formation_horizontal"],
+                             "axes": [r["localization_x"], r["localization_y"], r["localization_z"]],
+                             "along": r["along_line_of_sight"], "across": r["across_line_of_sight"], **common_row(r)})
+        axes = " / ".join(f"{r[k]['rms_m']:.2f}" for k in ("localization_x", "localization_y", "localization_z"))
+        lines.append(f"| {i + 1} | {thesis[i]:.2f} | {loc['rms_m']:.3f} (n = {loc['n']}) | {axes} | "
+                     f"{r['along_line_of_sight']['rms_m']:.2f} / {r['across_line_of_sight']['rms_m']:.2f} | "
+                     f"{r['formation_horizontal']['rms_m']:.3f} | {100 * rate(r):.0f} % | "
+                     f"{r['latency']['p50_ms']:.0f} |")
+    avg = sum(r["localization"]["rms_m"] for r in rs) / len(rs)
+    data["average_rms_m"] = avg
+    lines.append(f"| average | 2.86 | {avg:.3f} | | | | | |")
+    write(out, "formation_2d", data, lines)
+
+
+def max_range(out, run):
+    r = load(run)
+    log = os.path.join(os.path.dirname(run), "flight.lcmlog")
+    edges = [10 + 2.5 * k for k in range(1, 21)]  # 12.5 .. 60 m
+    wingman = os.path.join(os.environ.get("WINGMAN_BIN_DIR", "build/bin"), "wingman")
+    fine = json.loads(subprocess.run([wingman, "eval", log, "--json-stdout", "--quiet", "--range-bins",
+                                      ",".join(f"{e:g}" for e in edges)], check=True, capture_output=True,
+                                     text=True).stdout)
+    bins = [b for b in fine["detection_by_range"] if b["visible"]]
+    reach = 0.0
+    for b in bins:
+        if b["detected"] / b["visible"] >= 0.5 and b["hi_m"] is not None:
+            reach = max(reach, b["hi_m"])
+    data = {"bins": bins, "max_range_m": reach, "criterion": "farthest 2.5 m bin with the leader detected in >= 50 % "
+            "of its frames", **common_row(r), "thesis_m": 13.75}
+    lines = ["| maximum detection range, F450-sized quad, 1280×720 | thesis (simulation) | ours |", "|---|---|---|",
+             f"| farthest 2.5 m bin with ≥ 50 % of frames detected | ≈ 13.75 m | {reach:g} m |", "",
+             "| truth range | frames | detected |", "|---|---|---|"]
+    for b in bins:
+        hi = "+" if b["hi_m"] is None else f"–{b['hi_m']:g}"
+        lines.append(f"| {b['lo_m']:g}{hi} m | {b['visible']} | {100 * b['detected'] / b['visible']:.0f} % |")
+    write(out, "max_range", data, lines)
+
+
+KINDS = {"static_sweep": (static_sweep, 2), "distance": (distance, 4), "follow_1d": (follow_1d, 1),
+         "formation_2d": (formation_2d, 3), "max_range": (max_range, 1)}
+
+if __name__ == "__main__":
+    if len(sys.argv) < 3 or sys.argv[1] not in KINDS or len(sys.argv) - 3 != KINDS[sys.argv[1]][1]:
+        sys.exit(__doc__)
+    KINDS[sys.argv[1]][0](*sys.argv[2:])
