@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# tools/experiment_summary.py on real `wingman eval` output: a synthetic flight log (wingman-write-report-flight,
+# fixed seed) is evaluated, and every experiment's summary is made from it; the tables must carry the eval's numbers
+# beside the thesis's figures.
+# Usage: experiment_summary_test.sh SOURCE_DIR WINGMAN WRITE_REPORT_FLIGHT
+set -euo pipefail
+src="$1" wingman="$2" write_flight="$3"
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+fail() { echo "experiment_summary_test: FAIL: $*" >&2; exit 1; }
+export PYENV_VERSION=system WINGMAN_BIN_DIR=$(dirname "$wingman")
+summary="$src/tools/experiment_summary.py"
+
+mkdir -p "$work/run"
+"$write_flight" "$work/run/flight.lcmlog"
+"$wingman" eval "$work/run/flight.lcmlog" --json "$work/run/eval.json" --quiet > /dev/null
+run="$work/run/eval.json"
+val() { python3 -c "import json,sys; r=json.load(open('$1')); print(eval(sys.argv[1]))" "$2"; }
+
+for kind in static_sweep distance follow_1d formation_2d max_range; do mkdir -p "$work/$kind"; done
+python3 "$summary" static_sweep "$work/static_sweep" "$run" "$run" > /dev/null
+python3 "$summary" distance "$work/distance" "$run" "$run" "$run" "$run" > /dev/null
+python3 "$summary" follow_1d "$work/follow_1d" "$run" > /dev/null
+python3 "$summary" formation_2d "$work/formation_2d" "$run" "$run" "$run" > /dev/null
+python3 "$summary" max_range "$work/max_range" "$run" > /dev/null
+
+# Formation: the average of three identical runs is the run's RMS; the thesis's column is there.
+rms=$(val "$run" "r['localization']['rms_m']")
+avg=$(val "$work/formation_2d/results.json" "r['average_rms_m']")
+python3 -c "import sys; sys.exit(0 if abs($rms - $avg) < 1e-9 and $rms > 0 else 1)" || fail "average $avg != run $rms"
+grep -q "^| average | 2.86 | $(printf '%.3f' "$rms") |" "$work/formation_2d/results.md" || fail "formation table: $(cat "$work/formation_2d/results.md")"
+# Static sweep: the single-pass mean box-width error of the eval, as a fraction of the width.
+single=$(val "$run" "'%.4f' % r['box_width_single']['mean']")
+grep -q "^| single detection | 0.026 | $single (n = " "$work/static_sweep/results.md" || fail "sweep table: $(cat "$work/static_sweep/results.md")"
+# Distance: the along-the-line-of-sight mean and max.
+along=$(val "$run" "'%.2f / %.2f' % (r['along_line_of_sight']['mean_m'], r['along_line_of_sight']['max_m'])")
+grep -q "^| single detection, unfiltered | 1.59 / 19.77 | $along |" "$work/distance/results.md" || fail "distance table: $(cat "$work/distance/results.md")"
+# 1-D follow and max range: the tables exist with the thesis's figures.
+grep -q "^| mean absolute X error | 1.12 m |" "$work/follow_1d/results.md" || fail "follow table"
+grep -q "≈ 13.75 m" "$work/max_range/results.md" || fail "range table"
+python3 -c "import json; r=json.load(open('$work/max_range/results.json')); assert r['bins'] and sum(b['visible'] for b in r['bins']) > 0" || fail "max_range has no bins"
+# Wrong arguments: the usage, not a traceback.
+if python3 "$summary" formation_2d "$work" "$run" 2> "$work/err"; then fail "two runs accepted"; fi
+grep -q "Usage" "$work/err" || fail "no usage on bad arguments: $(cat "$work/err")"
+if python3 "$summary" follow_1d "$work" "$work/missing.json" 2> "$work/err"; then fail "missing file accepted"; fi
+grep -q "missing.json" "$work/err" || fail "missing file not named: $(cat "$work/err")"
+echo "experiment_summary_test: ok"
