@@ -41,31 +41,40 @@ double median(std::vector<double> v) {
 std::vector<std::string> builtin_cfg_names() { return {"wingman-small", "tiny-yolo-thesis"}; }
 std::vector<std::string> builtin_weights_names() { return {"wingman-small"}; }
 
-DarknetModel load_model(const std::string& cfg, const std::string& weights) {
+namespace {
+
+std::string builtin_name(const std::string& s) {
   const std::string prefix = kBuiltinPrefix;
-  const auto builtin = [&prefix](const std::string& s) { return s.rfind(prefix, 0) == 0 ? s.substr(prefix.size()) : ""; };
-  const auto known = [&prefix](const std::vector<std::string>& names) {
-    std::string s;
-    for (const auto& n : names) s += (s.empty() ? "" : ", ") + prefix + n;
-    return s;
-  };
-  DarknetModel model;
-  const std::string cfg_name = builtin(cfg);
+  return s.rfind(prefix, 0) == 0 ? s.substr(prefix.size()) : "";
+}
+
+std::string known_names(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + std::string(kBuiltinPrefix) + n;
+  return s;
+}
+
+}  // namespace
+
+DarknetModel load_cfg(const std::string& cfg) {
+  const std::string name = builtin_name(cfg);
   if (cfg.empty()) {
     throw std::runtime_error("model.cfg is empty: expected a Darknet .cfg path or one of " +
-                             known(builtin_cfg_names()));
-  } else if (cfg_name == "wingman-small") {
-    model = parse_darknet_cfg_string(builtin_small_cfg(), "<built-in wingman-small.cfg>");
-  } else if (cfg_name == "tiny-yolo-thesis") {
-    model = parse_darknet_cfg_string(builtin_thesis_cfg(), "<built-in tiny-yolo-thesis.cfg>");
-  } else if (!cfg_name.empty()) {
-    throw std::runtime_error("model.cfg = '" + cfg + "': no such built-in network; expected one of " +
-                             known(builtin_cfg_names()) + " or a .cfg path");
-  } else {
-    model = parse_darknet_cfg(cfg);
+                             known_names(builtin_cfg_names()));
   }
-  const std::string weights_name = builtin(weights);
-  if (weights_name == "wingman-small") {
+  if (name == "wingman-small") return parse_darknet_cfg_string(builtin_small_cfg(), "<built-in wingman-small.cfg>");
+  if (name == "tiny-yolo-thesis")
+    return parse_darknet_cfg_string(builtin_thesis_cfg(), "<built-in tiny-yolo-thesis.cfg>");
+  if (!name.empty()) {
+    throw std::runtime_error("model.cfg = '" + cfg + "': no such built-in network; expected one of " +
+                             known_names(builtin_cfg_names()) + " or a .cfg path");
+  }
+  return parse_darknet_cfg(cfg);
+}
+
+void load_weights(DarknetModel& model, const std::string& weights) {
+  const std::string name = builtin_name(weights);
+  if (name == "wingman-small") {
     const std::vector<char> bytes = builtin_small_weights();
     if (bytes.empty()) {
       throw std::runtime_error(
@@ -73,12 +82,17 @@ DarknetModel load_model(const std::string& cfg, const std::string& weights) {
           "was absent when it was built); give a .weights path");
     }
     load_darknet_weights_from_buffer(model, bytes, "<built-in wingman-small.weights>");
-  } else if (!weights_name.empty()) {
+  } else if (!name.empty()) {
     throw std::runtime_error("model.weights = '" + weights + "': no such built-in model; expected " +
-                             known(builtin_weights_names()) + " or a .weights path");
+                             known_names(builtin_weights_names()) + " or a .weights path");
   } else {
     load_darknet_weights(model, weights);
   }
+}
+
+DarknetModel load_model(const std::string& cfg, const std::string& weights) {
+  DarknetModel model = load_cfg(cfg);
+  load_weights(model, weights);
   return model;
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `wingman bench detector`: the thesis network per frame on OpenCL, CpuBackend and bare OpenCV DNN; the pipeline.
+// `wingman bench detector`: a network (default: the thesis network) per frame on OpenCL, CpuBackend and bare OpenCV DNN; the pipeline.
 #include "wingman/tools/bench.hpp"
 
 #include <fmt/format.h>
@@ -66,17 +66,16 @@ std::string cpu_model_name() {
   return "(unknown)";
 }
 
-/// The thesis network at `size` x `size`: the built-in cfg with [net] width/height changed.
+/// The network (`o.cfg`, the thesis network by default) at `size` x `size`: its cfg with [net] width/height changed.
 DarknetModel thesis_model(int size, const BenchDetectorOptions& o) {
-  DarknetModel m =
-      detector::parse_darknet_cfg_string(detector::builtin_thesis_cfg(), "<built-in tiny-yolo-thesis.cfg>");
+  DarknetModel m = detector::load_cfg(o.cfg);
   m.net.width = size;
   m.net.height = size;
   detector::compute_shapes(m);
   if (o.weights.empty())
     detector::randomize_weights(m, o.seed);
   else
-    detector::load_darknet_weights(m, o.weights);
+    detector::load_weights(m, o.weights);
   return m;
 }
 
@@ -202,6 +201,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
   report.stream_width = o.stream_width;
   report.stream_height = o.stream_height;
   report.weights = o.weights.empty() ? fmt::format("random (seed {})", o.seed) : o.weights;
+  report.cfg = o.cfg;
   MachineInfo& m = report.machine;
   m.cpu_model = cpu_model_name();
   m.cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -433,7 +433,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
 
 std::string BenchDetectorReport::table() const {
   std::ostringstream s;
-  s << "wingman bench detector: thesis network (built-in cfg), weights " << weights << "\n";
+  s << "wingman bench detector: network " << cfg << ", weights " << weights << "\n";
   s << fmt::format("machine: {}, {} cores; OpenCV {}\n", machine.cpu_model, machine.cores, machine.opencv_version);
   for (const auto& d : machine.opencl_devices) s << "OpenCL device: " << d << "\n";
   s << fmt::format("POCL_AFFINITY={}  POCL_MAX_PTHREAD_COUNT={}\n", machine.pocl_affinity,
@@ -499,7 +499,7 @@ std::string BenchDetectorReport::table() const {
 
 std::string BenchDetectorReport::json() const {
   std::ostringstream s;
-  s << "{\"benchmark\": \"detector\", \"weights\": " << json_string(weights) << ", \"repetitions\": " << repetitions
+  s << "{\"benchmark\": \"detector\", \"cfg\": " << json_string(cfg) << ", \"weights\": " << json_string(weights) << ", \"repetitions\": " << repetitions
     << ", \"warmup\": " << warmup << ", \"stream\": [" << stream_width << ", " << stream_height
     << "],\n \"machine\": {\"cpu_model\": " << json_string(machine.cpu_model) << ", \"cores\": " << machine.cores
     << ", \"opencl_devices\": [";

@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
   auto* be = app.add_subcommand("bench", "Benchmarks (numbers, not tests)");
   be->require_subcommand(1);
   auto* bd = be->add_subcommand(
-      "detector", "Thesis network per frame: OpenCL vs CpuBackend vs bare OpenCV DNN, and the whole pipeline");
+      "detector", "A network (default: the thesis network) per frame: OpenCL vs CpuBackend vs bare OpenCV DNN, and the whole pipeline");
   bd->add_option("--sizes", bench_detector.sizes, "Network input sizes, multiples of 32 (default 416,320,256)")
       ->delimiter(',');
   bd->add_option("--threads", bench_detector.threads,
@@ -160,7 +160,10 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   bd->add_option("--repetitions", bench_detector.repetitions, "Timed runs per row (default 7)");
   bd->add_option("--warmup", bench_detector.warmup, "Untimed runs before each row (default 2)");
-  bd->add_option("--weights", bench_detector.weights, "Darknet .weights (default: random weights, fixed seed)");
+  bd->add_option("--cfg", bench_detector.cfg,
+                 "Network: a .cfg or builtin:tiny-yolo-thesis (default) or builtin:wingman-small (the shipped model)");
+  bd->add_option("--weights", bench_detector.weights,
+                 "Darknet .weights or builtin:wingman-small (default: random weights, fixed seed)");
   bd->add_option("--seed", bench_detector.seed, "Seed of the random weights (default 42)");
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 

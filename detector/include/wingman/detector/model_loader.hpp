@@ -36,6 +36,12 @@ std::vector<std::string> builtin_weights_names();
 /// built-in name and the known ones.
 DarknetModel load_model(const std::string& cfg, const std::string& weights);
 
+/// The .cfg half of load_model: a path or "builtin:<name>".
+DarknetModel load_cfg(const std::string& cfg);
+
+/// The .weights half of load_model: a path or "builtin:wingman-small", into `model` (shapes computed).
+void load_weights(DarknetModel& model, const std::string& weights);
+
 /// Creates the backend `kind` ("opencl", "cpu" or "auto") for `model`. auto takes OpenCL when its
 /// device is a GPU; otherwise it times both backends on the model and takes the faster: OpenCL over 3
 /// forwards after a warm-up, the CPU backend over 1 after a warm-up, or 3 when that one is within 1.5x

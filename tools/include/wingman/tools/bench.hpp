@@ -16,7 +16,8 @@ struct BenchDetectorOptions {
   int repetitions = 7;                    ///< timed runs per measurement (median/min/max over these), >= 1
   int warmup = 2;                         ///< untimed runs before each measurement, >= 0
   bool json = false;                      ///< print one JSON object instead of the table
-  std::string weights;                    ///< Darknet .weights for the thesis network; "" = random weights, `seed`
+  std::string cfg = "builtin:tiny-yolo-thesis";  ///< network: a .cfg path or builtin:<name> (detector::load_model)
+  std::string weights;                    ///< Darknet .weights (path or builtin:<name>); "" = random weights, `seed`
   uint32_t seed = 42;                     ///< seed of the random weights
   int stream_width = 1280;                ///< width of the synthetic BGR stream for the pipeline, pixels, >= 32
   int stream_height = 720;                ///< height of the synthetic BGR stream for the pipeline, pixels, >= 32
@@ -87,6 +88,7 @@ struct MachineInfo {
 /// Everything one `wingman bench detector` run measured.
 struct BenchDetectorReport {
   MachineInfo machine;
+  std::string cfg;      ///< the network's cfg (path or builtin:<name>)
   std::string weights;  ///< "random (seed N)" or the .weights path
   int repetitions = 0;
   int warmup = 0;
