@@ -62,8 +62,10 @@ static_sweep() {
   rm -rf "$out"; mkdir -p "$out"
   # The thesis: a hovering drone seen from the side from 0.5 to 30 m; 10 frames per 0.25 m step.
   local scn; scn=$(scenario_variant "$out/scenario" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/")
-  fly "$out/single" --scenario "$scn"
-  fly "$out/zoom" --scenario "$scn" --zoom-in
+  # The bounding sphere's own radius (the default quad's), so that the sweep measures the boxes' range scale.
+  printf 'target: {radius_m: 0.348}\n' > "$out/sphere.localizer.yaml"
+  fly "$out/single" --scenario "$scn" --localizer-config "$out/sphere.localizer.yaml"
+  fly "$out/zoom" --scenario "$scn" --zoom-in --localizer-config "$out/sphere.localizer.yaml"
   py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json"
 }
 
@@ -71,8 +73,9 @@ distance() {
   local out="$out_root/distance" dur=30; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
-  printf 'tracker: {mode: sliding_window, window_size: 1}\n' > "$out/raw.localizer.yaml"
-  printf 'tracker: {mode: sliding_window, window_size: 5}\n' > "$out/window5.localizer.yaml"
+  local calibration="$src/config/flights/cnn.localizer.yaml"
+  { cat "$calibration"; printf 'tracker: {mode: sliding_window, window_size: 1}\n'; } > "$out/raw.localizer.yaml"
+  { cat "$calibration"; printf 'tracker: {mode: sliding_window, window_size: 5}\n'; } > "$out/window5.localizer.yaml"
   fly "$out/single" --scenario fast_target --duration "$dur" --localizer-config "$out/raw.localizer.yaml"
   fly "$out/zoom" --scenario fast_target --duration "$dur" --zoom-in --localizer-config "$out/raw.localizer.yaml"
   fly "$out/zoom_window5" --scenario fast_target --duration "$dur" --zoom-in \

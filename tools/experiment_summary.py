@@ -49,14 +49,33 @@ def common_row(r):
     }
 
 
+def range_scale(csv_path, lo=2.0, hi=20.0):
+    """Median of true range / the localizer's range over the leader's targets with true range in [lo, hi] m: the
+    factor by which the detector's boxes are narrower than the bounding sphere's (see docs/localization.md)."""
+    import csv
+    ratios = []
+    try:
+        with open(csv_path) as f:
+            for row in csv.DictReader(f):
+                if row["vehicle_id"] == "1" and float(row.get("range_est_m") or 0) > 0 and lo <= float(row["range_m"]) <= hi:
+                    ratios.append(float(row["range_m"]) / float(row["range_est_m"]))
+    except OSError:
+        return None, 0
+    ratios.sort()
+    return (ratios[len(ratios) // 2] if ratios else None), len(ratios)
+
+
 def static_sweep(out, single, zoom):
     s, z = load(single), load(zoom)
+    k, k_n = range_scale(os.path.join(os.path.dirname(single), "targets.csv"))
+    kz, kz_n = range_scale(os.path.join(os.path.dirname(zoom), "targets.csv"))
     bins = []
     for bs, bz in zip(s["box_width_single_by_range"], z["box_width_zoom_by_range"]):
         bins.append({"lo_m": bs["lo_m"], "hi_m": bs["hi_m"], "single": bs["error"], "zoom": bz["error"]})
     data = {"single": {"box_width_error": s["box_width_single"], **common_row(s)},
             "zoom": {"box_width_error": z["box_width_zoom"], **common_row(z)}, "by_range": bins,
-            "thesis": {"single_mean": 0.026, "zoom_mean": 0.007}}
+            "thesis": {"single_mean": 0.026, "zoom_mean": 0.007},
+            "range_scale": {"single": k, "single_n": k_n, "zoom": kz, "zoom_n": kz_n, "true_range_m": [2.0, 20.0]}}
     f = lambda e: f"{e['mean']:.4f} (n = {e['n']})" if e["n"] else "no detections"
     lines = ["| box width error, mean abs., fraction of image width | thesis (Fig. 13) | ours |", "|---|---|---|",
              f"| single detection | 0.026 | {f(s['box_width_single'])} |",
@@ -69,6 +88,11 @@ def static_sweep(out, single, zoom):
     lines += ["", f"Leader detected in {100 * rate(s):.1f} % (single) and {100 * rate(z):.1f} % (zoom-in) of the "
               f"frames; median inference {s['inference_latency']['p50_ms']:.1f} ms single, "
               f"{z['inference_latency']['p50_ms']:.1f} ms with zoom-in."]
+    if k:
+        lines += ["", f"Range scale (median true / estimated range, 2–20 m, the localizer's radius as configured): "
+                  f"{k:.3f} single (n = {k_n})" + (f", {kz:.3f} zoom-in (n = {kz_n})" if kz else "") +
+                  ": the detector's boxes are this fraction of the bounding sphere's width when the flight used the "
+                  "sphere's radius (multiply target.radius_m by it to calibrate)."]
     write(out, "static_sweep", data, lines)
 
 

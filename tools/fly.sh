@@ -21,7 +21,9 @@
 #   --truth-box      ground-truth detections: the bounding sphere's exact box, the localizer's model (default), or
 #                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
 #   --zoom-in        the detector re-detects each box in a full-resolution crop (Algorithm 2's zoom-in)
-#   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any, else defaults)
+#   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any; else with
+#                    cnn detections config/flights/cnn.localizer.yaml, the range calibrated to the shipped model's
+#                    boxes; else the defaults)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -61,6 +63,10 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
     $([ "$zoom_in" = true ] && echo --zoom-in) ${localizer_config:+--localizer-config "$localizer_config"}
 fi
 [ -z "$localizer_config" ] || [ -r "$localizer_config" ] || { echo "fly: --localizer-config $localizer_config: cannot read it" >&2; exit 2; }
+if [ -z "$localizer_config" ] && [ ! -r "$src/config/flights/$name.localizer.yaml" ] && [ "$detections" = cnn ] &&
+   [ -r "$src/config/flights/cnn.localizer.yaml" ]; then
+  localizer_config="$src/config/flights/cnn.localizer.yaml"
+fi
 
 mkdir -p "$out"
 out=$(realpath "$out")

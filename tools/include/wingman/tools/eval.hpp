@@ -132,6 +132,7 @@ struct EvalResult {
     double range_m;                  ///< true follower-to-vehicle distance (matched), else target_t.range
     Eigen::Vector3d p_est, p_truth;  ///< world frame, metres; p_truth is NaN for a false target
     double error_m;                  ///< |p_est - p_truth|, NaN for a false target
+    double range_est_m;              ///< target_t.range: the localizer's camera-to-target distance, metres
   };
   std::vector<TargetSample> targets;
   /// One matched detection's box width (the report's scatter).

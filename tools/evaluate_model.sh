@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Measures a detector model the way its card reports it (models/wingman-small.md): wingman val on the clip-disjoint
+# Halmstad val clips (drone clips; airplane, bird and helicopter clips as negatives, false positives per image), on
+# the synthetic val split it was trained beside, and on a synthetic 1280x720 set up to 30 m; and its speed
+# (wingman bench detector). Writes OUT/*.json and OUT/summary.md.
+#
+# Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
+#   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
+#   --cfg      default builtin:wingman-small; --weights default builtin:wingman-small (the shipped model)
+#   --out      default build/model-eval
+set -euo pipefail
+cd "$(dirname "$0")/.."
+src=$(pwd)
+bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
+data="$src/build/training-data" cfg=builtin:wingman-small weights=builtin:wingman-small out="$src/build/model-eval"
+bench=true
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --data) data="$2"; shift 2 ;;
+    --cfg) cfg="$2"; shift 2 ;;
+    --weights) weights="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --no-bench) bench=false; shift ;;
+    -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
+    *) echo "evaluate_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[ -f "$data/halmstad/data.yaml" ] || { echo "evaluate_model: $data/halmstad is missing: run tools/train_model.sh" >&2; exit 2; }
+mkdir -p "$out"
+
+# Halmstad val, per kind of clip (lists of the val split's images, named V_<KIND>_NNN_<frame>.jpg).
+for kind in DRONE AIRPLANE BIRD HELICOPTER; do
+  ls "$data/halmstad/images/val" | grep "^V_${kind}_" | sed "s|^|$data/halmstad/images/val/|" > "$out/val_$kind.txt"
+  printf 'path: %s\nval: val_%s.txt\nnc: 1\nnames: [drone]\n' "$out" "$kind" > "$out/val_$kind.yaml"
+done
+val() {  # name data.yaml [args]
+  local name="$1" yaml="$2"; shift 2
+  echo "evaluate_model: $name" >&2
+  "$bin/wingman" val --data "$yaml" --cfg "$cfg" --weights "$weights" --backend opencl "$@" --json > "$out/$name.json"
+  "$bin/wingman" val --data "$yaml" --cfg "$cfg" --weights "$weights" --backend opencl "$@" > "$out/$name.txt" 2>&1
+}
+val halmstad_val "$data/halmstad/data.yaml"
+for kind in DRONE AIRPLANE BIRD HELICOPTER; do val "halmstad_val_$kind" "$out/val_$kind.yaml"; done
+val synth_val "$data/synth/data.yaml"
+# A synthetic 1280x720 set (the simulator's camera) up to 30 m, seed 99: never trained on.
+if [ ! -f "$data/synth720/data.yaml" ]; then
+  rm -rf "$data/synth720"
+  printf 'synth:\n  width: 1280\n  height: 720\n  range_max_m: 30.0\n  val_fraction: 1.0\n  image_format: "jpg"\n  jpeg_quality: 92\n' \
+    > "$data/synth720.yaml"
+  "$bin/wingman" dataset synth --out "$data/synth720" --count 300 --seed 99 --config "$data/synth720.yaml" \
+    --meshes "$src/../shared/meshes"
+fi
+val synth720_val "$data/synth720/data.yaml"
+if $bench; then
+  POCL_AFFINITY=1 "$bin/wingman" bench detector --cfg "$cfg" --weights "$weights" --sizes 416 --threads 1,2 \
+    --repetitions 15 > "$out/bench.txt" 2>&1
+fi
+PYENV_VERSION=system python3 - "$out" <<'PY'
+import json, os, sys
+out = sys.argv[1]
+def load(n):
+    return json.load(open(os.path.join(out, n + ".json")))
+def recall_at_precision(c, p_min):
+    return max([r for r, p, _ in c["pr_curve"] if p >= p_min] or [0.0])
+lines = ["| set | images | truths | criterion | AP@0.5 | precision / recall at conf 0.2 | recall at precision >= 0.90 | mean IoU |",
+         "|---|---|---|---|---|---|---|---|"]
+for name, label in [("halmstad_val", "Halmstad val clips (all)"), ("halmstad_val_DRONE", "Halmstad val, drone clips"),
+                    ("synth_val", "synthetic val (960x540, as trained)"), ("synth720_val", "synthetic 1280x720, <= 30 m")]:
+    r = load(name)
+    for crit in ("iou", "centre"):
+        a = r[crit]["all"]
+        lines.append(f"| {label} | {r['images']} | {r['truths']} | {'IoU >= 0.5' if crit == 'iou' else 'centre in box'} | "
+                     f"{a['ap']:.3f} | {a['precision']:.3f} / {a['recall']:.3f} | {recall_at_precision(r[crit], 0.9):.3f} | "
+                     f"{a['mean_iou']:.3f} |")
+lines += ["", "| negative clips (Halmstad val) | images | false positives at conf 0.2 | per image |", "|---|---|---|---|"]
+for kind in ("AIRPLANE", "BIRD", "HELICOPTER"):
+    r = load("halmstad_val_" + kind)
+    fp = r["centre"]["all"]["false_positives"]
+    lines.append(f"| {kind.lower()} | {r['images']} | {fp} | {fp / max(1, r['images']):.3f} |")
+open(os.path.join(out, "summary.md"), "w").write("\n".join(lines) + "\n")
+print("\n".join(lines))
+PY
