@@ -15,7 +15,14 @@ lcm-logger --lcm-url="$url" --force --quiet "$log" & pids+=($!)
 "$bin/wingman-detector" --lcm-url "$url" --log-level warn & pids+=($!)
 "$bin/wingman-localizer" --lcm-url "$url" --log-level warn & pids+=($!)
 "$bin/wingman-follower-ctrl" --lcm-url "$url" --log-level warn & pids+=($!)
-sleep 0.5   # let the subscribers join the group before the first frame
+# Start-up takes seconds (the detector loads its model and builds its OpenCL kernels): wait, at most 60 s, until
+# every process has published its first status heartbeat, which it does once it listens.
+for _ in $(seq 120); do
+  info=$("$bin/wingman" loginfo "$log" 2>/dev/null || true)
+  grep -q "^STATUS_DETECTOR " <<<"$info" && grep -q "^STATUS_LOCALIZER " <<<"$info" &&
+    grep -q "^STATUS_FOLLOWER_CTRL " <<<"$info" && break
+  sleep 0.5
+done
 
 cat > "$out/camera_driver.yaml" <<YAML
 # Demo: play the clip once at its own rate, stamped by the wall clock like a live camera.
