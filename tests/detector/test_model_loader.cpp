@@ -53,8 +53,9 @@ TEST(BuiltinModels, ShippedWeightsAreBuiltInByteForByte) {
 }
 
 TEST(BuiltinModels, UnknownNamesEmptyCfgAndMissingFilesAreErrorsNamingThem) {
-  EXPECT_NE(error_of("builtin:yolov9", "").find("model.cfg = 'builtin:yolov9': no such built-in network; expected one "
-                                                "of builtin:wingman-small, builtin:tiny-yolo-thesis"),
+  EXPECT_NE(error_of("builtin:yolov9", "")
+                .find("model.cfg = 'builtin:yolov9': no such built-in network; expected one "
+                      "of builtin:wingman-small, builtin:tiny-yolo-thesis"),
             std::string::npos)
       << error_of("builtin:yolov9", "");
   EXPECT_NE(error_of("builtin:wingman-small", "builtin:thesis").find("model.weights = 'builtin:thesis'"),

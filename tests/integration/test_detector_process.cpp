@@ -73,7 +73,8 @@ struct DetectorRun {
 DetectorRun run_detector(const TempDir& dir, const std::string& in, const std::string& weights,
                          const std::string& backend, const std::string& name) {
   const std::string cfg = dir.file(name + ".yaml");
-  std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << weights << ", backend: " << backend << "}\ninput: {mode: replay}\n";
+  std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << weights << ", backend: " << backend
+                     << "}\ninput: {mode: replay}\n";
   const std::string out = dir.file(name + ".lcmlog");
   const auto r = run({bin_path("wingman-detector"), "--config", cfg, "--lcm-in", "file://" + in + "?speed=0",
                       "--lcm-out", "file://" + out + "?mode=w"},

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// `wingman bench detector`: a network (default: the thesis network) per frame on OpenCL, CpuBackend and bare OpenCV DNN; the pipeline.
+// `wingman bench detector`: a network (default: the thesis network) per frame on OpenCL, CpuBackend and bare OpenCV
+// DNN; the pipeline.
 #include "wingman/tools/bench.hpp"
 
 #include <fmt/format.h>
@@ -499,10 +500,10 @@ std::string BenchDetectorReport::table() const {
 
 std::string BenchDetectorReport::json() const {
   std::ostringstream s;
-  s << "{\"benchmark\": \"detector\", \"cfg\": " << json_string(cfg) << ", \"weights\": " << json_string(weights) << ", \"repetitions\": " << repetitions
-    << ", \"warmup\": " << warmup << ", \"stream\": [" << stream_width << ", " << stream_height
-    << "],\n \"machine\": {\"cpu_model\": " << json_string(machine.cpu_model) << ", \"cores\": " << machine.cores
-    << ", \"opencl_devices\": [";
+  s << "{\"benchmark\": \"detector\", \"cfg\": " << json_string(cfg) << ", \"weights\": " << json_string(weights)
+    << ", \"repetitions\": " << repetitions << ", \"warmup\": " << warmup << ", \"stream\": [" << stream_width << ", "
+    << stream_height << "],\n \"machine\": {\"cpu_model\": " << json_string(machine.cpu_model)
+    << ", \"cores\": " << machine.cores << ", \"opencl_devices\": [";
   for (size_t i = 0; i < machine.opencl_devices.size(); ++i)
     s << (i ? ", " : "") << json_string(machine.opencl_devices[i]);
   s << "], \"pocl_affinity\": " << json_string(machine.pocl_affinity)

@@ -382,8 +382,8 @@ EvalResult evaluate_log(const EvalOptions& o) {
   Acc width_single, width_zoom;
   BinnedAcc width_single_bins(o.range_bins_m), width_zoom_bins(o.range_bins_m);
   for (size_t i = 0; i <= o.range_bins_m.size(); ++i) {
-    r.detection_by_range.push_back({i == 0 ? 0.0 : o.range_bins_m[i - 1],
-                                    i < o.range_bins_m.size() ? o.range_bins_m[i] : kInf, 0, 0});
+    r.detection_by_range.push_back(
+        {i == 0 ? 0.0 : o.range_bins_m[i - 1], i < o.range_bins_m.size() ? o.range_bins_m[i] : kInf, 0, 0});
   }
   const auto inside = [](const wingman::detection_t& b, const wingman::truth_box_t& tb) {
     return std::abs(b.cx - tb.cx) <= 0.5 * tb.w && std::abs(b.cy - tb.cy) <= 0.5 * tb.h;
@@ -399,7 +399,8 @@ EvalResult evaluate_log(const EvalOptions& o) {
     }
     for (const auto& b : d.boxes) {
       bool in_any = false;
-      for (const auto& tb : boxes->second) in_any = in_any || (tb.visible && tb.camera_id == d.camera_id && inside(b, tb));
+      for (const auto& tb : boxes->second)
+        in_any = in_any || (tb.visible && tb.camera_id == d.camera_id && inside(b, tb));
       if (!in_any) ++r.detections_outside_truth;
     }
     if (d.image_width <= 0) continue;

@@ -151,8 +151,9 @@ int main(int argc, char** argv) {
   BenchDetectorOptions bench_detector;
   auto* be = app.add_subcommand("bench", "Benchmarks (numbers, not tests)");
   be->require_subcommand(1);
-  auto* bd = be->add_subcommand(
-      "detector", "A network (default: the thesis network) per frame: OpenCL vs CpuBackend vs bare OpenCV DNN, and the whole pipeline");
+  auto* bd = be->add_subcommand("detector",
+                                "A network (default: the thesis network) per frame: OpenCL vs CpuBackend vs bare "
+                                "OpenCV DNN, and the whole pipeline");
   bd->add_option("--sizes", bench_detector.sizes, "Network input sizes, multiples of 32 (default 416,320,256)")
       ->delimiter(',');
   bd->add_option("--threads", bench_detector.threads,

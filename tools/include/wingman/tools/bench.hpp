@@ -11,19 +11,19 @@ namespace wingman::tools {
 
 /// Options of `wingman bench detector`. A benchmark, not a test: nothing here is asserted.
 struct BenchDetectorOptions {
-  std::vector<int> sizes{416, 320, 256};  ///< network input sizes (square), pixels; each a multiple of 32, >= 32
-  std::vector<int> threads{1, 2};         ///< CPU thread counts for OpenCV (cv::setNumThreads), each >= 1
-  int repetitions = 7;                    ///< timed runs per measurement (median/min/max over these), >= 1
-  int warmup = 2;                         ///< untimed runs before each measurement, >= 0
-  bool json = false;                      ///< print one JSON object instead of the table
+  std::vector<int> sizes{416, 320, 256};         ///< network input sizes (square), pixels; each a multiple of 32, >= 32
+  std::vector<int> threads{1, 2};                ///< CPU thread counts for OpenCV (cv::setNumThreads), each >= 1
+  int repetitions = 7;                           ///< timed runs per measurement (median/min/max over these), >= 1
+  int warmup = 2;                                ///< untimed runs before each measurement, >= 0
+  bool json = false;                             ///< print one JSON object instead of the table
   std::string cfg = "builtin:tiny-yolo-thesis";  ///< network: a .cfg path or builtin:<name> (detector::load_model)
-  std::string weights;                    ///< Darknet .weights (path or builtin:<name>); "" = random weights, `seed`
-  uint32_t seed = 42;                     ///< seed of the random weights
-  int stream_width = 1280;                ///< width of the synthetic BGR stream for the pipeline, pixels, >= 32
-  int stream_height = 720;                ///< height of the synthetic BGR stream for the pipeline, pixels, >= 32
-  int pipeline_max_batch = 4;             ///< backends' max_batch in the pipeline (zoom-in crops per forward), >= 1
-  bool pipeline = true;                   ///< also time DetectionPipeline::detect() (slow: zoom-in on the CPU)
-  bool layers = true;                     ///< also profile the OpenCL backend per layer (`repetitions` more runs)
+  std::string weights;         ///< Darknet .weights (path or builtin:<name>); "" = random weights, `seed`
+  uint32_t seed = 42;          ///< seed of the random weights
+  int stream_width = 1280;     ///< width of the synthetic BGR stream for the pipeline, pixels, >= 32
+  int stream_height = 720;     ///< height of the synthetic BGR stream for the pipeline, pixels, >= 32
+  int pipeline_max_batch = 4;  ///< backends' max_batch in the pipeline (zoom-in crops per forward), >= 1
+  bool pipeline = true;        ///< also time DetectionPipeline::detect() (slow: zoom-in on the CPU)
+  bool layers = true;          ///< also profile the OpenCL backend per layer (`repetitions` more runs)
 
   /// One "field = value: rule" line per problem; empty when valid.
   std::vector<std::string> validate() const;

@@ -12,9 +12,10 @@ namespace wingman::tools {
 
 /// Options of `wingman predict`.
 struct PredictOptions {
-  std::vector<std::string> inputs;              ///< image files and/or folders (their images, not recursive)
-  std::string cfg = "builtin:wingman-small";      ///< Darknet .cfg path or builtin:<name> (detector::load_model)
-  std::string weights = "builtin:wingman-small";  ///< Darknet .weights path or builtin:wingman-small (the shipped model)
+  std::vector<std::string> inputs;            ///< image files and/or folders (their images, not recursive)
+  std::string cfg = "builtin:wingman-small";  ///< Darknet .cfg path or builtin:<name> (detector::load_model)
+  std::string weights =
+      "builtin:wingman-small";                  ///< Darknet .weights path or builtin:wingman-small (the shipped model)
   std::string backend = "auto";                 ///< inference backend: auto, opencl or cpu (OpenCV DNN)
   std::string out_dir = "predictions";          ///< folder for <stem>.txt (and <stem>.pred.jpg with draw)
   bool draw = false;                            ///< also write each image with its boxes drawn

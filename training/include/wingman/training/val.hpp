@@ -14,8 +14,8 @@ namespace wingman::training {
 
 /// What `wingman val` evaluates and how.
 struct ValOptions {
-  std::string data;             ///< data.yaml or YOLO-layout folder (required)
-  std::string split = "val";    ///< the split to evaluate ("" = a folder's images/ without splits)
+  std::string data;                           ///< data.yaml or YOLO-layout folder (required)
+  std::string split = "val";                  ///< the split to evaluate ("" = a folder's images/ without splits)
   std::string cfg = "builtin:wingman-small";  ///< Darknet .cfg path or builtin:<name> (detector::load_model)
   std::string weights;          ///< run the detector with these .weights (exactly one of weights / predictions)
   std::string predictions;      ///< or read `wingman predict` output: <predictions>/<image stem>.txt per image
