@@ -15,8 +15,8 @@
 #                  all           all of them, one after the other
 #   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
 #   --out DIR      output folder (default build/experiments)
-# Lengths (rendering takes 0.1-0.2 s a frame here): static_sweep 2 x 1190 frames, distance 3 x 30 s, follow_1d 60 s,
-# formation_2d 3 x 40 s, max_range 1010 frames; about 25 min in all on the 2-core development VM.
+# Lengths (a rendered closed-loop frame takes 0.1-0.2 s here): static_sweep 2 x 952 frames, distance 4 x 20 s,
+# follow_1d 60 s, formation_2d 3 x 30 s, max_range 600 frames; about 25 min in all on the 2-core development VM.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -58,9 +58,9 @@ fly() {  # out-dir fly.sh-arguments...
 }
 
 static_sweep() {
-  local out="$out_root/static_sweep" fps=10; $quick && fps=2
+  local out="$out_root/static_sweep" fps=8; $quick && fps=2
   rm -rf "$out"; mkdir -p "$out"
-  # The thesis: a hovering drone seen from the side from 0.5 to 30 m; 10 frames per 0.25 m step.
+  # The thesis: a hovering drone seen from the side from 0.5 to 30 m; 8 frames per 0.25 m step.
   local scn; scn=$(scenario_variant "$out/scenario" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/")
   # The bounding sphere's own radius (the default quad's), so that the sweep measures the boxes' range scale.
   printf 'target: {radius_m: 0.348}\n' > "$out/sphere.localizer.yaml"
@@ -70,7 +70,7 @@ static_sweep() {
 }
 
 distance() {
-  local out="$out_root/distance" dur=30; $quick && dur=4
+  local out="$out_root/distance" dur=20; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
   local calibration="$src/config/flights/cnn.localizer.yaml"
@@ -93,7 +93,7 @@ follow_1d() {
 }
 
 formation_2d() {
-  local out="$out_root/formation_2d" dur=40; $quick && dur=4
+  local out="$out_root/formation_2d" dur=30; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   local runs=()
   for seed in 1 2 3; do
@@ -105,7 +105,7 @@ formation_2d() {
 }
 
 max_range() {
-  local out="$out_root/max_range" fps=10; $quick && fps=2
+  local out="$out_root/max_range" fps=6; $quick && fps=2
   rm -rf "$out"; mkdir -p "$out"
   # The static sweep carried on to 60 m in 0.5 m steps from 10 m, an F450-sized quad (the default airframe).
   local scn; scn=$(scenario_variant "$out/scenario" static_sweep \
