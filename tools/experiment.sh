@@ -6,7 +6,7 @@
 # eval.json, report.html), a results.json and a results.md table with the thesis's figures beside ours, in
 # build/experiments/NAME/ (docs/results.md collects them).
 #
-# Usage: tools/experiment.sh NAME [--quick] [--out DIR]
+# Usage: tools/experiment.sh NAME [--quick] [--out DIR] [--detections cnn|truth]
 #   NAME           static_sweep  box width error over distance, single pass vs zoom-in (thesis Fig. 13)
 #                  distance      distance error on a fast-moving leader: single, zoom-in, zoom-in filtered (Table 3)
 #                  follow_1d     the 1-D PID follow (thesis section 5.3)
@@ -14,7 +14,10 @@
 #                  max_range     the farthest range at which the detector still finds an F450-sized drone at 1280x720
 #                  all           all of them, one after the other
 #   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
-#   --out DIR      output folder (default build/experiments)
+#   --out DIR      output folder (default build/experiments, or build/experiments-truth with --detections truth)
+#   --detections   cnn (default): the shipped model on rendered images; truth: boxes from the simulator's ground truth
+#                  (the bounding sphere's box, 1 px noise; no rendering): what the rest of the pipeline does with
+#                  perfect boxes (distance, follow_1d and formation_2d only)
 # Lengths (a rendered closed-loop frame takes 0.1-0.2 s here): static_sweep 2 x 952 frames, distance 4 x 20 s,
 # follow_1d 60 s, formation_2d 3 x 30 s, max_range 600 frames; about 25 min in all on the 2-core development VM.
 set -euo pipefail
@@ -24,15 +27,24 @@ bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 name="${1:-}"
 [ -n "$name" ] || { sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 2; }
 shift
-quick=false out_root="$src/build/experiments"
+quick=false out_root="" detections=cnn
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=true; shift ;;
     --out) out_root="$2"; shift 2 ;;
+    --detections) detections="$2"; shift 2 ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "experiment: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+case "$detections" in cnn|truth) ;; *) echo "experiment: --detections '$detections': expected cnn or truth" >&2; exit 2 ;; esac
+if [ "$detections" = truth ]; then
+  case "$name" in static_sweep|max_range|all)
+    echo "experiment: $name measures the detector: it needs --detections cnn (all: run the three flights by name)" >&2
+    exit 2 ;;
+  esac
+fi
+[ -n "$out_root" ] || out_root="$src/build/experiments$([ "$detections" = truth ] && echo -truth)"
 export PYENV_VERSION=system WINGMAN_BIN_DIR="$bin"
 py() { python3 "$src/tools/experiment_summary.py" "$@"; }
 
@@ -50,7 +62,7 @@ scenario_variant() {  # dir scenario sed-expression...
 fly() {  # out-dir fly.sh-arguments...
   local dir="$1"; shift
   echo "experiment: flying $(basename "$dir") ..." >&2
-  if ! WINGMAN_BIN_DIR="$bin" tools/fly.sh --out "$dir" "$@" > "$dir.log" 2>&1; then
+  if ! WINGMAN_BIN_DIR="$bin" tools/fly.sh --out "$dir" --detections "$detections" "$@" > "$dir.log" 2>&1; then
     tail -20 "$dir.log" >&2
     echo "experiment: the flight $(basename "$dir") failed (log: $dir.log)" >&2
     exit 1
@@ -73,7 +85,9 @@ distance() {
   local out="$out_root/distance" dur=20; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
-  local calibration="$src/config/flights/cnn.localizer.yaml"
+  # CNN boxes: the radius calibrated for them; ground-truth sphere boxes: the true radius (the default).
+  local calibration=/dev/null
+  [ "$detections" = cnn ] && calibration="$src/config/flights/cnn.localizer.yaml"
   { cat "$calibration"; printf 'tracker: {mode: sliding_window, window_size: 1}\n'; } > "$out/raw.localizer.yaml"
   { cat "$calibration"; printf 'tracker: {mode: sliding_window, window_size: 5}\n'; } > "$out/window5.localizer.yaml"
   fly "$out/single" --scenario fast_target --duration "$dur" --localizer-config "$out/raw.localizer.yaml"
