@@ -44,7 +44,7 @@ if [ "$detections" = truth ]; then
     exit 2 ;;
   esac
 fi
-[ -n "$out_root" ] || out_root="$src/build/experiments$([ "$detections" = truth ] && echo -truth)"
+[ -n "$out_root" ] || out_root="$src/build/experiments$( [ "$detections" = truth ] && echo -truth || true)"
 export PYENV_VERSION=system WINGMAN_BIN_DIR="$bin"
 py() { python3 "$src/tools/experiment_summary.py" "$@"; }
 
