@@ -18,8 +18,8 @@
 #   --detections   cnn (default): the shipped model on rendered images; truth: boxes from the simulator's ground truth
 #                  (the bounding sphere's box, 1 px noise; no rendering): what the rest of the pipeline does with
 #                  perfect boxes (distance, follow_1d and formation_2d only)
-# Lengths (a rendered closed-loop frame takes 0.1-0.2 s here): static_sweep 2 x 952 frames, distance 4 x 20 s,
-# follow_1d 60 s, formation_2d 3 x 30 s, max_range 600 frames; about 25 min in all on the 2-core development VM.
+# Lengths (a rendered closed-loop frame takes 0.2-0.5 s here): static_sweep 2 x 952 frames, distance 4 x 10 s,
+# follow_1d 20 s, formation_2d 3 x 10 s, max_range 200 frames; about 30 min in all on the 2-core development VM.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -82,7 +82,7 @@ static_sweep() {
 }
 
 distance() {
-  local out="$out_root/distance" dur=20; $quick && dur=4
+  local out="$out_root/distance" dur=10; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
   # CNN boxes: the radius calibrated for them; ground-truth sphere boxes: the true radius (the default).
@@ -100,14 +100,14 @@ distance() {
 }
 
 follow_1d() {
-  local out="$out_root/follow_1d" dur=60; $quick && dur=4
+  local out="$out_root/follow_1d" dur=20; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   fly "$out/run" --scenario follow_1d --duration "$dur"
   py follow_1d "$out" "$out/run/eval.json"
 }
 
 formation_2d() {
-  local out="$out_root/formation_2d" dur=30; $quick && dur=4
+  local out="$out_root/formation_2d" dur=10; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   local runs=()
   for seed in 1 2 3; do
@@ -119,7 +119,7 @@ formation_2d() {
 }
 
 max_range() {
-  local out="$out_root/max_range" fps=6; $quick && fps=2
+  local out="$out_root/max_range" fps=2; $quick && fps=1
   rm -rf "$out"; mkdir -p "$out"
   # The static sweep carried on to 60 m in 0.5 m steps from 10 m, an F450-sized quad (the default airframe).
   local scn; scn=$(scenario_variant "$out/scenario" static_sweep \
