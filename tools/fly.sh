@@ -93,13 +93,17 @@ else
   [ "$render" = false ] && echo "fly: images are not rendered (ground-truth detections need none; --render renders them)"
 fi
 
+# The box noise follows the scenario's seed (as the rendered noise does), so runs of different seeds differ.
+scenario_seed=$(awk '/^seed:/{print $2; exit}' "$scenario_file")
+case "$scenario_seed" in ''|*[!0-9]*) scenario_seed=1 ;; esac
+
 # Per-flight configs: the process defaults, plus config/flights/<scenario>.<process>.yaml where one exists.
 flight_cfg() { local f="$src/config/flights/$name.$1.yaml"; [ -r "$f" ] && echo "--config $f" || true; }
 cat > "$out/sim.yaml" <<YAML
 # Written by tools/fly.sh for this flight.
 scenario: {file: "$scenario_file"}
 sync: {mode: lockstep, timeout_s: 10.0, wait_for: [detector, localizer, follower_ctrl], startup_timeout_s: 60.0}
-detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0}
+detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0, seed: $scenario_seed}
 render: {enabled: $render}
 YAML
 if [ "$detections" = cnn ]; then
