@@ -128,8 +128,9 @@ def follow_1d(out, run):
              f"| mean absolute X error | 1.12 m | {fh['mean_m']:.3f} m |",
              f"| maximum X error | 4.34 m | {fh['max_m']:.3f} m |",
              f"| leader kept | lost after 180 s | {lost} over {r['duration_s']:.0f} s |",
-             f"| localization RMS | — | {r['localization']['rms_m']:.3f} m |",
-             f"| latency exposure → target, median | ≈ 0.7 s | {r['latency']['p50_ms']:.0f} ms |"]
+             f"| localization RMS | — | " + (f"{r['localization']['rms_m']:.3f} m |" if r['localization']['n'] else "no targets |"),
+             f"| latency exposure → target, median | ≈ 0.7 s | " +
+             (f"{r['latency']['p50_ms']:.1f} ms |" if r['latency']['n'] else "no targets |")]
     write(out, "follow_1d", data, lines)
 
 
@@ -145,14 +146,20 @@ def formation_2d(out, *runs):
         data["runs"].append({"localization": loc, "formation_horizontal": r["formation_horizontal"],
                              "axes": [r["localization_x"], r["localization_y"], r["localization_z"]],
                              "along": r["along_line_of_sight"], "across": r["across_line_of_sight"], **common_row(r)})
-        axes = " / ".join(f"{r[k]['rms_m']:.2f}" for k in ("localization_x", "localization_y", "localization_z"))
-        lines.append(f"| {i + 1} | {thesis[i]:.2f} | {loc['rms_m']:.3f} (n = {loc['n']}) | {axes} | "
-                     f"{r['along_line_of_sight']['rms_m']:.2f} / {r['across_line_of_sight']['rms_m']:.2f} | "
-                     f"{r['formation_horizontal']['rms_m']:.3f} | {100 * rate(r):.0f} % | "
-                     f"{r['latency']['p50_ms']:.0f} |")
-    avg = sum(r["localization"]["rms_m"] for r in rs) / len(rs)
+        if loc["n"]:
+            axes = " / ".join(f"{r[k]['rms_m']:.2f}" for k in ("localization_x", "localization_y", "localization_z"))
+            lines.append(f"| {i + 1} | {thesis[i]:.2f} | {loc['rms_m']:.3f} (n = {loc['n']}) | {axes} | "
+                         f"{r['along_line_of_sight']['rms_m']:.2f} / {r['across_line_of_sight']['rms_m']:.2f} | "
+                         f"{r['formation_horizontal']['rms_m']:.3f} | {100 * rate(r):.0f} % | "
+                         f"{r['latency']['p50_ms']:.1f} |")
+        else:
+            lines.append(f"| {i + 1} | {thesis[i]:.2f} | no targets | — | — | "
+                         f"{r['formation_horizontal']['rms_m']:.3f} (held) | {100 * rate(r):.0f} % | — |")
+    localized = [r["localization"]["rms_m"] for r in rs if r["localization"]["n"]]
+    avg = sum(localized) / len(localized) if localized else None
     data["average_rms_m"] = avg
-    lines.append(f"| average | 2.86 | {avg:.3f} | | | | | |")
+    lines.append(f"| average | 2.86 | {avg:.3f} | | | | | |" if avg is not None else
+                 "| average | 2.86 | no targets in any run | | | | | |")
     write(out, "formation_2d", data, lines)
 
 
