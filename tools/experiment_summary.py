@@ -114,7 +114,8 @@ def distance(out, single, zoom, window5, kalman):
         a = r["along_line_of_sight"]
         data["runs"][label] = {"along_line_of_sight": a, "localization": r["localization"], **common_row(r)}
         ours = f"{a['mean_m']:.2f} / {a['max_m']:.2f}" if a["n"] else "no targets"
-        lines.append(f"| {label} | {thesis} | {ours} | {100 * rate(r):.0f} % | {r['localization']['rms_m']:.2f} |")
+        rms = f"{r['localization']['rms_m']:.2f}" if r["localization"]["n"] else "—"
+        lines.append(f"| {label} | {thesis} | {ours} | {100 * rate(r):.0f} % | {rms} |")
     write(out, "distance", data, lines)
 
 
