@@ -7,7 +7,7 @@
 #
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
-#                     [--localizer-config FILE] [--quiet-eval]
+#                     [--localizer-config FILE]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)

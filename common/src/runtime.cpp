@@ -20,8 +20,8 @@ namespace wingman::common {
 namespace {
 
 std::atomic<int> g_signal{0};
-/// True until the process first waits for input: start-up (config, model loading, OpenCL kernel builds) may take
-/// seconds in calls that cannot be interrupted, and nothing has been published that needs a final status yet.
+/// True until the process first waits for input or asks whether to stop: start-up (config, model loading, OpenCL
+/// kernel builds) may take seconds in calls that cannot be interrupted, and nothing needs a final status yet.
 std::atomic<bool> g_starting{true};
 
 extern "C" void on_signal(int sig) {
@@ -102,7 +102,11 @@ Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
 
 Runtime::~Runtime() = default;
 
-bool Runtime::stop_requested() const { return g_signal.load() != 0 || stop_requested_locally_; }
+bool Runtime::stop_requested() const {
+  // A process that asks has a loop that honours the answer: start-up is over (see on_signal).
+  g_starting.store(false);
+  return g_signal.load() != 0 || stop_requested_locally_;
+}
 
 void Runtime::request_stop(const std::string& reason) {
   stop_requested_locally_ = true;

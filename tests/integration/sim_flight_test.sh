@@ -37,7 +37,9 @@ problems = []
 def check(ok, what):
     if not ok: problems.append(what)
 # Bounds (docs/simulation.md): 20 s of formation_2d, lockstep, 0.1 s command delay, 1 px edge noise.
-check(r["duration_s"] >= 19.5, f"flew {r['duration_s']} s, expected 20")
+# The simulator's own count says the flight was 20 s (checked below); the log may lack a lost tail (seen once: the
+# logger recorded 17.3 s of 20 on a loaded machine), so the recorded span only has to cover most of it.
+check(r["duration_s"] >= 15.0, f"the log spans {r['duration_s']} s of the 20 s flight")
 # lcm-logger may lose some messages when the machine is saturated (seen: 512 of 600 under a parallel ctest); the
 # error bounds hold on what was recorded, and the count must stay well above half.
 check(r["truth_frames"] >= 450, f"{r['truth_frames']} ground-truth frames recorded of 600")
@@ -56,3 +58,5 @@ print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(pr
 sys.exit(1 if problems else 0)
 PY
 grep -q "SIMULATOR'S GROUND TRUTH" <<<"$log" || fail "the flight did not say its detections came from ground truth"
+grep -Eq "\[sim\] info: 600 frames in .*0 lockstep timeouts; setpoints 600 on time" <<<"$log" ||
+  fail "the simulator did not fly 600 frames with every setpoint on time"
