@@ -3,7 +3,7 @@
 # Measures a detector model the way its card reports it (models/wingman-small.md): wingman val on the clip-disjoint
 # Halmstad val clips (drone clips; airplane, bird and helicopter clips as negatives, false positives per image), on
 # the synthetic val split it was trained beside, and on a synthetic 1280x720 set up to 30 m; and its speed
-# (wingman bench detector). Writes OUT/*.json and OUT/summary.md.
+# (wingman bench detector). Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
 #
 # Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
@@ -38,7 +38,6 @@ val() {  # name data.yaml [args]
   local name="$1" yaml="$2"; shift 2
   echo "evaluate_model: $name" >&2
   "$bin/wingman" val --data "$yaml" --cfg "$cfg" --weights "$weights" --backend opencl "$@" --json > "$out/$name.json"
-  "$bin/wingman" val --data "$yaml" --cfg "$cfg" --weights "$weights" --backend opencl "$@" > "$out/$name.txt" 2>&1
 }
 val halmstad_val "$data/halmstad/data.yaml"
 for kind in DRONE AIRPLANE BIRD HELICOPTER; do val "halmstad_val_$kind" "$out/val_$kind.yaml"; done

@@ -68,7 +68,7 @@ std::string cpu_model_name() {
 }
 
 /// The network (`o.cfg`, the thesis network by default) at `size` x `size`: its cfg with [net] width/height changed.
-DarknetModel thesis_model(int size, const BenchDetectorOptions& o) {
+DarknetModel bench_model(int size, const BenchDetectorOptions& o) {
   DarknetModel m = detector::load_cfg(o.cfg);
   m.net.width = size;
   m.net.height = size;
@@ -227,7 +227,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
   for (int i = 0; i < 8; ++i) stream.push_back(synthetic_frame(o.stream_width, o.stream_height, i));
 
   for (const int size : o.sizes) {
-    const DarknetModel model = thesis_model(size, o);
+    const DarknetModel model = bench_model(size, o);
     const double flops = model.flops();
     const cv::Size net(size, size);
     // The same frame for every backend: our CHW input, and the net-sized BGR image for bare cv::dnn.
@@ -378,7 +378,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
   // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on.
   cv::setNumThreads(max_threads);
   for (const int size : o.pipeline ? o.sizes : std::vector<int>{}) {
-    const DarknetModel model = thesis_model(size, o);
+    const DarknetModel model = bench_model(size, o);
     for (const std::string kind : {"opencl", "cpu"}) {
       for (const bool zoom : {false, true}) {
         PipelineResult r;
