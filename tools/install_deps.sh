@@ -27,6 +27,9 @@ packages=(
   xvfb xauth x11-apps netpbm
   # `wingman report` opened in a headless browser (tests/tools/report_chromium_test.sh)
   chromium
+  # reliability (docs/reliability.md): supervisord for the supervision fault tests, clang for libFuzzer targets and
+  # the AddressSanitizer/UndefinedBehaviorSanitizer/ThreadSanitizer builds
+  supervisor clang
 )
 
 missing=()
