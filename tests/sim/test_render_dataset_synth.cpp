@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -132,6 +133,45 @@ TEST(DatasetSynth, WritesAYoloDatasetWhoseLabelsAreTheTruthBoxesOfItsMetadata) {
     }
   }
   EXPECT_EQ(images, 6u);
+}
+
+TEST(DatasetSynth, HorizonTargetsFlyAtTheCamerasHeight) {
+  // synth.horizon_fraction 1: every target is seen within +-horizon_elevation_max_deg of the horizontal.
+  wingman::testing::TempDir dir;
+  DatasetSynthRequest request;
+  request.out_dir = dir.file("set");
+  request.count = 5;
+  request.seed = 4;
+  request.config = write_config(dir,
+                                "  horizon_fraction: 1.0\n  horizon_elevation_max_deg: 2.0\n"
+                                "  camera_height_min_m: 3.0\n  camera_height_max_m: 10.0\n  range_max_m: 30.0\n");
+  std::ostringstream progress;
+  const DatasetSynthSummary summary = run_dataset_synth(request, progress);
+  ASSERT_EQ(summary.images, 5);
+  int checked = 0;
+  for (const char* split : {"train", "val"}) {
+    const fs::path meta_dir = fs::path(request.out_dir) / "meta" / split;
+    if (!fs::is_directory(meta_dir)) continue;
+    for (const auto& entry : fs::directory_iterator(meta_dir)) {
+      const YAML::Node meta = YAML::LoadFile(entry.path().string());
+      const Eigen::Vector3d p_cam_in_world = pose(meta["T_cam_to_world"]).translation();
+      const Eigen::Vector3d p_target_in_world = pose(meta["target"]["T_body_to_world"]).translation();
+      const Eigen::Vector3d d = p_target_in_world - p_cam_in_world;
+      const double elevation_deg = std::atan2(d.z(), d.head<2>().norm()) * 180.0 / M_PI;
+      EXPECT_LE(std::abs(elevation_deg), 2.0 + 1e-6) << entry.path();
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 5);
+
+  // Out of range: named with its rule.
+  DatasetSynthConfig config;
+  config.horizon_fraction = 1.5;
+  config.horizon_elevation_max_deg = -1.0;
+  const std::vector<std::string> problems = config.validate();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("synth.horizon_fraction"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("synth.horizon_elevation_max_deg"), std::string::npos) << problems[1];
 }
 
 TEST(DatasetSynth, SameSeedSameBytesOtherSeedOtherImages) {

@@ -299,6 +299,10 @@ std::vector<std::string> DatasetSynthConfig::validate() const {
   fraction("synth.disc_fraction", disc_fraction);
   fraction("synth.blur_fraction", blur_fraction);
   fraction("synth.val_fraction", val_fraction);
+  fraction("synth.horizon_fraction", horizon_fraction);
+  if (!(horizon_elevation_max_deg >= 0.0 && horizon_elevation_max_deg <= 45.0)) {
+    p.push_back(problem("synth.horizon_elevation_max_deg", horizon_elevation_max_deg, "must be in [0, 45] degrees"));
+  }
   if (!(blur_exposure_max_s >= 0.002 && blur_exposure_max_s <= 0.1)) {
     p.push_back(problem("synth.blur_exposure_max_s", blur_exposure_max_s, "must be in [0.002, 0.1]"));
   }
@@ -383,7 +387,17 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
       const Eigen::Isometry3d T_cam_to_world = random_camera_pose(config, rng);
       const Eigen::Vector2d uv(rng.uniform(-0.5, config.width - 0.5), rng.uniform(-0.5, config.height - 0.5));
       const double range = rng.log_uniform(config.range_min_m, config.range_max_m);
-      const Eigen::Vector3d ray = camera.model.unproject(uv);
+      Eigen::Vector3d ray = camera.model.unproject(uv);
+      if (config.horizon_fraction > 0.0 && rng.chance(config.horizon_fraction)) {
+        // On the horizon: a world direction of small elevation within the camera's horizontal field of view.
+        const Eigen::Vector3d z_cam_in_world = T_cam_to_world.linear().col(2);
+        const double yaw = std::atan2(z_cam_in_world.y(), z_cam_in_world.x());
+        const double azimuth = yaw + rng.uniform(-0.5, 0.5) * config.hfov_max_deg * kDeg;
+        const double elevation = rng.uniform(-1.0, 1.0) * config.horizon_elevation_max_deg * kDeg;
+        const Eigen::Vector3d d_in_world(std::cos(elevation) * std::cos(azimuth),
+                                         std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+        ray = T_cam_to_world.linear().transpose() * d_in_world;  // unit ray in the optical frame
+      }
       sim::DroneInstance target;
       target.vehicle_id = 1;
       target.model = model.get();

@@ -49,7 +49,12 @@ struct DatasetSynthConfig {
   std::string image_format = "png";    ///< png (lossless) or jpg
   int jpeg_quality = 95;               ///< jpg quality, 1..100
   int min_visible_pixels = 12;         ///< a drone seen at fewer pixel centres is drawn again elsewhere
-  sim::RenderOptions render;           ///< base scene and sensor options (render.*)
+  /// Share of images whose target flies at about the camera's height: seen within +-horizon_elevation_max_deg of
+  /// the horizontal, i.e. on the horizon, often against the treeline (the view of a follower in formation). The
+  /// other targets are anywhere in the image. 0 draws exactly the images of earlier versions.
+  double horizon_fraction = 0.0;
+  double horizon_elevation_max_deg = 3.0;  ///< elevation of those targets seen from the camera, within +-this, degrees
+  sim::RenderOptions render;               ///< base scene and sensor options (render.*)
 
   template <class V>
   void visit(V& v) {
@@ -82,6 +87,9 @@ struct DatasetSynthConfig {
     v("synth.image_format", image_format, "png or jpg");
     v("synth.jpeg_quality", jpeg_quality, "jpg quality, 1..100");
     v("synth.min_visible_pixels", min_visible_pixels, "redraw a target seen at fewer pixel centres");
+    v("synth.horizon_fraction", horizon_fraction, "share of targets at about the camera's height (on the horizon)");
+    v("synth.horizon_elevation_max_deg", horizon_elevation_max_deg,
+      "those targets' elevation seen from the camera, within +-this, degrees");
     render.visit(v);
   }
   /// Every problem, as "synth.key = value: rule" (and render.*), empty when valid.
