@@ -33,8 +33,17 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
 
   const detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
   std::string why;
+  const auto t_backend = std::chrono::steady_clock::now();
+  // model.backend = opencl: no usable OpenCL device, or a kernel that fails to build, throws here (exit 1, one line).
   auto backend = detector::make_backend(o.backend, model, o.opencl, o.opencl.max_batch, &why);
-  spdlog::info("{}", why);
+  const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
+  if (why.find("no usable OpenCL device") != std::string::npos) {
+    spdlog::warn("{}; running on the CPU (chosen in {:.2f} s)", why, backend_s);  // auto fell back
+  } else {
+    spdlog::info("{} (chosen in {:.2f} s)", why, backend_s);
+  }
+  // The heartbeat says which backend runs, and why, for as long as nothing else needs saying.
+  rt.status().set_state(status_t::STATE_OK, why);
   detector::DetectionPipeline pipeline(o.detection, std::move(backend), model);
 
   auto detect_and_publish = [&](const image_t& img) {

@@ -191,8 +191,19 @@ struct OpenClBackend::Impl {
         log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device);
       } catch (const cl::Error&) {
       }
-      throw std::runtime_error(describe_cl_error(e, "building OpenCL program with '" + opts + "'") + "\nbuild log:\n" +
-                               log);
+      // One line (fatal errors are one line): the log's lines joined, cut to a readable length.
+      std::string one_line;
+      for (char c : log) {
+        if (c == '\n' || c == '\r') {
+          if (!one_line.empty() && one_line.back() != ' ') one_line += " | ";
+        } else {
+          one_line += c;
+        }
+      }
+      while (!one_line.empty() && (one_line.back() == ' ' || one_line.back() == '|')) one_line.pop_back();
+      if (one_line.size() > 400) one_line = one_line.substr(0, 400) + " ...";
+      throw std::runtime_error(describe_cl_error(e, "building OpenCL program with '" + opts + "'") +
+                               (one_line.empty() ? std::string("; empty build log") : "; build log: " + one_line));
     }
     return program;
   }

@@ -68,8 +68,9 @@ std::vector<cl::Device> devices_or_empty(const cl::Platform& platform) {
 std::string available_list() {
   const auto lines = list_opencl_devices();
   if (lines.empty()) return "no OpenCL platform found (is an ICD such as pocl-opencl-icd installed?)";
+  // One line: fatal errors are one line on stderr (and one status_t field).
   std::string s = "available:";
-  for (const auto& l : lines) s += "\n  " + l;
+  for (size_t i = 0; i < lines.size(); ++i) s += (i == 0 ? " " : "; ") + lines[i];
   return s;
 }
 
@@ -98,6 +99,11 @@ cl::Device select_opencl_device(const OpenClOptions& options) {
   const auto platforms = platforms_or_empty();
   std::vector<std::string> pnames;
   for (const auto& p : platforms) pnames.push_back(trimmed(p.getInfo<CL_PLATFORM_NAME>()));
+  if (platforms.empty()) {
+    throw std::runtime_error(
+        "no OpenCL platform found (no ICD loaded: is pocl-opencl-icd or a GPU's OpenCL driver installed, and "
+        "OCL_ICD_VENDORS / OCL_ICD_FILENAMES, if set, right?)");
+  }
   const int p = choose(pnames, options.platform);
   if (p < 0)
     throw std::runtime_error("opencl.platform = '" + options.platform + "' matches no OpenCL platform; " +

@@ -25,7 +25,11 @@ struct DetectorOptions {
   /// Darknet .weights path, or builtin:wingman-small (the shipped trained model, built in; card:
   /// models/wingman-small.md); "" = no model: images are checked and counted, nothing is detected.
   std::string weights = "builtin:wingman-small";
-  std::string backend = "auto";  ///< auto | opencl | cpu
+  /// auto: an OpenCL GPU if there is one, else the faster of opencl and cpu here; without a usable OpenCL device
+  /// (no platform, no device, kernels that fail to build) the CPU backend, with one warning saying why.
+  /// opencl: OpenCL or nothing (no usable device: exit 1 with one line). cpu: OpenCV DNN.
+  /// The backend that runs, and why, is the heartbeat's detail.
+  std::string backend = "auto";
   DetectorPipelineOptions detection;
   OpenClOptions opencl;
 
@@ -40,7 +44,9 @@ struct DetectorOptions {
     v("model.weights", weights,
       "Darknet .weights path, or builtin:wingman-small (shipped, models/wingman-small.md); \"\" = no model "
       "(images are checked and counted only)");
-    v("model.backend", backend, "auto (OpenCL GPU if any, else the faster of opencl/cpu here), opencl or cpu");
+    v("model.backend", backend,
+      "auto (OpenCL GPU if any, else the faster of opencl/cpu here; no usable OpenCL device: cpu, with a warning), "
+      "opencl (no usable OpenCL device: exit 1) or cpu");
     detection.visit(v);
     opencl.visit(v);
   }
