@@ -3,7 +3,8 @@
 # Soak: the four-camera pipeline of tools/load_test.sh (what a 360-degree drone runs: four cameras, four detectors,
 # their localizers and the follower) in real time for a long run, sampling every process's RSS (/proc/PID/status
 # VmRSS) and CPU time every --sample-period seconds into processes.csv, with every heartbeat recorded. Summary: RSS
-# after the warm-up vs at the end per process (fails above --max-rss-growth-pct, default 5), and the latency trend
+# after the warm-up vs at the end per process (peak over the first third after the warm-up vs peak over the last
+# third; fails above --max-rss-growth-pct, default 5), and the latency trend
 # (heartbeat p50/p99 per process and end-to-end, first vs last third; reported, not asserted), plus the real-time
 # checks of tools/load_test.sh.
 #
