@@ -70,7 +70,9 @@ isnum() { [[ "$1" =~ ^[0-9]+([.][0-9]+)?$ ]]; }
 duration="${duration:-$([ "$soak" = true ] && echo 600 || echo 30)}"
 isnum "$duration" || die "--duration '$duration': expected seconds"
 if [ -z "$warmup" ]; then warmup=$(awk -v d="$duration" 'BEGIN{print (d <= 180 ? 30 : 60)}'); fi
-for v in "$warmup" "$sample_period" "$max_p99_s" "$max_rss_growth_pct"; do isnum "$v" || die "'$v': expected a number"; done
+for v in "$warmup" "$sample_period" "$max_p99_s" "$max_rss_growth_pct"; do
+  isnum "$v" || die "'$v': expected a number"
+done
 [[ "$replay_frames" =~ ^[1-9][0-9]*$ ]] || die "--replay-frames '$replay_frames': expected a positive integer"
 if [ "$soak" = true ] && awk -v d="$duration" -v w="$warmup" 'BEGIN{exit !(d < w + 20)}'; then
   die "--duration $duration: a soak needs at least the warm-up ($warmup s) plus 20 s"
@@ -182,6 +184,7 @@ cleanup() {
   logger_pid=""
 }
 trap cleanup EXIT
+exited() { echo "load_test: FAILED: $1 exited $2; its stderr:" >&2; tail -5 "$out/$1.stderr" >&2; exit 1; }
 start() {  # start NAME EXE ARGS...
   local name="$1" exe="$2"; shift 2
   "$bin/$exe" --name "$name" --lcm-url "$url" --log-level info "$@" 2> "$out/$name.stderr" &
@@ -204,7 +207,7 @@ for _ in $(seq 360); do
   ready=true
   for n in "${names[@]}"; do grep -q "^STATUS_${n^^} " <<<"$info" || { ready=false; break; }; done
   [ "$ready" = true ] && break
-  for n in "${names[@]}"; do kill -0 "${pid_of[$n]}" 2>/dev/null || { echo "load_test: $n exited during start-up:" >&2; cat "$out/$n.stderr" >&2; exit 1; }; done
+  for n in "${names[@]}"; do kill -0 "${pid_of[$n]}" 2>/dev/null || exited "$n" "during start-up"; done
   sleep 0.5
 done
 [ "$ready" = true ] || { echo "load_test: FAILED: not every process reported within 180 s" >&2; exit 1; }
@@ -240,7 +243,7 @@ SECONDS=0
 end=$(awk -v d="$duration" 'BEGIN{print int(d + 0.999)}')
 while [ "$SECONDS" -lt "$end" ]; do
   for n in "${names[@]}"; do
-    kill -0 "${pid_of[$n]}" 2>/dev/null || { echo "load_test: FAILED: $n exited during the run:" >&2; cat "$out/$n.stderr" >&2; exit 1; }
+    kill -0 "${pid_of[$n]}" 2>/dev/null || exited "$n" "during the run"
   done
   sleep 1
 done
@@ -257,9 +260,12 @@ kill -TERM "$logger_pid" 2>/dev/null || true; wait "$logger_pid" 2>/dev/null || 
 trap - EXIT
 # The namespace is ours alone: its UDP counters are this run's. RcvbufErrors: datagrams the kernel dropped because a
 # socket's receive buffer was full (a reader that did not keep up), the only way a published frame is lost here.
-udp_counter() { awk -v k="$1" '/^Udp:/{ if (!h) { for (i = 1; i <= NF; i++) c[$i] = i; h = 1 } else print $c[k] }' /proc/net/snmp; }
+udp_counter() {
+  awk -v k="$1" '/^Udp:/ { if (!h) { for (i = 1; i <= NF; i++) c[$i] = i; h = 1 } else print $c[k] }' /proc/net/snmp
+}
 rcvbuf_errors=$(udp_counter RcvbufErrors)
-echo "load_test: UDP in this namespace: $(udp_counter InDatagrams) datagrams received, $rcvbuf_errors dropped on full receive buffers"
+echo "load_test: UDP in this namespace: $(udp_counter InDatagrams) datagrams received," \
+     "$rcvbuf_errors dropped on full receive buffers"
 for n in "${names[@]}"; do
   grep -h "backend" "$out/$n.stderr" 2>/dev/null | sed "s/^/load_test: $n: /" | head -1 || true
   grep -E "\] (warning|error|critical):" "$out/$n.stderr" 2>/dev/null | sed "s/^/load_test: $n: /" | head -3 || true
