@@ -30,6 +30,8 @@ packages=(
   # reliability (docs/reliability.md): supervisord for the supervision fault tests, clang for libFuzzer targets and
   # the AddressSanitizer/UndefinedBehaviorSanitizer/ThreadSanitizer builds
   supervisor clang
+  # `systemd-analyze verify` of the shipped systemd units (nothing is started)
+  systemd
 )
 
 missing=()
