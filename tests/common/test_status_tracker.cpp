@@ -70,6 +70,8 @@ TEST(StatusTracker, OkWithFreshInputsStaysOk) {
 
 TEST(StatusTracker, AnInputSilentForLongerThanStaleAfterIsNamedAndOkBecomesDegraded) {
   wingman::common::StatusTracker t("localizer", 1);
+  EXPECT_DOUBLE_EQ(t.stale_after_s(), 3.0);  // the default
+  t.set_stale_after_s(2.0);
   t.declare_input("DETECTIONS_CAM0");
   t.declare_input("OWN_POSE");
   t.set_state(kOk, "tracking");
@@ -113,6 +115,7 @@ TEST(StatusTracker, AnInputThatNeverHadAMessageIsStaleAfterStaleAfterFromTheFirs
 
 TEST(StatusTracker, ErrorAndDegradedKeepTheirStateWithTheStaleInputAddedStoppingIsLeftAlone) {
   wingman::common::StatusTracker t("camera_driver", 1);
+  t.set_stale_after_s(2.0);
   t.declare_input("A");
   t.heartbeat(0, 0, 1.0);
   t.set_state(kError, "camera unplugged");

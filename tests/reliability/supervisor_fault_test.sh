@@ -221,6 +221,12 @@ for _ in $(seq 1 "$rounds"); do
       awk -v g="$gap_s" -v t="$hold_timeout_s" 'BEGIN {exit !(g > t + 0.1)}' && [ "$n_sp" -eq 0 ] &&
         fail "localizer down for $gap_s s of message time but no setpoint in the gap"
     fi
+    if [ "$prog" = wingman-detector ]; then
+      # Health in the heartbeat: while the detector was down the localizer's input went stale (docs: StatusTracker).
+      stale=$(awk -v a="$t_kill" '$2 == "STATUS" && $3 == "STATUS_LOCALIZER" && $1 >= a && $5 == 2 && /DETECTIONS_CAM0/ {
+                $1 = $2 = $3 = $4 = $5 = ""; sub(/^ +/, ""); print; exit}' "$bus")
+      line+="; localizer heartbeat meanwhile: ${stale:-no DEGRADED heartbeat naming DETECTIONS_CAM0}"
+    fi
     echo "supervisor_fault_test: $line"
     summary+=("$line")
   done

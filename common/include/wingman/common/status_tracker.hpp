@@ -27,7 +27,7 @@ namespace wingman::common {
 class StatusTracker {
  public:
   /// Default of stale_after_s(), seconds of wall time.
-  static constexpr double kDefaultStaleAfterS = 2.0;
+  static constexpr double kDefaultStaleAfterS = 3.0;
 
   /// `process`: instance name shown in status_t.process. `latency_window`: how many recent
   /// latency samples the percentiles cover.
