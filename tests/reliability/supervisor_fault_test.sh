@@ -41,6 +41,7 @@ url="$WINGMAN_LCM_URL"
 tmp=$(mktemp -d /tmp/wingman-supervisor-fault.XXXXXX)
 export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
 sup_pid="" sim_pid="" watch_pid=""
+SECONDS=0
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 now_us() { date +%s%6N; }
@@ -110,10 +111,15 @@ spawn_time_us() {
   echo $(( $(date -d "$stamp" +%s%3N) * 1000 ))
 }
 # wait_for LIMIT_S COMMAND [ARGS...]: runs the command every 0.1 s until it succeeds, for LIMIT_S seconds at most.
+# Every wait also ends at the test's own deadline (480 s of wall time), well before CTest's TIMEOUT.
 wait_for() {
   local limit="$1" _
   shift
-  for _ in $(seq 1 $((limit * 10))); do "$@" && return 0; sleep 0.1; done
+  for _ in $(seq 1 $((limit * 10))); do
+    "$@" && return 0
+    [ "$SECONDS" -lt 480 ] || { echo "supervisor_fault_test: the test's 480 s deadline has passed"; return 1; }
+    sleep 0.1
+  done
   return 1
 }
 all_running() {
@@ -165,8 +171,7 @@ summary=()
 for _ in $(seq 1 "$rounds"); do
   for prog in "${programs[@]}"; do
     # Steady state first: a fresh target (or, for the camera, an image) in the last 2 s.
-    wait_for 60 targets_steady ||
-      fail "$prog: no steady targets before the kill"
+    wait_for 60 targets_steady || { fail "$prog: no steady targets before the kill"; exit 1; }
     declare -A before_pid=() before_exits=()
     for p in "${programs[@]}"; do before_pid[$p]=$(pid_of "$p"); before_exits[$p]=$(exits_of "$p"); done
     spawns=$(spawns_of "$prog")
