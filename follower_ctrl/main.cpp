@@ -24,6 +24,9 @@ int run(common::Runtime& rt, const follower_ctrl::FollowerOptions& o) {
   if (follower.mode() == follower_ctrl::ControllerMode::kFormation) {
     rt.subscribe<targets_t>(o.targets_channel,
                             [&](const targets_t& t) { handle(o.targets_channel, follower.on_targets(t)); });
+    if (!o.localizer_instance.empty())
+      rt.subscribe<status_t>(common::status_channel(o.localizer_instance),
+                             [&](const status_t& s) { follower.on_localizer_status(s); });
   } else {
     rt.subscribe<detections_t>(o.detections_channel, [&](const detections_t& d) {
       rt.status().set_last_processed_seq(d.seq);

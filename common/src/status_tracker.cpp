@@ -2,6 +2,8 @@
 // Status bookkeeping and heartbeat construction.
 #include "wingman/common/status_tracker.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -37,6 +39,7 @@ void StatusTracker::input(const std::string& ch, int64_t utime) {
   Channel& c = channel(ch, kIn);
   ++c.count;
   ++c.window_count;
+  ++c.window_handled;
   c.last_utime = utime;
   last_input_utime_ = std::max(last_input_utime_, utime);
   ++messages_handled_;
@@ -101,8 +104,27 @@ wingman::status_t StatusTracker::heartbeat(int64_t wall_utime, int64_t uptime_us
   s.utime = wall_utime;
   s.process = process_;
   s.pid = pid_;
+  if (first_heartbeat_wall_utime_ < 0) first_heartbeat_wall_utime_ = wall_utime;
+  // Input freshness (see the class comment): channels with a handled message in this window are fresh now.
+  std::string stale;
+  for (const auto& key : channel_order_) {
+    if (key.second != kIn) continue;
+    Channel& c = channels_.at(key);
+    if (c.window_handled > 0) c.fresh_wall_utime = wall_utime;
+    c.window_handled = 0;
+    const int64_t since = c.fresh_wall_utime >= 0 ? c.fresh_wall_utime : first_heartbeat_wall_utime_;
+    const double silent_s = static_cast<double>(wall_utime - since) * 1e-6;
+    if (silent_s <= stale_after_s_) continue;
+    stale += stale.empty() ? "stale input: " : ", ";
+    stale += c.fresh_wall_utime >= 0 ? fmt::format("no message on {} for {:.1f} s", key.first, silent_s)
+                                     : fmt::format("no message yet on {} ({:.1f} s)", key.first, silent_s);
+  }
   s.state = state_;
   s.detail = detail_;
+  if (!stale.empty() && state_ != wingman::status_t::STATE_STOPPING) {
+    if (state_ == wingman::status_t::STATE_OK) s.state = wingman::status_t::STATE_DEGRADED;
+    s.detail = detail_.empty() ? stale : detail_ + "; " + stale;
+  }
   s.uptime_us = uptime_us;
   s.last_input_utime = last_input_utime_;
   s.last_processed_seq = last_processed_seq_;

@@ -39,7 +39,36 @@ Follower::Follower(const FollowerOptions& options)
       timeout_us_(options.hold_timeout_us()),
       select_policy_(*parse_select_policy(options.formation.select)),
       formation_(options.formation, options.limits, options.camera_mount.rotation()),
-      pid_1d_(options.pid_1d, options.limits, options.camera_mount.rotation()) {}
+      pid_1d_(options.pid_1d, options.limits, options.camera_mount.rotation()),
+      localizer_timeout_us_(options.localizer_heartbeat_timeout_us()) {}
+
+void Follower::saw_message_time(int64_t utime) {
+  if (!newest_utime_ || utime > *newest_utime_) newest_utime_ = utime;
+  // A heartbeat that came before any message time is dated by the first one.
+  if (localizer_armed_ && !localizer_seen_utime_) localizer_seen_utime_ = *newest_utime_;
+}
+
+void Follower::on_localizer_status(const wingman::status_t& status) {
+  if (mode_ != ControllerMode::kFormation || options_.localizer_instance.empty()) return;
+  localizer_armed_ = true;
+  localizer_state_ = status.state;
+  localizer_detail_ = status.detail;
+  if (newest_utime_) localizer_seen_utime_ = *newest_utime_;
+}
+
+std::string Follower::localizer_problem(int64_t utime) const {
+  if (mode_ != ControllerMode::kFormation || options_.localizer_instance.empty() || !localizer_armed_) return "";
+  if (localizer_state_ == wingman::status_t::STATE_STOPPING || localizer_state_ == wingman::status_t::STATE_ERROR)
+    return fmt::format("localizer '{}' reports {}{}", options_.localizer_instance,
+                       localizer_state_ == wingman::status_t::STATE_STOPPING ? "STOPPING" : "ERROR",
+                       localizer_detail_.empty() ? "" : " (" + localizer_detail_ + ")");
+  if (localizer_seen_utime_ && utime - *localizer_seen_utime_ > localizer_timeout_us_)
+    return fmt::format(
+        "no heartbeat from localizer '{}' for {:.3f} s of message time "
+        "(localizer.heartbeat_timeout_s = {})",
+        options_.localizer_instance, seconds(utime - *localizer_seen_utime_), options_.localizer_heartbeat_timeout_s);
+  return "";
+}
 
 FollowerOutput Follower::on_own_pose(const wingman::own_pose_t& pose) {
   if (own_ && pose.utime <= own_->utime)
@@ -47,6 +76,7 @@ FollowerOutput Follower::on_own_pose(const wingman::own_pose_t& pose) {
                                             pose.utime, own_->utime,
                                             pose.utime == own_->utime ? "duplicate" : "out of order"));
   own_ = own_state_from_message(pose);
+  saw_message_time(pose.utime);
   if (!first_pose_utime_) {
     first_pose_utime_ = pose.utime;
     start_height_m_ = own_->p_body_in_world.z();
@@ -59,6 +89,8 @@ FollowerOutput Follower::on_own_pose(const wingman::own_pose_t& pose) {
                                                 formation ? "targets_t" : "detections_t",
                                                 formation ? options_.targets_channel : options_.detections_channel,
                                                 seconds(pose.utime - since), options_.hold_timeout_s));
+  } else if (const std::string why = localizer_problem(pose.utime); !why.empty()) {
+    out.setpoint = hold(pose.utime, why);
   }
   return out;
 }
@@ -74,11 +106,18 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
                       i, msg.targets[i].detection_source));
   }
   accept_driving_input("targets_t.utime", msg.utime);
+  saw_message_time(msg.utime);
   FollowerOutput out;
   if (const std::string why = own_pose_problem(msg.utime); !why.empty()) {
     out.setpoint = hold(msg.utime, why);
     return out;
   }
+  if (const std::string why = localizer_problem(msg.utime); !why.empty()) {
+    out.setpoint = hold(msg.utime, why);
+    return out;
+  }
+  // A targets_t is the localizer's output: as good a sign of life as a heartbeat (see the class comment).
+  if (localizer_armed_) localizer_seen_utime_ = msg.utime;
   const OwnState own = own_->predicted_to(msg.utime);
   const std::vector<TargetState> usable = usable_targets(msg, timeout_us_);
   const std::optional<TargetState> chosen =
@@ -120,6 +159,7 @@ FollowerOutput Follower::on_detections(const wingman::detections_t& msg) {
     throw std::invalid_argument(
         fmt::format("detections_t.source = {}: must be SOURCE_CNN (0) or SOURCE_GROUND_TRUTH (1)", msg.source));
   accept_driving_input("detections_t.utime", msg.utime);
+  saw_message_time(msg.utime);
   last_source_ = msg.source;
   FollowerOutput out;
   for (size_t i = 0; i < msg.detections.size(); ++i) {

@@ -26,6 +26,8 @@ std::vector<std::string> FollowerOptions::validate() const {
   if (!parse_controller_mode(mode)) p.push_back(problem("controller.mode", mode, "must be formation or pid_1d"));
   if (!(hold_timeout_s > 0) || !std::isfinite(hold_timeout_s))
     p.push_back(problem("hold.timeout_s", hold_timeout_s, "must be a finite number > 0"));
+  if (!(localizer_heartbeat_timeout_s > 0) || !std::isfinite(localizer_heartbeat_timeout_s))
+    p.push_back(problem("localizer.heartbeat_timeout_s", localizer_heartbeat_timeout_s, "must be a finite number > 0"));
   for (const auto& part : {limits.validate(), camera_mount.validate(), formation.validate(), pid_1d.validate()})
     p.insert(p.end(), part.begin(), part.end());
   if (formation.avoid_climb_mps > limits.max_vertical_speed_mps)
@@ -36,5 +38,8 @@ std::vector<std::string> FollowerOptions::validate() const {
 }
 
 int64_t FollowerOptions::hold_timeout_us() const { return static_cast<int64_t>(std::llround(hold_timeout_s * 1e6)); }
+int64_t FollowerOptions::localizer_heartbeat_timeout_us() const {
+  return static_cast<int64_t>(std::llround(localizer_heartbeat_timeout_s * 1e6));
+}
 
 }  // namespace wingman::follower_ctrl

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// StatusTracker: counts per channel, drops, rates and latency percentiles in the heartbeat.
+// StatusTracker: counts per channel, drops, rates, latency percentiles and input staleness in the heartbeat.
 #include <gtest/gtest.h>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/common/status_tracker.hpp>
@@ -47,6 +47,97 @@ TEST(StatusTracker, LatencyPercentilesMatchNearestRankOverTheWindow) {
   EXPECT_FLOAT_EQ(s.latency_p90_ms, 90.0f);
   EXPECT_FLOAT_EQ(s.latency_p99_ms, 99.0f);
   EXPECT_FLOAT_EQ(s.latency_max_ms, 100.0f);
+}
+
+constexpr int64_t kS = 1000000;  // one second in microseconds
+// Copies of the LCM constants (the generated static members have no definition to bind a reference to).
+constexpr int8_t kOk = wingman::status_t::STATE_OK;
+constexpr int8_t kDegraded = wingman::status_t::STATE_DEGRADED;
+constexpr int8_t kError = wingman::status_t::STATE_ERROR;
+constexpr int8_t kStopping = wingman::status_t::STATE_STOPPING;
+
+TEST(StatusTracker, OkWithFreshInputsStaysOk) {
+  wingman::common::StatusTracker t("localizer", 1);
+  t.declare_input("DETECTIONS_CAM0");
+  t.set_state(kOk, "");
+  for (int i = 0; i < 5; ++i) {
+    t.input("DETECTIONS_CAM0", i);
+    const wingman::status_t s = t.heartbeat(100 * kS + i * kS, 0, 1.0);
+    EXPECT_EQ(s.state, kOk) << s.detail;
+    EXPECT_EQ(s.detail, "");
+  }
+}
+
+TEST(StatusTracker, AnInputSilentForLongerThanStaleAfterIsNamedAndOkBecomesDegraded) {
+  wingman::common::StatusTracker t("localizer", 1);
+  EXPECT_DOUBLE_EQ(t.stale_after_s(), 3.0);  // the default
+  t.set_stale_after_s(2.0);
+  t.declare_input("DETECTIONS_CAM0");
+  t.declare_input("OWN_POSE");
+  t.set_state(kOk, "tracking");
+  t.input("DETECTIONS_CAM0", 1);
+  t.input("OWN_POSE", 1);
+  EXPECT_EQ(t.heartbeat(10 * kS, 0, 1.0).state, kOk);
+  // Own poses keep coming; detections stop. 2.0 s after the last window with one: still fresh (not more than).
+  t.input("OWN_POSE", 2);
+  EXPECT_EQ(t.heartbeat(11 * kS, 0, 1.0).state, kOk);
+  t.input("OWN_POSE", 3);
+  EXPECT_EQ(t.heartbeat(12 * kS, 0, 1.0).state, kOk);
+  t.input("OWN_POSE", 4);
+  const wingman::status_t s = t.heartbeat(13 * kS, 0, 1.0);
+  EXPECT_EQ(s.state, kDegraded);
+  EXPECT_EQ(s.detail, "tracking; stale input: no message on DETECTIONS_CAM0 for 3.0 s");
+  EXPECT_EQ(t.state(), kOk);  // the process's own state is unchanged
+  // Dropped messages are not fresh data.
+  t.input_dropped("DETECTIONS_CAM0", "bad");
+  t.input("OWN_POSE", 5);
+  EXPECT_EQ(t.heartbeat(14 * kS, 0, 1.0).state, kDegraded);
+  // A handled message makes it fresh again.
+  t.input("DETECTIONS_CAM0", 6);
+  t.input("OWN_POSE", 6);
+  const wingman::status_t back = t.heartbeat(15 * kS, 0, 1.0);
+  EXPECT_EQ(back.state, kOk);
+  EXPECT_EQ(back.detail, "tracking");
+}
+
+TEST(StatusTracker, AnInputThatNeverHadAMessageIsStaleAfterStaleAfterFromTheFirstHeartbeat) {
+  wingman::common::StatusTracker t("detector", 1);
+  t.set_stale_after_s(5.0);
+  EXPECT_DOUBLE_EQ(t.stale_after_s(), 5.0);
+  t.declare_input("IMAGE_CAM0");
+  t.set_state(kOk, "");
+  EXPECT_EQ(t.heartbeat(20 * kS, 0, 1.0).state, kOk);
+  EXPECT_EQ(t.heartbeat(25 * kS, 0, 1.0).state, kOk);
+  const wingman::status_t s = t.heartbeat(26 * kS, 0, 1.0);
+  EXPECT_EQ(s.state, kDegraded);
+  EXPECT_EQ(s.detail, "stale input: no message yet on IMAGE_CAM0 (6.0 s)");
+}
+
+TEST(StatusTracker, ErrorAndDegradedKeepTheirStateWithTheStaleInputAddedStoppingIsLeftAlone) {
+  wingman::common::StatusTracker t("camera_driver", 1);
+  t.set_stale_after_s(2.0);
+  t.declare_input("A");
+  t.heartbeat(0, 0, 1.0);
+  t.set_state(kError, "camera unplugged");
+  wingman::status_t s = t.heartbeat(3 * kS, 0, 1.0);
+  EXPECT_EQ(s.state, kError);
+  EXPECT_EQ(s.detail, "camera unplugged; stale input: no message yet on A (3.0 s)");
+  t.set_state(kDegraded, "");
+  s = t.heartbeat(4 * kS, 0, 1.0);
+  EXPECT_EQ(s.state, kDegraded);
+  EXPECT_EQ(s.detail, "stale input: no message yet on A (4.0 s)");
+  t.set_state(kStopping, "signal 15");
+  s = t.heartbeat(5 * kS, 0, 1.0);
+  EXPECT_EQ(s.state, kStopping);
+  EXPECT_EQ(s.detail, "signal 15");
+}
+
+TEST(StatusTracker, OutputsAreNeverStale) {
+  wingman::common::StatusTracker t("camera_driver", 1);
+  t.declare_output("IMAGE_CAM0");
+  t.set_state(kOk, "file clip.avi");
+  t.heartbeat(0, 0, 1.0);
+  EXPECT_EQ(t.heartbeat(60 * kS, 0, 60.0).state, kOk);
 }
 
 }  // namespace

@@ -14,8 +14,21 @@ namespace wingman::common {
 
 /// Collects what a process did (messages in and out per channel, drops, latencies, errors) and
 /// builds its status_t heartbeat. Not thread-safe: use it from the process's main loop only.
+///
+/// Health: the heartbeat's state is the one the process set (set_state), except that a process that
+/// says OK but has a stale input is reported DEGRADED. An input channel (declared or seen) is stale
+/// when no message was handled on it (dropped ones do not count) for more than stale_after_s of wall
+/// time: each heartbeat marks the channels that had a message since the previous heartbeat as fresh
+/// at its wall_utime, so staleness is known to within one heartbeat period (1 s by default). A
+/// channel that never had a message is stale once stale_after_s has passed since the first
+/// heartbeat. Every stale channel is named in the detail ("stale input: no message on IMAGE_CAM0 for
+/// 3.0 s"), appended to the process's own detail in every state but STOPPING. Wall time is used
+/// because this is a liveness signal for monitoring; nothing in the data path depends on it.
 class StatusTracker {
  public:
+  /// Default of stale_after_s(), seconds of wall time.
+  static constexpr double kDefaultStaleAfterS = 3.0;
+
   /// `process`: instance name shown in status_t.process. `latency_window`: how many recent
   /// latency samples the percentiles cover.
   StatusTracker(std::string process, int32_t pid, size_t latency_window = 256);
@@ -43,6 +56,9 @@ class StatusTracker {
   void set_state(int8_t state, const std::string& detail);
   /// Remembers an error as last_error (does not change the state).
   void set_error(const std::string& error) { last_error_ = error; }
+  /// Seconds of wall time without a handled message after which an input counts as stale (> 0).
+  void set_stale_after_s(double seconds) { stale_after_s_ = seconds > 0.0 ? seconds : kDefaultStaleAfterS; }
+  double stale_after_s() const { return stale_after_s_; }
 
   int8_t state() const { return state_; }
   int64_t messages_handled() const { return messages_handled_; }
@@ -52,8 +68,9 @@ class StatusTracker {
   int64_t output_count(const std::string& channel) const;
   const std::string& last_error() const { return last_error_; }
 
-  /// Builds a heartbeat. `wall_utime`: now (monitoring only); `window_s`: seconds since the previous
-  /// heartbeat, over which rates are computed (rate counters restart after each call).
+  /// Builds a heartbeat. `wall_utime`: now (monitoring only; also the clock of the input staleness);
+  /// `window_s`: seconds since the previous heartbeat, over which rates are computed (rate counters
+  /// restart after each call).
   wingman::status_t heartbeat(int64_t wall_utime, int64_t uptime_us, double window_s);
 
  private:
@@ -62,7 +79,9 @@ class StatusTracker {
     int64_t count = 0;
     int64_t drops = 0;
     int64_t window_count = 0;
+    int64_t window_handled = 0;  ///< inputs: messages handled (not dropped) since the previous heartbeat
     int64_t last_utime = 0;
+    int64_t fresh_wall_utime = -1;  ///< inputs: wall time of the heartbeat that last saw a handled message, -1 never
   };
   Channel& channel(const std::string& name, int8_t direction);
 
@@ -79,6 +98,8 @@ class StatusTracker {
   int64_t last_processed_seq_ = -1;
   int64_t messages_handled_ = 0;
   int64_t drops_total_ = 0;
+  double stale_after_s_ = kDefaultStaleAfterS;
+  int64_t first_heartbeat_wall_utime_ = -1;
 };
 
 }  // namespace wingman::common

@@ -12,6 +12,7 @@
 #include <wingman/detections_t.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/setpoint_t.hpp>
+#include <wingman/status_t.hpp>
 #include <wingman/targets_t.hpp>
 
 #include <cstdint>
@@ -50,6 +51,18 @@ struct FollowerOutput {
 /// Own poses: when no driving input has arrived for longer than hold.timeout_s of own-pose time
 /// (counted from the first own pose when none has arrived yet), each own pose gives one MODE_HOLD
 /// with its utime, so a stopped localizer or detector cannot leave the follower flying.
+/// Localizer watchdog (mode formation, localizer.instance not ""): once a localizer heartbeat
+/// (status_t) has arrived, the follower also holds while the localizer is down:
+///  - its newest heartbeat reports STATE_STOPPING or STATE_ERROR, or
+///  - no heartbeat for longer than localizer.heartbeat_timeout_s of message time: the follower's
+///    newest own-pose/targets utime when it arrives is the heartbeat's time (never the receive clock
+///    or the heartbeat's wall-clock utime), and later inputs compare their utime with it. A targets_t
+///    accepted while the localizer is not STOPPING/ERROR counts as a heartbeat at its utime: heartbeats
+///    come once per second of wall time, so a simulation or replay running faster than real time would
+///    otherwise see gaps of several seconds of message time between them while targets flow.
+/// Then each targets_t gives a MODE_HOLD, and so does each own pose. The next heartbeat in another
+/// state ends it; the follower resumes with the next usable target. Before the first heartbeat the
+/// watchdog is not armed (no targets come without a localizer, and the targets timeout holds).
 /// Every hold forgets the PID memory and the previous command; a track switch forgets the PID memory.
 /// setpoint_t.detection_source is copied from the data behind the setpoint (the followed target, the
 /// detections message; for a hold the newest known); target_track_id is the followed track (0 for pid_1d and holds).
@@ -68,6 +81,10 @@ class Follower {
   /// the previous one or an unknown source; throws std::logic_error in mode formation.
   FollowerOutput on_detections(const wingman::detections_t& detections);
 
+  /// A heartbeat of the watched localizer (the caller subscribes to its status channel; mode formation
+  /// only). Gives no setpoint: the next own pose or targets_t acts on it.
+  void on_localizer_status(const wingman::status_t& status);
+
   const FollowerStatus& status() const { return status_; }
   ControllerMode mode() const { return mode_; }
 
@@ -75,6 +92,10 @@ class Follower {
   wingman::setpoint_t hold(int64_t utime, const std::string& reason);
   /// "" when the own pose is usable at `utime`, else why not.
   std::string own_pose_problem(int64_t utime) const;
+  /// "" when the localizer watchdog lets the follower fly at message time `utime`, else why not.
+  std::string localizer_problem(int64_t utime) const;
+  /// Advances the newest message time (own poses and driving inputs) to `utime`.
+  void saw_message_time(int64_t utime);
   void accept_driving_input(const char* field, int64_t utime);
   wingman::setpoint_t fly(int64_t utime, const VelocityCommand& command, int32_t track_id, int8_t source,
                           const std::string& what);
@@ -93,6 +114,12 @@ class Follower {
   int32_t followed_track_id_ = 0;           ///< formation: the track followed, 0 none
   std::optional<TargetState> last_target_;  ///< formation: the last usable state of the followed track
   std::optional<int64_t> last_box_utime_;   ///< pid_1d: utime of the last detections with a usable box
+  int64_t localizer_timeout_us_;
+  std::optional<int64_t> newest_utime_;          ///< newest own-pose or driving-input utime
+  bool localizer_armed_ = false;                 ///< a localizer heartbeat has arrived
+  std::optional<int64_t> localizer_seen_utime_;  ///< message time of the newest heartbeat (unset: none yet)
+  int8_t localizer_state_ = wingman::status_t::STATE_STARTING;
+  std::string localizer_detail_;
   FollowerStatus status_;
 };
 

@@ -35,6 +35,13 @@ struct FollowerOptions {
   /// target), an own pose older than this at the input's time, or no driving input for longer at an
   /// own pose's time.
   double hold_timeout_s = 0.5;
+  /// Localizer watchdog (mode formation): the localizer instance whose heartbeats (STATUS_<NAME>,
+  /// status_t) are watched; "" switches the watchdog off.
+  std::string localizer_instance = "localizer";
+  /// No localizer heartbeat for longer than this, seconds of the follower's message time (own-pose and
+  /// targets utimes, > 0) -> MODE_HOLD. Heartbeats come every second of wall time: this must exceed the
+  /// localizer's status period times the simulator's sync.speed when it runs faster than real time.
+  double localizer_heartbeat_timeout_s = 3.0;
   LimitsOptions limits;
   CameraMountOptions camera_mount;
   FormationOptions formation;
@@ -49,6 +56,10 @@ struct FollowerOptions {
     v("controller.mode", mode, "formation (offset from a tracked target) or pid_1d (thesis 1-D PID on the box centre)");
     v("hold.timeout_s", hold_timeout_s,
       "no usable target, no fresh own pose or no driving input for longer than this (message time, s) -> MODE_HOLD");
+    v("localizer.instance", localizer_instance,
+      "mode formation: hold unless this localizer instance's heartbeat (STATUS_<NAME>) is alive; \"\" = no watchdog");
+    v("localizer.heartbeat_timeout_s", localizer_heartbeat_timeout_s,
+      "no localizer heartbeat for longer than this (own-pose/targets time, s), or STOPPING/ERROR -> MODE_HOLD");
     limits.visit(v);
     camera_mount.visit(v);
     formation.visit(v);
@@ -61,6 +72,8 @@ struct FollowerOptions {
   ControllerMode controller_mode() const { return *parse_controller_mode(mode); }
   /// hold_timeout_s in microseconds.
   int64_t hold_timeout_us() const;
+  /// localizer_heartbeat_timeout_s in microseconds.
+  int64_t localizer_heartbeat_timeout_us() const;
 };
 
 }  // namespace wingman::follower_ctrl

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Checks config/systemd/ with `systemd-analyze verify`: the units are rendered for the build tree (the executables'
+# folder substituted for /usr/local/bin, as for an install there) and any warning or error fails the test. Also
+# checks that each unit runs its process with its configuration, restarts it always, stops it with SIGTERM and
+# that wingman.target wants all four. Exits 77 (skipped) when systemd-analyze is not installed.
+# Usage: tests/reliability/systemd_units_test.sh SRC_DIR BIN_DIR
+set -euo pipefail
+src=$(cd "$1" && pwd) bin=$(cd "$2" && pwd)
+if ! command -v systemd-analyze > /dev/null; then
+  echo "systemd_units_test: SKIPPED: systemd-analyze is not installed (Debian package systemd)"
+  exit 77
+fi
+tmp=$(mktemp -d /tmp/wingman-systemd.XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+declare -A cfg=([wingman-camera-driver]=camera_driver [wingman-detector]=detector [wingman-localizer]=localizer
+                [wingman-follower-ctrl]=follower_ctrl)
+for unit in "$src"/config/systemd/*; do sed "s|/usr/local/bin/|$bin/|g" "$unit" > "$tmp/$(basename "$unit")"; done
+for exe in "${!cfg[@]}"; do
+  u="$src/config/systemd/$exe.service"
+  [ -r "$u" ] || { fail "no unit $u"; continue; }
+  grep -qx "ExecStart=/usr/local/bin/$exe --config /usr/local/etc/wingman/${cfg[$exe]}.yaml" "$u" || fail "$u: ExecStart"
+  for key in Type=simple Restart=always KillSignal=SIGTERM TimeoutStopSec=2 RestartSec=0.5 WantedBy=wingman.target \
+             PartOf=wingman.target; do
+    grep -qx "$key" "$u" || fail "$u: no $key"
+  done
+  grep -q '^Environment="LCM_DEFAULT_URL=udpm://.*ttl=0&recv_buf_size=4194304"$' "$u" || fail "$u: no LCM URL"
+  grep -q "^Wants=.*$exe.service" "$src/config/systemd/wingman.target" || fail "wingman.target does not want $exe"
+done
+# verify reads the units as systemd would load them; it prints every problem (unknown keys included) on stderr.
+if ! systemd-analyze verify --man=no "$tmp"/wingman.target "$tmp"/wingman-*.service > "$tmp/verify.txt" 2>&1 ||
+   [ -s "$tmp/verify.txt" ]; then
+  fail "systemd-analyze verify:"; cat "$tmp/verify.txt"
+fi
+[ "$failures" -eq 0 ] || exit 1
+echo "systemd_units_test: 4 units and wingman.target verified ($(systemd-analyze --version | head -n 1))"
