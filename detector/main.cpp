@@ -6,6 +6,9 @@
 #include "wingman/detector/preprocess.hpp"
 
 #include <wingman/common/runtime.hpp>
+#include <wingman/common/sequence_gaps.hpp>
+
+#include <fmt/format.h>
 
 #include <spdlog/spdlog.h>
 
@@ -68,10 +71,27 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     rt.status().set_last_processed_seq(img.seq);
   };
   auto validate = [limits](const image_t& img) { return common::validate_message(img, limits); };
+  // Frames that never reached this process (lost at the camera, or on the bus when a receive buffer overflows)
+  // show only as gaps in image_t.seq: each missing frame is counted as a drop on the input channel.
+  common::SequenceGapCounter gaps;
+  auto count_gap = [&](const image_t& img) {
+    const int64_t missing = gaps.observe(img.seq);
+    for (int64_t i = 0; i < missing; ++i) {
+      rt.status().item_dropped(o.input_channel, fmt::format("channel {}: {} frame(s) missing before seq {} (lost "
+                                                            "upstream: at the camera or on the bus)",
+                                                            o.input_channel, missing, img.seq));
+    }
+  };
 
   if (o.mode == "replay" || rt.input_is_file()) {
     // Every frame, in order, inside its handler: deterministic, and lockstep-friendly.
-    rt.subscribe<image_t>(o.input_channel, detect_and_publish, validate);
+    rt.subscribe<image_t>(
+        o.input_channel,
+        [&](const image_t& img) {
+          count_gap(img);
+          detect_and_publish(img);
+        },
+        validate);
     return rt.spin();
   }
   // Real time: keep the newest frame; a frame superseded before it was processed is a counted drop.
@@ -79,6 +99,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   rt.subscribe<image_t>(
       o.input_channel,
       [&](const image_t& img) {
+        count_gap(img);
         if (pending) rt.status().item_dropped(o.input_channel, "frame superseded by a newer one while busy");
         pending = img;
       },

@@ -149,7 +149,7 @@ def realtime(a):
     st = statuses(a.log)
     series = latency_series(a.log, a.cameras)
     print("load: per camera (from each process's last status_t; counts since start)")
-    print("  camera  published  received  processed  dropped  in-flight  lost-in-transport   fps-pub  fps-proc")
+    print("  camera  published  received  processed  dropped  unaccounted  lost-in-transport   fps-pub  fps-proc")
     for i in range(a.cameras):
         cam, det = st.get(f"camera_{i}"), st.get(f"detector_{i}")
         if not cam or not det:
@@ -161,33 +161,36 @@ def realtime(a):
         received = d["channels"].get((img, "in"), {}).get("count", 0)
         dropped = d["channels"].get((img, "in"), {}).get("drops", 0)
         processed = d["channels"].get((f"DETECTIONS_CAM{i}", "out"), {}).get("count", 0)
-        in_flight = received - processed - dropped
+        # The detector counts as dropped both the frames it superseded (newest-frame policy) and those that never
+        # reached it (gaps in image_t.seq), so every published frame is processed or dropped, except the one in
+        # hand at the stop and frames lost after the last one that arrived (no later frame shows their gap).
+        unaccounted = published - processed - dropped
         lost = published - received
         up = c["uptime_us"] / 1e6
         fps_pub = published / up if up > 0 else 0.0
         fps_proc = processed / up if up > 0 else 0.0
         final = c["state"] == 4 and d["state"] == 4
-        print(f"  {i:6d} {published:10d} {received:9d} {processed:10d} {dropped:8d} {in_flight:10d} "
+        print(f"  {i:6d} {published:10d} {received:9d} {processed:10d} {dropped:8d} {unaccounted:12d} "
               f"{lost:18d} {fps_pub:9.1f} {fps_proc:9.2f}{'' if final else '  (no final STOPPING status)'}")
         result["cameras"].append({"camera": i, "published": published, "received": received, "processed": processed,
-                                  "dropped": dropped, "in_flight": in_flight, "lost_in_transport": lost,
+                                  "dropped": dropped, "unaccounted": unaccounted, "lost_in_transport": lost,
                                   "fps_published": fps_pub, "fps_processed": fps_proc, "final_status": final})
         if not final:
             failures.append(f"camera {i}: camera_{i} or detector_{i} published no final STOPPING status")
         if processed == 0:
             failures.append(f"camera {i}: detector_{i} processed no frame")
-        # The newest-frame policy: every frame received is processed or counted as dropped (at most the one
-        # pending frame is in flight when the detector stops).
-        if not 0 <= in_flight <= 1:
-            failures.append(f"camera {i}: detector_{i} received {received} frames but processed {processed} and "
-                            f"counted {dropped} dropped ({in_flight} unaccounted)")
-        # A frame lost on the bus is not counted by the detector (it sees no message). Under CPU saturation the
+        # Accounting: at most the frame in hand plus a short tail of lost frames (max(3, 2 %)) are unaccounted.
+        if not 0 <= unaccounted <= max(3, 0.02 * published):
+            failures.append(f"camera {i}: camera_{i} published {published} frames; detector_{i} processed {processed} "
+                            f"and counted {dropped} dropped (superseded or missing from the sequence): "
+                            f"{unaccounted} unaccounted")
+        # A frame lost on the bus is counted by the detector only from the seq gap it leaves. Under CPU saturation the
         # kernel drops datagrams when a socket's receive thread falls behind (2-7 % of the frames here); the bound
         # (20 %) is generous: it catches a bus that loses most frames (e.g. no recv_buf_size), and the loss must be
         # explained by the kernel's receive-buffer drops (checked over all cameras below).
         if lost < 0 or lost > max(2, 0.20 * published):
             failures.append(f"camera {i}: {lost} of {published} published frames never reached detector_{i} "
-                            "(lost on the bus, uncounted by the detector)")
+                            "(lost on the bus)")
     lost_total = sum(c["lost_in_transport"] for c in result["cameras"])
     result["lost_in_transport"] = lost_total
     if a.udp_rcvbuf_errors is not None:
