@@ -329,7 +329,13 @@ CalibrationFormat detect_calibration_format(const std::string& path) {
 
 CameraModel load_calibration(const std::string& path, const std::string& kalibr_camera) {
   const CalibrationFormat format = detect_calibration_format(path);
-  if (format == CalibrationFormat::kOpenCvFileStorage) return read_opencv(path);
+  if (format == CalibrationFormat::kOpenCvFileStorage) {
+    try {
+      return read_opencv(path);
+    } catch (const cv::Exception& e) {  // e.g. a top level that is not a mapping (a fuzzed file): fs[key] asserts
+      throw CalibrationError(fmt::format("{}: not a valid OpenCV calibration file: {}", path, e.err));
+    }
+  }
   const YAML::Node root = parse_yaml(path, read_text(path));
   if (format == CalibrationFormat::kRosCameraInfo) return read_ros(path, root);
   return read_kalibr(path, root, kalibr_camera);
