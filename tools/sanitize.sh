@@ -8,7 +8,8 @@
 #   tsan  build-tsan: ThreadSanitizer. Without ctest args: the multi-process tests and the tests whose code
 #         runs threads (TSAN_TESTS below).
 # With ctest args, only `ctest <args>` runs (e.g. `tools/sanitize.sh asan -R fuzz_corpus`).
-# Environment: WINGMAN_FUZZ_SECONDS (fuzz time per target), JOBS (build and ctest parallelism, default 2).
+# Environment: WINGMAN_FUZZ_SECONDS (fuzz time per target), JOBS (build and ctest parallelism, default 2),
+#   SANITIZE_TARGETS (build only these targets, space-separated; default: everything the stage needs).
 # Each stage's wall time is printed ("sanitize: <stage> took N s").
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,8 +41,9 @@ common_cmake=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clan
 if [[ $kind == asan ]]; then
   build=build-asan
   stage "asan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=address,undefined \
-    -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-30}" >/dev/null
-  stage "asan build" nice -n 5 cmake --build $build -j"$jobs"
+    -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-30}" --log-level=WARNING
+  # shellcheck disable=SC2086  # SANITIZE_TARGETS is a list
+  stage "asan build" nice -n 5 cmake --build $build -j"$jobs" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}
   # Leaks fail a test (a process exits non-zero at its end); suppressions name third-party libraries only.
   export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:detect_stack_use_after_return=0:strict_init_order=1:${ASAN_OPTIONS:-}"
   export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0:${LSAN_OPTIONS:-}"
@@ -67,8 +69,11 @@ TSAN_TESTS='^(ProcessConfig|ProcessFileIo|ProcessSignals|Replay|LocalizerProcess
 tsan_targets=(wingman-camera-driver wingman-detector wingman-localizer wingman-follower-ctrl wingman
   test_process_runtime test_replay test_localizer_process test_detector_process test_detector_realtime
   test_follower_process)
-stage "tsan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=thread >/dev/null
-if [[ $# -gt 0 ]]; then
+stage "tsan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=thread --log-level=WARNING
+if [[ -n ${SANITIZE_TARGETS:-} ]]; then
+  # shellcheck disable=SC2086  # a list
+  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target $SANITIZE_TARGETS
+elif [[ $# -gt 0 ]]; then
   stage "tsan build" nice -n 5 cmake --build $build -j"$jobs"
 else
   stage "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target "${tsan_targets[@]}" \
