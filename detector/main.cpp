@@ -12,6 +12,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <stdexcept>
@@ -31,6 +32,12 @@ int run_without_model(common::Runtime& rt, const detector::DetectorOptions& o, c
 
 int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   const common::ImageLimits limits{o.max_image_width, o.max_image_height};
+  // Oversized images are dropped before they are decoded (no allocation for their pixels).
+  common::MessageLimits message_limits;
+  message_limits.image = limits;
+  message_limits.max_message_bytes =
+      std::max<std::size_t>(message_limits.max_message_bytes, message_limits.image_bytes_limit() + 4096);
+  rt.set_message_limits(message_limits);
   rt.status().declare_output(o.output_channel);
   if (o.weights.empty()) return run_without_model(rt, o, limits);
 

@@ -68,6 +68,12 @@ std::string RuntimeOptions::validate() const {
   return "";
 }
 
+void Runtime::set_message_limits(const MessageLimits& limits) {
+  const std::string problem = limits.validate();
+  if (!problem.empty()) throw std::invalid_argument("message limits: " + problem);
+  message_limits_ = limits;
+}
+
 std::string status_channel(const std::string& instance) {
   std::string ch = "STATUS_";
   for (char c : instance) ch += std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::toupper(c)) : '_';

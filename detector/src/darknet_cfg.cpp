@@ -353,30 +353,50 @@ DarknetModel parse_darknet_cfg(const std::string& path) {
   return parse_darknet_cfg_string(ss.str(), path);
 }
 
+namespace {
+
+/// Largest layer output accepted, values (c x h x w), and largest convolution, weights: beyond them the int shapes
+/// and counts would overflow (a fuzzed .cfg found it), and no network that runs here comes near.
+constexpr int64_t kMaxLayerValues = (int64_t{1} << 31) - 1;
+constexpr int64_t kMaxLayerWeights = (int64_t{1} << 31) - 1;
+
+}  // namespace
+
 void compute_shapes(DarknetModel& model) {
   Shape current{model.net.channels, model.net.height, model.net.width};
   for (size_t i = 0; i < model.layers.size(); ++i) {
     Layer& l = model.layers[i];
+    // Computed in 64 bits and checked before they become the layer's int shape.
+    int64_t c = 0;
+    int64_t h = 0;
+    int64_t w = 0;
     switch (l.type) {
       case LayerType::kConvolutional: {
         l.input = current;
-        const int oh = (l.input.h + 2 * l.padding - l.size) / l.stride + 1;
-        const int ow = (l.input.w + 2 * l.padding - l.size) / l.stride + 1;
-        l.output = {l.filters, oh, ow};
+        c = l.filters;
+        h = (int64_t{l.input.h} + 2 * int64_t{l.padding} - l.size) / l.stride + 1;
+        w = (int64_t{l.input.w} + 2 * int64_t{l.padding} - l.size) / l.stride + 1;
+        const double weights = static_cast<double>(l.filters) * l.input.c * l.size * l.size;
+        if (weights > static_cast<double>(kMaxLayerWeights))
+          shape_error(model, l, i,
+                      fmt::format("{} filters x {} channels x {}x{} = {:.0f} weights: more than {}", l.filters,
+                                  l.input.c, l.size, l.size, weights, kMaxLayerWeights));
         break;
       }
       case LayerType::kMaxpool: {
         l.input = current;
-        const int oh = (l.input.h + l.pool_padding - l.pool_size) / l.pool_stride + 1;
-        const int ow = (l.input.w + l.pool_padding - l.pool_size) / l.pool_stride + 1;
-        l.output = {l.input.c, oh, ow};
+        c = l.input.c;
+        h = (int64_t{l.input.h} + l.pool_padding - l.pool_size) / l.pool_stride + 1;
+        w = (int64_t{l.input.w} + l.pool_padding - l.pool_size) / l.pool_stride + 1;
         break;
       }
       case LayerType::kRegion:
       case LayerType::kYolo: {
         l.input = current;
-        l.output = current;
-        const int expected = l.num * (5 + l.classes);
+        c = current.c;
+        h = current.h;
+        w = current.w;
+        const int64_t expected = int64_t{l.num} * (5 + int64_t{l.classes});
         if (l.input.c != expected)
           shape_error(model, l, i,
                       fmt::format("input has {} channels, expected num x (5 + classes) = {} x (5 + {}) = {}", l.input.c,
@@ -384,34 +404,40 @@ void compute_shapes(DarknetModel& model) {
         break;
       }
       case LayerType::kRoute: {
-        Shape out{0, 0, 0};
         for (int src : l.route_layers) {
           if (src < 0 || static_cast<size_t>(src) >= i)
             shape_error(model, l, i, fmt::format("route source {} is not an earlier layer", src));
           const Shape& s = model.layers[src].output;
-          if (out.c == 0) {
-            out = s;
+          if (c == 0) {
+            c = s.c;
+            h = s.h;
+            w = s.w;
           } else {
-            if (s.h != out.h || s.w != out.w)
-              shape_error(
-                  model, l, i,
-                  fmt::format("layer {} is {}x{}, expected {}x{} like the first source", src, s.h, s.w, out.h, out.w));
-            out.c += s.c;
+            if (s.h != h || s.w != w)
+              shape_error(model, l, i,
+                          fmt::format("layer {} is {}x{}, expected {}x{} like the first source", src, s.h, s.w, h, w));
+            c += s.c;
+            if (c > kMaxLayerValues) break;  // reported below
           }
         }
-        l.input = out;
-        l.output = out;
+        l.input = {0, 0, 0};
         break;
       }
       case LayerType::kUpsample:
         l.input = current;
-        l.output = {current.c, current.h * l.upsample_stride, current.w * l.upsample_stride};
+        c = current.c;
+        h = int64_t{current.h} * l.upsample_stride;
+        w = int64_t{current.w} * l.upsample_stride;
         break;
     }
-    if (l.output.c < 1 || l.output.h < 1 || l.output.w < 1)
-      shape_error(model, l, i,
-                  fmt::format("output shape {}x{}x{} from input {}x{}x{} is empty", l.output.c, l.output.h, l.output.w,
-                              l.input.c, l.input.h, l.input.w));
+    if (c < 1 || h < 1 || w < 1)
+      shape_error(
+          model, l, i,
+          fmt::format("output shape {}x{}x{} from input {}x{}x{} is empty", c, h, w, l.input.c, l.input.h, l.input.w));
+    if (static_cast<double>(c) * static_cast<double>(h) * static_cast<double>(w) > static_cast<double>(kMaxLayerValues))
+      shape_error(model, l, i, fmt::format("output shape {}x{}x{}: more than {} values", c, h, w, kMaxLayerValues));
+    l.output = {static_cast<int>(c), static_cast<int>(h), static_cast<int>(w)};
+    if (l.type == LayerType::kRoute) l.input = l.output;
     current = l.output;
   }
 }

@@ -18,7 +18,9 @@ namespace {
 
 static_assert(sizeof(float) == 4, "float32 expected");
 
-bool seen_is_64bit(int32_t major, int32_t minor) { return major * 10 + minor >= 2; }
+/// Darknet's rule: version major.minor >= 0.2 stores `seen` in 64 bits. In 64-bit arithmetic: a fuzzed header with
+/// major = -555855834 overflowed int.
+bool seen_is_64bit(int32_t major, int32_t minor) { return int64_t{major} * 10 + minor >= 2; }
 
 template <class T>
 void put(std::vector<char>& out, T value) {

@@ -16,6 +16,38 @@ cv::Mat fail(std::string* error, const std::string& message) {
   if (error) *error = message;
   return {};
 }
+
+/// The frame size in a JPEG's first SOF marker, without decoding it; false when the markers before it are not
+/// well formed. cv::imdecode would allocate whatever size the header claims (a 300-byte JPEG can claim
+/// 65535 x 65535 pixels), so the claim is checked against image_t's width and height first.
+bool jpeg_frame_size(const uint8_t* d, size_t n, int* width, int* height) {
+  if (n < 4 || d[0] != 0xFF || d[1] != 0xD8) return false;
+  size_t pos = 2;
+  while (pos + 4 <= n) {
+    if (d[pos] != 0xFF) return false;
+    const uint8_t marker = d[pos + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++pos;
+      continue;
+    }
+    if (marker == 0xD8 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // no length
+      pos += 2;
+      continue;
+    }
+    if (marker == 0xD9 || marker == 0xDA) return false;  // end of image or scan data before any frame header
+    const size_t length = (static_cast<size_t>(d[pos + 2]) << 8) | d[pos + 3];
+    if (length < 2 || pos + 2 + length > n) return false;
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (sof) {
+      if (length < 7) return false;
+      *height = (d[pos + 5] << 8) | d[pos + 6];
+      *width = (d[pos + 7] << 8) | d[pos + 8];
+      return true;
+    }
+    pos += 2 + length;
+  }
+  return false;
+}
 }  // namespace
 
 cv::Mat image_to_bgr(const wingman::image_t& image, std::string* error) {
@@ -41,6 +73,13 @@ cv::Mat image_to_bgr(const wingman::image_t& image, std::string* error) {
     case wingman::image_t::MJPEG: {
       if (image.stride != 0) return fail(error, fmt::format("image_t.stride = {}: must be 0 for MJPEG", image.stride));
       if (image.data.empty()) return fail(error, "image_t.size = 0: an MJPEG frame needs data");
+      int jpeg_width = 0;
+      int jpeg_height = 0;
+      if (!jpeg_frame_size(image.data.data(), image.data.size(), &jpeg_width, &jpeg_height))
+        return fail(error, fmt::format("image_t.data ({} bytes): not a JPEG (no frame header)", image.size));
+      if (jpeg_width != image.width || jpeg_height != image.height)
+        return fail(error, fmt::format("image_t.width x height = {}x{}: the JPEG header says {}x{}", image.width,
+                                       image.height, jpeg_width, jpeg_height));
       const cv::Mat encoded(1, image.size, CV_8UC1, const_cast<uint8_t*>(image.data.data()));
       cv::Mat bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
       if (bgr.empty()) return fail(error, fmt::format("image_t.data ({} bytes): not a decodable JPEG", image.size));

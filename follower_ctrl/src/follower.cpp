@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace wingman::follower_ctrl {
@@ -223,6 +224,10 @@ wingman::setpoint_t Follower::hold(int64_t utime, const std::string& reason) {
 
 wingman::setpoint_t Follower::fly(int64_t utime, const VelocityCommand& command, int32_t track_id, int8_t source,
                                   const std::string& what) {
+  // Finite but extreme inputs (e.g. positions of 1e300 m, found by fuzzing) can overflow the controller: never fly
+  // on a non-finite command.
+  if (!command.v_body_in_world.allFinite() || !std::isfinite(command.yaw_rate_radps) || !std::isfinite(command.yaw_rad))
+    return hold(utime, "controller output is not finite (inputs out of range)");
   status_.flying = true;
   status_.detail = what;
   return detail::velocity_setpoint(utime, own_->frame, command, track_id, source);

@@ -25,7 +25,9 @@ std::vector<TargetState> usable_targets(const wingman::targets_t& msg, int64_t m
   const bool ned = msg.frame == wingman::own_pose_t::FRAME_NED;
   std::vector<TargetState> out;
   for (const auto& t : msg.targets) {
-    if (!t.world_valid || msg.utime - t.source_utime > max_age_us) continue;
+    // A source_utime so far from utime that the difference overflows (a fuzzed message) is not usable either.
+    int64_t age_us = 0;
+    if (!t.world_valid || __builtin_sub_overflow(msg.utime, t.source_utime, &age_us) || age_us > max_age_us) continue;
     TargetState s;
     s.track_id = t.track_id;
     s.p_target_in_world = Eigen::Vector3d(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);

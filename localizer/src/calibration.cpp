@@ -220,6 +220,18 @@ std::vector<double> mat_values(const std::string& path, const std::string& key, 
     }
     return v;
   }
+  // OpenCV allocates rows x cols before it reads the data: a fuzzed 'rows' asked it for 64 GB. Calibration
+  // matrices are small; anything else is not one.
+  if (node.isMap()) {
+    const cv::FileNode rows = node["rows"];
+    const cv::FileNode cols = node["cols"];
+    const cv::FileNode data = node["data"];
+    if (!rows.isInt() || !cols.isInt() || static_cast<int>(rows) < 1 || static_cast<int>(rows) > 64 ||
+        static_cast<int>(cols) < 1 || static_cast<int>(cols) > 64)
+      fail(path, key, "expected a matrix (!!opencv-matrix) with integer rows and cols in 1..64");
+    if (!data.isSeq() || data.size() > 4 * 64 * 64)
+      fail(path, key, "expected a matrix (!!opencv-matrix) whose data is a list of at most 16384 numbers");
+  }
   cv::Mat m;
   try {
     if (!node.isMap()) throw cv::Exception(0, "not a mapping", "", "", 0);
@@ -243,6 +255,8 @@ CameraModel read_opencv(const std::string& path) {
       throw CalibrationError(fmt::format("{}: cannot open as an OpenCV FileStorage file", path));
   } catch (const cv::Exception& e) {
     throw CalibrationError(fmt::format("{}: not a valid OpenCV FileStorage file: {}", path, e.err));
+  } catch (const std::exception& e) {  // OpenCV's YAML parser also lets std::length_error out (a fuzzed file)
+    throw CalibrationError(fmt::format("{}: not a valid OpenCV FileStorage file: {}", path, e.what()));
   }
   std::string key;
   cv::FileNode k_node = first_of(fs, {"camera_matrix", "cameraMatrix", "K"}, key);
@@ -315,7 +329,13 @@ CalibrationFormat detect_calibration_format(const std::string& path) {
 
 CameraModel load_calibration(const std::string& path, const std::string& kalibr_camera) {
   const CalibrationFormat format = detect_calibration_format(path);
-  if (format == CalibrationFormat::kOpenCvFileStorage) return read_opencv(path);
+  if (format == CalibrationFormat::kOpenCvFileStorage) {
+    try {
+      return read_opencv(path);
+    } catch (const cv::Exception& e) {  // e.g. a top level that is not a mapping (a fuzzed file): fs[key] asserts
+      throw CalibrationError(fmt::format("{}: not a valid OpenCV calibration file: {}", path, e.err));
+    }
+  }
   const YAML::Node root = parse_yaml(path, read_text(path));
   if (format == CalibrationFormat::kRosCameraInfo) return read_ros(path, root);
   return read_kalibr(path, root, kalibr_camera);

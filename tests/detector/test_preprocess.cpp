@@ -66,6 +66,22 @@ TEST(ImageToBgr, MjpegDecodes) {
   EXPECT_NE(err.find("image_t.width"), std::string::npos) << err;
 }
 
+TEST(ImageToBgr, MjpegWhoseHeaderClaimsAnotherSizeIsRejectedBeforeDecoding) {
+  cv::Mat src(8, 16, CV_8UC3, cv::Scalar(200, 100, 50));
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", src, jpeg));
+  size_t sof = 2;
+  while (sof + 8 < jpeg.size() && !(jpeg[sof] == 0xFF && jpeg[sof + 1] == 0xC0)) ++sof;
+  ASSERT_LT(sof + 8, jpeg.size());
+  jpeg[sof + 5] = jpeg[sof + 7] = 30000 >> 8;  // 30000 x 30000: decoding would allocate 2.7 GB
+  jpeg[sof + 6] = jpeg[sof + 8] = 30000 & 0xff;
+  std::string err;
+  EXPECT_TRUE(image_to_bgr(make_image(16, 8, 0, wingman::image_t::MJPEG, jpeg), &err).empty());
+  EXPECT_NE(err.find("the JPEG header says 30000x30000"), std::string::npos) << err;
+  EXPECT_TRUE(image_to_bgr(make_image(16, 8, 0, wingman::image_t::MJPEG, {1, 2, 3, 4}), &err).empty());
+  EXPECT_NE(err.find("not a JPEG"), std::string::npos) << err;
+}
+
 TEST(ImageToBgr, ImpossibleMessagesNameTheField) {
   std::string err;
   EXPECT_TRUE(image_to_bgr(make_image(0, 3, 3, wingman::image_t::GRAY8, {}), &err).empty());

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wingman/common/config.hpp"
+#include "wingman/common/message_limits.hpp"
 #include "wingman/common/message_validation.hpp"
 #include "wingman/common/status_tracker.hpp"
 
@@ -15,6 +16,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -94,6 +96,11 @@ class Runtime {
   bool stop_requested() const;
   void request_stop(const std::string& reason);
 
+  /// Limits every subscription checks before decoding (default: MessageLimits{}). Throws std::invalid_argument
+  /// naming the limit when `limits` is invalid.
+  void set_message_limits(const MessageLimits& limits);
+  const MessageLimits& message_limits() const { return message_limits_; }
+
  private:
   class SubscriptionBase {
    public:
@@ -123,6 +130,7 @@ class Runtime {
   bool input_is_file_ = false;
   bool end_of_input_ = false;
   StatusTracker status_;
+  MessageLimits message_limits_;
   std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_heartbeat_;
@@ -138,21 +146,10 @@ class Runtime::Subscription : public Runtime::SubscriptionBase {
       : rt_(rt), channel_(std::move(channel)), handler_(std::move(handler)), validate_(std::move(validate)) {}
 
   void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+    // The same path as the fuzz targets (tests/fuzz): wire-format and size checks before decoding, then
+    // decode, then validation; anything wrong drops and counts the message, naming the channel and field.
     Msg msg;
-    int decoded = -1;
-    try {
-      decoded = msg.decode(rbuf->data, 0, rbuf->data_size);
-    } catch (const std::exception&) {  // e.g. a negative array length makes the generated code throw
-      decoded = -1;
-    }
-    if (decoded < 0) {
-      rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + std::to_string(rbuf->data_size) +
-                                               " bytes do not decode as " + Msg::getTypeName() +
-                                               " (wrong type or truncated)");
-      rt_->after_message();
-      return;
-    }
-    const std::string problem = validate_ ? validate_(msg) : std::string();
+    const std::string problem = decode_message<Msg>(rbuf->data, rbuf->data_size, rt_->message_limits_, msg, validate_);
     if (!problem.empty()) {
       rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + problem);
       rt_->after_message();
@@ -180,6 +177,9 @@ class Runtime::Subscription : public Runtime::SubscriptionBase {
 template <class Msg>
 void Runtime::subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
                         std::function<std::string(const Msg&)> validate) {
+  if (!knows_encoding(Msg::getTypeName()))
+    throw std::invalid_argument(std::string("subscribe: no wire-format check for ") + Msg::getTypeName() +
+                                " (add it to common/src/message_limits.cpp)");
   auto sub = std::make_unique<Subscription<Msg>>(this, channel, std::move(handler), std::move(validate));
   // LCM treats the channel as a regular expression; anchor it so "IMAGE" does not match "IMAGE_2".
   input().subscribe("^" + channel + "$", &Subscription<Msg>::on_message, sub.get());

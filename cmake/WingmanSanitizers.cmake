@@ -1,0 +1,42 @@
+# SPDX-License-Identifier: MIT
+# Sanitizer and libFuzzer builds (docs/reliability.md, tools/sanitize.sh).
+#   WINGMAN_SANITIZE        "" (default), "address,undefined" or "thread": instruments every target (libraries,
+#                           processes, tests). UBSan findings abort (-fno-sanitize-recover), so they fail the test.
+#   WINGMAN_BUILD_FUZZERS   OFF (default); ON needs clang: the project is compiled with -fsanitize=fuzzer-no-link
+#                           and the targets in tests/fuzz are linked with -fsanitize=fuzzer.
+#   WINGMAN_FUZZ_SECONDS    seconds each fuzz.<target> test runs libFuzzer (default 60).
+# Without these options the build is unchanged.
+
+set(WINGMAN_SANITIZE "" CACHE STRING "Sanitizers for every target: '', 'address,undefined' or 'thread'")
+set_property(CACHE WINGMAN_SANITIZE PROPERTY STRINGS "" "address,undefined" "thread")
+option(WINGMAN_BUILD_FUZZERS "Build the libFuzzer targets (clang only)" OFF)
+set(WINGMAN_FUZZ_SECONDS 60 CACHE STRING "Seconds each fuzz.<target> test runs libFuzzer")
+
+if(WINGMAN_SANITIZE STREQUAL "address,undefined")
+  # No vptr check: it needs RTTI of every polymorphic type, which uninstrumented libraries (OpenCV, LCM) lack.
+  set(_wingman_san_flags -fsanitize=address,undefined -fno-sanitize=vptr -fno-sanitize-recover=undefined
+                         -fno-omit-frame-pointer)
+elseif(WINGMAN_SANITIZE STREQUAL "thread")
+  set(_wingman_san_flags -fsanitize=thread -fno-omit-frame-pointer)
+elseif(NOT WINGMAN_SANITIZE STREQUAL "")
+  message(FATAL_ERROR "WINGMAN_SANITIZE='${WINGMAN_SANITIZE}': must be '', 'address,undefined' or 'thread'")
+endif()
+
+if(WINGMAN_BUILD_FUZZERS)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang" OR NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "WINGMAN_BUILD_FUZZERS needs clang (libFuzzer): configure with "
+                        "-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++")
+  endif()
+  if(WINGMAN_SANITIZE STREQUAL "thread")
+    message(FATAL_ERROR "WINGMAN_BUILD_FUZZERS: use WINGMAN_SANITIZE='' or 'address,undefined', not 'thread'")
+  endif()
+  list(APPEND _wingman_san_flags -fsanitize=fuzzer-no-link)
+endif()
+
+if(_wingman_san_flags)
+  # Directory-wide from here on: every target below the top-level CMakeLists gets them, compile and link.
+  add_compile_options(${_wingman_san_flags})
+  list(REMOVE_ITEM _wingman_san_flags -fsanitize=fuzzer-no-link)  # the fuzzer runtime links only into fuzz targets
+  add_link_options(${_wingman_san_flags})
+  message(STATUS "wingman: WINGMAN_SANITIZE='${WINGMAN_SANITIZE}' WINGMAN_BUILD_FUZZERS=${WINGMAN_BUILD_FUZZERS}")
+endif()

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Runs one libFuzzer target for a bounded time on a temporary copy of its seed corpus (ctest fuzz.<target>).
+# Usage: run_fuzzer.sh FUZZER CORPUS_DIR SECONDS ARTIFACT_DIR [extra libFuzzer flags...]
+# Fails on any finding: crash, sanitizer report, an input over 10 s (-timeout), an allocation over 512 MB
+# (-malloc_limit_mb) or RSS over 2 GB (-rss_limit_mb). The crashing input lands in ARTIFACT_DIR; reproduce with
+# `FUZZER ARTIFACT_DIR/crash-...`. Prints libFuzzer's final stats (executions, exec/s).
+set -euo pipefail
+if [[ $# -lt 4 ]]; then
+  echo "usage: $0 FUZZER CORPUS_DIR SECONDS ARTIFACT_DIR [libFuzzer flags...]" >&2
+  exit 2
+fi
+fuzzer=$1
+corpus=$2
+seconds=$3
+artifacts=$4
+shift 4
+work=$(mktemp -d "${TMPDIR:-/tmp}/wingman-fuzz.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+cp -r "$corpus"/. "$work"/
+mkdir -p "$artifacts"
+# ASAN_OPTIONS from the caller (tools/sanitize.sh) are kept; libFuzzer needs the allocator to report, not return
+# null, so a huge allocation is a finding.
+"$fuzzer" -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=512 -timeout=10 -print_final_stats=1 \
+  -artifact_prefix="$artifacts/" "$@" "$work"

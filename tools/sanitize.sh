@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Sanitizer runs of the test suite (docs/reliability.md). Builds with clang and runs ctest there.
+# Usage: tools/sanitize.sh asan|tsan [ctest args...]
+#   asan  build-asan: AddressSanitizer + UndefinedBehaviorSanitizer, libFuzzer targets ON, training OFF.
+#         Without ctest args: stage 1 runs the whole suite (except the fuzz label and the exclusions below),
+#         stage 2 the fuzz targets (fuzz.*, WINGMAN_FUZZ_SECONDS each, default 30 here).
+#   tsan  build-tsan: ThreadSanitizer. Without ctest args: the multi-process tests and the tests whose code
+#         runs threads (TSAN_TESTS below).
+# With ctest args, only `ctest <args>` runs (e.g. `tools/sanitize.sh asan -R fuzz_corpus`).
+# Environment: WINGMAN_FUZZ_SECONDS (fuzz time per target), JOBS (build and ctest parallelism, default 2),
+#   SANITIZE_TARGETS (build only these targets, space-separated; default: everything the stage needs).
+# Each stage's wall time is printed ("sanitize: <stage> took N s").
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [[ $# -lt 1 || ( $1 != asan && $1 != tsan ) ]]; then
+  echo "usage: $0 asan|tsan [ctest args...]" >&2
+  exit 2
+fi
+kind=$1
+shift
+jobs=${JOBS:-2}
+root=$(pwd)
+supp=$root/tools/sanitizers
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(dirname "$root")}
+export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
+
+stage() {  # stage NAME CMD...: runs CMD, prints its wall time, keeps its exit status
+  local name=$1 start rc=0
+  shift
+  start=$(date +%s)
+  "$@" || rc=$?
+  echo "sanitize: $name took $(($(date +%s) - start)) s (exit $rc)"
+  return $rc
+}
+
+common_cmake=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
+  -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DWINGMAN_WITH_TRAINING=OFF
+  -DWINGMAN_BUILD_BENCHMARKS=OFF)
+
+if [[ $kind == asan ]]; then
+  build=build-asan
+  stage "asan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=address,undefined \
+    -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-30}" --log-level=WARNING
+  # shellcheck disable=SC2086  # SANITIZE_TARGETS is a list
+  stage "asan build" nice -n 5 cmake --build $build -j"$jobs" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}
+  # Leaks fail a test (a process exits non-zero at its end); suppressions name third-party libraries only.
+  export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:detect_stack_use_after_return=0:strict_init_order=1:${ASAN_OPTIONS:-}"
+  export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0:${LSAN_OPTIONS:-}"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
+  if [[ $# -gt 0 ]]; then
+    stage "asan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
+    exit
+  fi
+  # Excluded under ASan:
+  #  lint.ClangFormat: checks sources, not code; it runs in the normal build.
+  rc=0
+  stage "asan suite" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -LE '^fuzz$' \
+    -E '^lint\.' || rc=$?
+  stage "asan fuzz" ctest --test-dir $build --output-on-failure -j"$jobs" -L '^fuzz$' || rc=$?
+  exit $rc
+fi
+
+build=build-tsan
+# The multi-process tests (processes talk over LCM in private network namespaces) and the tests whose code uses
+# threads: only `wingman bench` starts threads of its own (tools/src/bench.cpp); LCM's receive thread, OpenCV's
+# and PoCL's workers run inside every process.
+TSAN_TESTS='^(ProcessConfig|ProcessFileIo|ProcessSignals|Replay|LocalizerProcess|FollowerProcess|DetectorProcess|DetectorRealtime)\.|^demo\.|^sim_flight\.'
+tsan_targets=(wingman-camera-driver wingman-detector wingman-localizer wingman-follower-ctrl wingman
+  test_process_runtime test_replay test_localizer_process test_detector_process test_detector_realtime
+  test_follower_process)
+stage "tsan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=thread --log-level=WARNING
+if [[ -n ${SANITIZE_TARGETS:-} ]]; then
+  # shellcheck disable=SC2086  # a list
+  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target $SANITIZE_TARGETS
+elif [[ $# -gt 0 ]]; then
+  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs"
+else
+  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target "${tsan_targets[@]}" \
+    $(grep -q 'WINGMAN_WITH_SIM:BOOL=ON' $build/CMakeCache.txt && echo wingman-sim)
+fi
+# A race fails the process (exit 66) and so its test; suppressions name third-party libraries only.
+export TSAN_OPTIONS="halt_on_error=0:exitcode=66:second_deadlock_stack=1:suppressions=$supp/tsan.supp:${TSAN_OPTIONS:-}"
+if [[ $# -gt 0 ]]; then
+  stage "tsan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
+  exit
+fi
+stage "tsan multi-process tests" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -R "$TSAN_TESTS"
