@@ -79,16 +79,23 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   };
   auto validate = [limits](const image_t& img) { return common::validate_message(img, limits); };
   // Frames that never reached this process (lost at the camera, or on the bus when a receive buffer overflows)
-  // show only as gaps in image_t.seq: each missing frame is counted as a drop on the input channel.
+  // show only as gaps in image_t.seq: each missing frame is counted as a drop on the input channel. Messages the
+  // runtime dropped in between (undecodable or invalid) did arrive and are counted already, so they are taken off
+  // the gap.
   common::SequenceGapCounter gaps;
+  int64_t drops_accounted = 0;  // the channel's drops when this code last accounted for them
+  bool handler_threw = false;   // the previous frame's handler threw: the runtime counted that drop after it
   auto count_gap = [&](const image_t& img) {
-    const int64_t missing = gaps.observe(img.seq);
+    const int64_t rejected = rt.status().input_drops(o.input_channel) - drops_accounted - (handler_threw ? 1 : 0);
+    handler_threw = false;
+    const int64_t missing = std::max<int64_t>(0, gaps.observe(img.seq) - rejected);
     for (int64_t i = 0; i < missing; ++i) {
       rt.status().item_dropped(o.input_channel, fmt::format("channel {}: {} frame(s) missing before seq {} (lost "
                                                             "upstream: at the camera or on the bus)",
                                                             o.input_channel, missing, img.seq));
     }
   };
+  auto accounted = [&] { drops_accounted = rt.status().input_drops(o.input_channel); };
 
   if (o.mode == "replay" || rt.input_is_file()) {
     // Every frame, in order, inside its handler: deterministic, and lockstep-friendly.
@@ -96,7 +103,13 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
         o.input_channel,
         [&](const image_t& img) {
           count_gap(img);
-          detect_and_publish(img);
+          accounted();
+          try {
+            detect_and_publish(img);
+          } catch (...) {
+            handler_threw = true;  // the runtime drops and counts it
+            throw;
+          }
         },
         validate);
     return rt.spin();
@@ -108,6 +121,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       [&](const image_t& img) {
         count_gap(img);
         if (pending) rt.status().item_dropped(o.input_channel, "frame superseded by a newer one while busy");
+        accounted();
         pending = img;
       },
       validate);
@@ -120,6 +134,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       detect_and_publish(img);
     } catch (const std::invalid_argument& e) {
       rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + e.what());
+      accounted();
     }
   }
   return rt.shutdown();

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# README's test command: installs what is missing, builds, and runs every test with CTest.
+# README's test command: installs what is missing, builds, and runs every test with CTest, then the sanitizer
+# stages (tools/sanitize.sh).
 # Multi-process tests run in private network namespaces (tools/netns_run.sh); nothing multicasts on
 # the host. Tests that read ../shared skip with a message when it is absent.
 set -euo pipefail
@@ -8,3 +9,11 @@ cd "$(dirname "$0")/.."
 tools/build.sh
 export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
 ctest --test-dir build --output-on-failure -j2 --timeout 900 "$@"
+# With ctest arguments (a selection), only that selection runs. Otherwise the sanitizer stages follow
+# (docs/reliability.md): the suite under AddressSanitizer + UndefinedBehaviorSanitizer with the libFuzzer targets
+# run for WINGMAN_FUZZ_SECONDS each (default 30), then the multi-process and threaded tests under ThreadSanitizer.
+# WINGMAN_SKIP_SANITIZERS=1 skips them.
+if [ $# -eq 0 ] && [ "${WINGMAN_SKIP_SANITIZERS:-0}" != 1 ]; then
+  tools/sanitize.sh asan
+  tools/sanitize.sh tsan
+fi

@@ -32,7 +32,7 @@ StatusTracker::Channel& StatusTracker::channel(const std::string& name, int8_t d
   return it->second;
 }
 
-void StatusTracker::declare_input(const std::string& ch) { channel(ch, kIn); }
+void StatusTracker::declare_input(const std::string& ch) { channel(ch, kIn).declared = true; }
 void StatusTracker::declare_output(const std::string& ch) { channel(ch, kOut); }
 
 void StatusTracker::input(const std::string& ch, int64_t utime) {
@@ -112,6 +112,7 @@ wingman::status_t StatusTracker::heartbeat(int64_t wall_utime, int64_t uptime_us
     Channel& c = channels_.at(key);
     if (c.window_handled > 0) c.fresh_wall_utime = wall_utime;
     c.window_handled = 0;
+    if (!c.declared) continue;
     const int64_t since = c.fresh_wall_utime >= 0 ? c.fresh_wall_utime : first_heartbeat_wall_utime_;
     const double silent_s = static_cast<double>(wall_utime - since) * 1e-6;
     if (silent_s <= stale_after_s_) continue;

@@ -132,6 +132,18 @@ TEST(StatusTracker, ErrorAndDegradedKeepTheirStateWithTheStaleInputAddedStopping
   EXPECT_EQ(s.detail, "signal 15");
 }
 
+TEST(StatusTracker, OnlyDeclaredInputsAreWatchedAChannelOnlySeenIsNot) {
+  // A recorder takes every channel: one that came once (LCM_SELF_TEST) and went quiet is not a stale input.
+  wingman::common::StatusTracker t("recorder", 1);
+  t.set_stale_after_s(2.0);
+  t.set_state(kOk, "recording");
+  t.input("LCM_SELF_TEST", 1);
+  EXPECT_EQ(t.heartbeat(0, 0, 1.0).state, kOk);
+  const wingman::status_t s = t.heartbeat(10 * kS, 0, 1.0);
+  EXPECT_EQ(s.state, kOk);
+  EXPECT_EQ(s.detail, "recording");
+}
+
 TEST(StatusTracker, OutputsAreNeverStale) {
   wingman::common::StatusTracker t("camera_driver", 1);
   t.declare_output("IMAGE_CAM0");

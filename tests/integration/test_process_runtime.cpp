@@ -140,6 +140,29 @@ TEST(ProcessSignals, SigtermAndSigintEndEveryProcessWithExitZeroWithinOneSecond)
   }
 }
 
+TEST(ProcessFileIo, DetectorCountsFramesMissingFromTheSequenceAsDropsButNotThoseThatArrivedBroken) {
+  // seq 0 1 2 (3 and 4 never arrive) 5, garbage in place of 6, 7: two frames lost upstream, one dropped here.
+  TempDir dir;
+  std::vector<wingman::testing::LogEvent> events;
+  for (int i : {0, 1, 2, 5}) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
+  events.push_back({1006, "IMAGE_CAM0", {1, 2, 3}});
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(7), 1007));
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+  const auto r = run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
+                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
+                     20s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = wingman::testing::read_log(dir.file("out.lcmlog"));
+  ASSERT_FALSE(out.empty());
+  wingman::status_t last;
+  ASSERT_GE(last.decode(out.back().data.data(), 0, static_cast<int>(out.back().data.size())), 0);
+  EXPECT_EQ(last.messages_handled, 6);
+  EXPECT_EQ(last.drops_total, 3);  // 3 and 4 (missing), the garbage (arrived, does not decode)
+  int detections = 0;
+  for (const auto& e : out) detections += e.channel == "DETECTIONS_CAM0";
+  EXPECT_EQ(detections, 5);
+}
+
 TEST(ProcessFileIo, FileInputIsProcessedToItsEndWithExitZeroAndBadMessagesAreCountedNotFatal) {
   TempDir dir;
   std::vector<wingman::testing::LogEvent> events;

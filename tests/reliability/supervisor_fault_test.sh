@@ -89,6 +89,8 @@ hold: {timeout_s: $hold_timeout_s}
 formation: {offset_m: [0.0, -4.0, 0.0]}
 localizer: {instance: localizer}
 YAML
+# The recorder at its defaults: recordings/ in its working directory, the log folder (tools/supervise.sh makes it).
+printf 'output: {directory: "recordings"}\n' > "$etc/recorder.yaml"
 "$src/tools/supervise.sh" --bin "$bin" --etc "$etc" --lcm-url "$url" --standalone "$tmp/sup" > /dev/null
 conf="$tmp/sup/supervisord.conf" suplog="$tmp/sup/supervisord.log"
 # The rendered file is the shipped one with the paths substituted: same lines otherwise.

@@ -16,7 +16,8 @@ namespace wingman::common {
 /// builds its status_t heartbeat. Not thread-safe: use it from the process's main loop only.
 ///
 /// Health: the heartbeat's state is the one the process set (set_state), except that a process that
-/// says OK but has a stale input is reported DEGRADED. An input channel (declared or seen) is stale
+/// says OK but has a stale input is reported DEGRADED. A declared input channel (declare_input: every
+/// subscription; channels only seen, e.g. by a recorder that takes every channel, are not watched) is stale
 /// when no message was handled on it (dropped ones do not count) for more than stale_after_s of wall
 /// time: each heartbeat marks the channels that had a message since the previous heartbeat as fresh
 /// at its wall_utime, so staleness is known to within one heartbeat period (1 s by default). A
@@ -82,6 +83,7 @@ class StatusTracker {
     int64_t window_handled = 0;  ///< inputs: messages handled (not dropped) since the previous heartbeat
     int64_t last_utime = 0;
     int64_t fresh_wall_utime = -1;  ///< inputs: wall time of the heartbeat that last saw a handled message, -1 never
+    bool declared = false;          ///< inputs: declared with declare_input (watched for staleness)
   };
   Channel& channel(const std::string& name, int8_t direction);
 
