@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: MIT
 # Reproduces the shipped detector model (models/wingman-small.weights, card: models/wingman-small.md) on the CPU:
 # imports the Halmstad videos (real, clip-split, tightened boxes, hard negatives), renders the synthetic sets with
-# the simulator, trains models/wingman-small.cfg on Halmstad + synth with the card's schedule (stage 1), then
-# fine-tunes stage 1's iteration-1000 weights with the follower's-view set (drones on the horizon) added (stage 2).
+# the simulator, and trains models/wingman-small.cfg on Halmstad + synth with the card's schedule (stage 1; the
+# shipped weights are its iteration 1000). With --stage2-batches N it then fine-tunes those weights with the
+# follower's-view set (drones on the horizon) added (stage 2: in progress, not shipped yet; see the card).
 # Resumable: run it again after an interruption and it continues from the last checkpoint (datasets are kept once
 # complete; a finished stage is not trained again).
 #
@@ -13,14 +14,14 @@
 #                     (default build/train-wingman-small)
 #   --threads         libtorch threads (default 2)
 #   --max-batches     stage 1 iterations (default 1500; the schedule scales with it)
-#   --stage2-batches  stage 2 iterations (default 400; 0 = stage 1 only). Stage 2 starts from stage 1's
+#   --stage2-batches  stage 2 iterations (default 0 = stage 1 only; 400 was tried). Stage 2 starts from stage 1's
 #                     iteration-1000 weights (or its final ones when it is shorter)
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
-data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
+data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -71,7 +72,7 @@ EOF
 
 # 2b. The follower's view: 1500 images whose drone mostly flies at the camera's height, on the horizon, often against
 # the treeline (the formation flights' view, which stage 1's data rarely shows).
-if [ ! -f "$data/horizon/data.yaml" ]; then
+if [ "$stage2_batches" -gt 0 ] && [ ! -f "$data/horizon/data.yaml" ]; then
   rm -rf "$data/horizon"
   cat > "$data/horizon.yaml" <<'EOF'
 synth:
