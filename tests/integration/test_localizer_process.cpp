@@ -156,7 +156,7 @@ TEST(LocalizerProcess, OneTargetsMessagePerDetectionsEmptyUntilConfirmedWithTheS
   ASSERT_EQ(r.targets[2].num_targets, 1);
   for (const auto& t : r.targets) {
     for (const auto& target : t.targets) {
-      EXPECT_EQ(target.detection_source, wingman::detections_t::SOURCE_GROUND_TRUTH);
+      EXPECT_EQ(target.detection_source, int{wingman::detections_t::SOURCE_GROUND_TRUTH});
     }
   }
 }
