@@ -155,7 +155,8 @@ TEST(Simulator, ATargetBehindTheCameraIsNotVisible) {
   s.vehicles[1].motion.type = wingman::sim::MotionSpec::Type::kHover;
   s.vehicles[1].p_initial_in_world = {0, -8, 5};
   Simulator sim(s, default_camera());
-  const auto& b = box_of(sim.step(), 1);
+  const auto frame = sim.step();  // box_of refers into it: keep it alive
+  const auto& b = box_of(frame, 1);
   EXPECT_FALSE(b.visible);
   EXPECT_NEAR(b.range, 8.0, 1e-12);
 }

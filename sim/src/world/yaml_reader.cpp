@@ -36,6 +36,15 @@ YamlReader::YamlReader(std::string source_name, const YAML::Node& mapping, std::
 
 void YamlReader::flatten(const YAML::Node& node, const std::string& prefix) {
   for (const auto& kv : node) {
+    if (!kv.first.IsScalar()) {  // e.g. "? [a, b]": YAML allows it, a configuration does not
+      const auto mark = kv.first.Mark();
+      const std::string at = path_prefix_ + (prefix.empty() ? std::string("(top level)") : prefix);
+      problems_->push_back(mark.line >= 0 ? fmt::format("{}:{}: {}: a key must be a plain name, got {}", source_name_,
+                                                        mark.line + 1, at, describe_node(kv.first))
+                                          : fmt::format("{}: {}: a key must be a plain name, got {}", source_name_, at,
+                                                        describe_node(kv.first)));
+      continue;
+    }
     const std::string name = kv.first.as<std::string>();
     const std::string key = prefix.empty() ? name : prefix + "." + name;
     if (kv.second.IsMap()) {
