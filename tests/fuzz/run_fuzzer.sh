@@ -5,6 +5,8 @@
 # Fails on any finding: crash, sanitizer report, an input over 10 s (-timeout), an allocation over 512 MB
 # (-malloc_limit_mb) or RSS over 2 GB (-rss_limit_mb). The crashing input lands in ARTIFACT_DIR; reproduce with
 # `FUZZER ARTIFACT_DIR/crash-...`. Prints libFuzzer's final stats (executions, exec/s).
+# The random seed is WINGMAN_FUZZ_SEED (default 1), so a CI run explores the same inputs each time (how far depends
+# on the machine's speed); set WINGMAN_FUZZ_SEED=0 for a random seed, as in long runs by hand.
 set -euo pipefail
 if [[ $# -lt 4 ]]; then
   echo "usage: $0 FUZZER CORPUS_DIR SECONDS ARTIFACT_DIR [libFuzzer flags...]" >&2
@@ -22,4 +24,4 @@ mkdir -p "$artifacts"
 # ASAN_OPTIONS from the caller (tools/sanitize.sh) are kept; libFuzzer needs the allocator to report, not return
 # null, so a huge allocation is a finding.
 "$fuzzer" -max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=512 -timeout=10 -print_final_stats=1 \
-  -artifact_prefix="$artifacts/" "$@" "$work"
+  -seed="${WINGMAN_FUZZ_SEED:-1}" -artifact_prefix="$artifacts/" "$@" "$work"
