@@ -4,13 +4,17 @@
 #                           processes, tests). UBSan findings abort (-fno-sanitize-recover), so they fail the test.
 #   WINGMAN_BUILD_FUZZERS   OFF (default); ON needs clang: the project is compiled with -fsanitize=fuzzer-no-link
 #                           and the targets in tests/fuzz are linked with -fsanitize=fuzzer.
-#   WINGMAN_FUZZ_SECONDS    seconds each fuzz.<target> test runs libFuzzer (default 60).
+#   WINGMAN_FUZZ_SECONDS    the most seconds each fuzz.<target> test runs libFuzzer (default 60).
+#   WINGMAN_FUZZ_RUNS       inputs each fuzz.<target> test tries (default 0: until WINGMAN_FUZZ_SECONDS). With a
+#                           fixed seed (run_fuzzer.sh) a run count makes the run the same on every machine, fast
+#                           or slow, as long as it ends before WINGMAN_FUZZ_SECONDS: CI uses it.
 # Without these options the build is unchanged.
 
 set(WINGMAN_SANITIZE "" CACHE STRING "Sanitizers for every target: '', 'address,undefined' or 'thread'")
 set_property(CACHE WINGMAN_SANITIZE PROPERTY STRINGS "" "address,undefined" "thread")
 option(WINGMAN_BUILD_FUZZERS "Build the libFuzzer targets (clang only)" OFF)
-set(WINGMAN_FUZZ_SECONDS 60 CACHE STRING "Seconds each fuzz.<target> test runs libFuzzer")
+set(WINGMAN_FUZZ_SECONDS 60 CACHE STRING "The most seconds each fuzz.<target> test runs libFuzzer")
+set(WINGMAN_FUZZ_RUNS 0 CACHE STRING "Inputs each fuzz.<target> test tries (0: until WINGMAN_FUZZ_SECONDS)")
 
 if(WINGMAN_SANITIZE STREQUAL "address,undefined")
   # No vptr check: it needs RTTI of every polymorphic type, which uninstrumented libraries (OpenCV, LCM) lack.

@@ -4,14 +4,16 @@
 # Usage: tools/sanitize.sh asan|tsan [ctest args...]
 #   asan  build-asan: AddressSanitizer + UndefinedBehaviorSanitizer, libFuzzer targets ON, training OFF.
 #         Without ctest args: stage 1 runs the whole suite (except the fuzz label and the exclusions below),
-#         stage 2 the fuzz targets (fuzz.*, WINGMAN_FUZZ_SECONDS each, default 30 here).
+#         stage 2 the fuzz targets (fuzz.*: WINGMAN_FUZZ_RUNS inputs each, default 100000 here, from a fixed seed,
+#         so CI tries the same inputs on any machine; at most WINGMAN_FUZZ_SECONDS each, default 90 here).
 #   tsan  build-tsan: ThreadSanitizer. Without ctest args: the multi-process tests and the tests whose code
 #         runs threads (TSAN_TESTS below).
 # With ctest args, only `ctest <args>` runs (e.g. `tools/sanitize.sh asan -R fuzz_corpus`).
 # The trainer (libtorch) is not built. asan builds the simulator (for the scenario parser's fuzz target) but runs
 # none of the tests that render (label sim, and the supervision fault test's flight): Mesa's llvmpipe is not
 # instrumented and a rendered flight takes minutes even without a sanitizer. tsan builds no simulator.
-# Environment: WINGMAN_FUZZ_SECONDS (fuzz time per target), JOBS (build and ctest parallelism, default 2),
+# Environment: WINGMAN_FUZZ_RUNS, WINGMAN_FUZZ_SECONDS (inputs and the most seconds per fuzz target; RUNS=0:
+#   fuzz for the whole time, e.g. WINGMAN_FUZZ_RUNS=0 WINGMAN_FUZZ_SECONDS=600 for a longer hunt), JOBS (build and ctest parallelism, default 2),
 #   SANITIZE_TARGETS (build only these targets, space-separated; default: everything the stage needs).
 # Each stage's wall time is printed ("sanitize: <stage> took N s").
 set -euo pipefail
@@ -47,7 +49,8 @@ fi
 if [[ $kind == asan ]]; then
   build=build-asan
   stage "asan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=address,undefined \
-    -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-30}" --log-level=WARNING
+    -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-90}" \
+    -DWINGMAN_FUZZ_RUNS="${WINGMAN_FUZZ_RUNS:-100000}" --log-level=WARNING
   # shellcheck disable=SC2086  # SANITIZE_TARGETS is a list
   stage "asan build" nice -n 5 cmake --build $build -j"$jobs" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}
   # Leaks fail a test (a process exits non-zero at its end); suppressions name third-party libraries only.

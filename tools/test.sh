@@ -11,7 +11,8 @@ export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
 ctest --test-dir build --output-on-failure -j2 --timeout 900 "$@"
 # With ctest arguments (a selection), only that selection runs. Otherwise the sanitizer stages follow
 # (docs/reliability.md): the suite under AddressSanitizer + UndefinedBehaviorSanitizer with the libFuzzer targets
-# run for WINGMAN_FUZZ_SECONDS each (default 30), then the multi-process and threaded tests under ThreadSanitizer.
+# given WINGMAN_FUZZ_RUNS inputs each from a fixed seed (default 100000, at most WINGMAN_FUZZ_SECONDS), then the
+# multi-process and threaded tests under ThreadSanitizer.
 # WINGMAN_SKIP_SANITIZERS=1 skips them.
 if [ $# -eq 0 ] && [ "${WINGMAN_SKIP_SANITIZERS:-0}" != 1 ]; then
   tools/sanitize.sh asan

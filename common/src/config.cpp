@@ -59,6 +59,12 @@ ConfigLoader::ConfigLoader(std::string source_name, const YAML::Node& root) : so
 
 void ConfigLoader::flatten(const YAML::Node& node, const std::string& prefix) {
   for (const auto& kv : node) {
+    if (!kv.first.IsScalar()) {  // e.g. "? mode: x" or "? [a, b]": YAML allows it, a configuration does not
+      const std::string at = prefix.empty() ? std::string("(top level)") : prefix;
+      errors_.push_back(
+          fmt::format("{}: a key must be a plain name, got {}", where(at, kv.first), scalar_text(kv.first)));
+      continue;
+    }
     const std::string name = kv.first.as<std::string>();
     const std::string key = prefix.empty() ? name : prefix + "." + name;
     if (kv.second.IsMap()) {

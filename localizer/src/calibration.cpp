@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Calibration file readers: ROS camera_info and Kalibr with yaml-cpp, OpenCV FileStorage with cv::FileStorage.
+// Calibration file readers: ROS camera_info, Kalibr and OpenCV FileStorage (YAML), all with yaml-cpp.
 #include "wingman/localizer/calibration.hpp"
 
 #include <fmt/format.h>
@@ -197,91 +197,87 @@ CameraModel read_kalibr(const std::string& path, const YAML::Node& root, const s
                      distortion, std::move(d), camera);
 }
 
-// --- OpenCV FileStorage ---
+// --- OpenCV FileStorage (YAML) ---
+// Read with yaml-cpp, not cv::FileStorage: OpenCV 4.6's YAML parser hung forever on a fuzzed file (fuzz.calibration),
+// allocated rows x cols before reading data (64 GB for a fuzzed 'rows') and let std::length_error escape.
 
-cv::FileNode first_of(const cv::FileStorage& fs, std::initializer_list<const char*> names, std::string& found) {
+/// OpenCV writes "%YAML:1.0", which is not YAML's directive syntax; yaml-cpp reads the rest of the file as is.
+std::string without_opencv_directive(const std::string& text) {
+  if (text.rfind("%YAML", 0) != 0) return text;
+  const std::size_t eol = text.find('\n');
+  // Keep the line count (an empty line), so yaml-cpp's line numbers are the file's.
+  return eol == std::string::npos ? std::string() : text.substr(eol);
+}
+
+YAML::Node first_of(const YAML::Node& root, std::initializer_list<const char*> names, std::string& found) {
   for (const char* name : names) {
-    cv::FileNode node = fs[name];
-    if (!node.empty()) {
+    YAML::Node node = root[name];
+    if (node && !node.IsNull()) {
       found = name;
       return node;
     }
   }
   found.clear();
-  return cv::FileNode();
+  return YAML::Node(YAML::NodeType::Undefined);
 }
 
-std::vector<double> mat_values(const std::string& path, const std::string& key, const cv::FileNode& node) {
-  std::vector<double> v;
-  if (node.isSeq()) {  // a plain list, e.g. image_size: [w, h]
-    for (const auto& item : node) {
-      if (!item.isReal() && !item.isInt()) fail(path, key, "expected a list of numbers");
-      v.push_back(static_cast<double>(item));
-    }
-    return v;
-  }
-  // OpenCV allocates rows x cols before it reads the data: a fuzzed 'rows' asked it for 64 GB. Calibration
-  // matrices are small; anything else is not one.
-  if (node.isMap()) {
-    const cv::FileNode rows = node["rows"];
-    const cv::FileNode cols = node["cols"];
-    const cv::FileNode data = node["data"];
-    if (!rows.isInt() || !cols.isInt() || static_cast<int>(rows) < 1 || static_cast<int>(rows) > 64 ||
-        static_cast<int>(cols) < 1 || static_cast<int>(cols) > 64)
-      fail(path, key, "expected a matrix (!!opencv-matrix) with integer rows and cols in 1..64");
-    if (!data.isSeq() || data.size() > 4 * 64 * 64)
-      fail(path, key, "expected a matrix (!!opencv-matrix) whose data is a list of at most 16384 numbers");
-  }
-  cv::Mat m;
-  try {
-    if (!node.isMap()) throw cv::Exception(0, "not a mapping", "", "", 0);
-    node >> m;
-  } catch (const cv::Exception&) {
+/// Calibration matrices are small: an !!opencv-matrix has rows and cols in 1..64 and one channel.
+constexpr int kMaxMatrixSide = 64;
+
+std::vector<double> mat_values(const std::string& path, const std::string& key, const YAML::Node& node) {
+  if (node.IsSequence()) return to_doubles(path, key, node);  // a plain list, e.g. image_size: [w, h]
+  if (!node.IsMap())
     fail(path, key, "expected a matrix (!!opencv-matrix with rows, cols, dt, data) or a list of numbers");
+  const YAML::Node rows_node = need(path, node, key, "rows");
+  const YAML::Node cols_node = need(path, node, key, "cols");
+  const YAML::Node data = need(path, node, key, "data");
+  const int rows = to_int(path, key + ".rows", rows_node);
+  const int cols = to_int(path, key + ".cols", cols_node);
+  if (rows < 1 || rows > kMaxMatrixSide || cols < 1 || cols > kMaxMatrixSide)
+    fail(path, key,
+         fmt::format("expected a matrix with rows and cols in 1..{}, got {}x{}", kMaxMatrixSide, rows, cols));
+  if (node["dt"]) {
+    const std::string dt = to_string(path, key + ".dt", node["dt"]);
+    if (dt.size() != 1 || std::string("ucwsifd").find(dt[0]) == std::string::npos)
+      fail(path, key + ".dt", fmt::format("expected a one-channel element type (u, c, w, s, i, f or d), got '{}'", dt));
   }
-  if (m.empty()) fail(path, key, "expected a matrix (!!opencv-matrix with rows, cols, dt, data), got an empty one");
-  m.convertTo(m, CV_64F);
-  m = m.reshape(1, 1);
-  v.assign(m.begin<double>(), m.end<double>());
-  for (std::size_t i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i])) fail(path, key, fmt::format("element {} = {}: expected a finite number", i, v[i]));
+  const std::vector<double> v = to_doubles(path, key + ".data", data);
+  if (v.size() != static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols))
+    fail(path, key + ".data", fmt::format("expected {}x{} = {} numbers, got {}", rows, cols, rows * cols, v.size()));
   return v;
 }
 
-CameraModel read_opencv(const std::string& path) {
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML))
-      throw CalibrationError(fmt::format("{}: cannot open as an OpenCV FileStorage file", path));
-  } catch (const cv::Exception& e) {
-    throw CalibrationError(fmt::format("{}: not a valid OpenCV FileStorage file: {}", path, e.err));
-  } catch (const std::exception& e) {  // OpenCV's YAML parser also lets std::length_error out (a fuzzed file)
-    throw CalibrationError(fmt::format("{}: not a valid OpenCV FileStorage file: {}", path, e.what()));
-  }
+int top_level_int(const std::string& path, const YAML::Node& root, const char* name) {
+  return to_int(path, name, root[name]);
+}
+
+CameraModel read_opencv(const std::string& path, const std::string& text) {
+  const YAML::Node root = parse_yaml(path, without_opencv_directive(text));
+  if (!root.IsMap()) fail(path, "(top level)", "expected a mapping of calibration keys");
   std::string key;
-  cv::FileNode k_node = first_of(fs, {"camera_matrix", "cameraMatrix", "K"}, key);
-  if (k_node.empty()) fail(path, "camera_matrix", "missing (also looked for cameraMatrix, K)");
+  const YAML::Node k_node = first_of(root, {"camera_matrix", "cameraMatrix", "K"}, key);
+  if (!k_node) fail(path, "camera_matrix", "missing (also looked for cameraMatrix, K)");
   const std::vector<double> f = intrinsics_from_k(path, key, mat_values(path, key, k_node));
 
   std::string d_key;
-  cv::FileNode d_node = first_of(fs, {"distortion_coefficients", "distCoeffs", "dist_coeffs", "D"}, d_key);
-  if (d_node.empty()) fail(path, "distortion_coefficients", "missing (also looked for distCoeffs, dist_coeffs, D)");
+  const YAML::Node d_node = first_of(root, {"distortion_coefficients", "distCoeffs", "dist_coeffs", "D"}, d_key);
+  if (!d_node) fail(path, "distortion_coefficients", "missing (also looked for distCoeffs, dist_coeffs, D)");
   std::vector<double> d = mat_values(path, d_key, d_node);
 
   int width = 0, height = 0;
-  if (!fs["image_width"].empty() || !fs["image_height"].empty()) {
-    if (fs["image_width"].empty()) fail(path, "image_width", "missing (image_height is present)");
-    if (fs["image_height"].empty()) fail(path, "image_height", "missing (image_width is present)");
-    if (!fs["image_width"].isInt()) fail(path, "image_width", "expected an integer");
-    if (!fs["image_height"].isInt()) fail(path, "image_height", "expected an integer");
-    width = static_cast<int>(fs["image_width"]);
-    height = static_cast<int>(fs["image_height"]);
+  if (root["image_width"] || root["image_height"]) {
+    if (!root["image_width"]) fail(path, "image_width", "missing (image_height is present)");
+    if (!root["image_height"]) fail(path, "image_height", "missing (image_width is present)");
+    width = top_level_int(path, root, "image_width");
+    height = top_level_int(path, root, "image_height");
   } else {
     std::string s_key;
-    cv::FileNode s_node = first_of(fs, {"image_size", "imageSize"}, s_key);
-    if (s_node.empty()) fail(path, "image_width", "missing (also looked for image_height, image_size, imageSize)");
+    const YAML::Node s_node = first_of(root, {"image_size", "imageSize"}, s_key);
+    if (!s_node) fail(path, "image_width", "missing (also looked for image_height, image_size, imageSize)");
     const std::vector<double> s = mat_values(path, s_key, s_node);
     if (s.size() != 2) fail(path, s_key, fmt::format("expected [width, height], got {} numbers", s.size()));
+    if (s[0] != std::floor(s[0]) || s[1] != std::floor(s[1]) || std::fabs(s[0]) > 1e6 || std::fabs(s[1]) > 1e6)
+      fail(path, s_key, fmt::format("expected whole pixel counts [width, height], got [{}, {}]", s[0], s[1]));
     width = static_cast<int>(s[0]);
     height = static_cast<int>(s[1]);
   }
@@ -289,11 +285,10 @@ CameraModel read_opencv(const std::string& path) {
     fail(path, "image_width", fmt::format("expected a size > 0, got {}x{}", width, height));
 
   Distortion distortion;
-  if (!fs["distortion_model"].empty()) {
-    if (!fs["distortion_model"].isString()) fail(path, "distortion_model", "expected a string");
-    const std::string model = static_cast<std::string>(fs["distortion_model"]);
-    distortion = ros_distortion(path, "distortion_model", model);
-  } else if (!fs["fisheye_model"].empty() && static_cast<int>(fs["fisheye_model"]) != 0) {
+  if (root["distortion_model"]) {
+    distortion =
+        ros_distortion(path, "distortion_model", to_string(path, "distortion_model", root["distortion_model"]));
+  } else if (root["fisheye_model"] && top_level_int(path, root, "fisheye_model") != 0) {
     distortion = Distortion::kEquidistant;
   } else if (d.size() == 4 || d.size() == 5) {
     distortion = Distortion::kRadTan;
@@ -329,14 +324,9 @@ CalibrationFormat detect_calibration_format(const std::string& path) {
 
 CameraModel load_calibration(const std::string& path, const std::string& kalibr_camera) {
   const CalibrationFormat format = detect_calibration_format(path);
-  if (format == CalibrationFormat::kOpenCvFileStorage) {
-    try {
-      return read_opencv(path);
-    } catch (const cv::Exception& e) {  // e.g. a top level that is not a mapping (a fuzzed file): fs[key] asserts
-      throw CalibrationError(fmt::format("{}: not a valid OpenCV calibration file: {}", path, e.err));
-    }
-  }
-  const YAML::Node root = parse_yaml(path, read_text(path));
+  const std::string text = read_text(path);
+  if (format == CalibrationFormat::kOpenCvFileStorage) return read_opencv(path, text);
+  const YAML::Node root = parse_yaml(path, text);
   if (format == CalibrationFormat::kRosCameraInfo) return read_ros(path, root);
   return read_kalibr(path, root, kalibr_camera);
 }

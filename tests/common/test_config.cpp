@@ -67,6 +67,18 @@ TEST(ConfigLoader, ReportsEveryBadKeyAtOnceWithFileAndLine) {
   }
 }
 
+TEST(ConfigLoader, NonScalarKeyIsANamedProblemNotACrash) {
+  // Found by fuzz.config: YAML's complex keys ("? ...") made the loader throw yaml-cpp's bad conversion.
+  try {
+    load_options_from_string<Demo>("camera:\n  ? fps: 3\n  : 1\n  width: 0\n", "k.yaml");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("k.yaml:2: camera: a key must be a plain name, got a mapping"), std::string::npos) << m;
+    EXPECT_NE(m.find("camera.width = 0: must be > 0"), std::string::npos) << "other problems still reported: " << m;
+  }
+}
+
 TEST(ConfigLoader, UnknownKeyInWrongSectionSuggestsTheKnownOne) {
   try {
     load_options_from_string<Demo>("file:\n  fps: 10\n", "s.yaml");

@@ -207,6 +207,24 @@ TEST(Calibration, ErrorsNameTheFileTheKeyAndWhatWasExpected) {
       {write(dir, "other.yaml", "fps: 30\n"), "cam0", "'(top level)'", "not a calibration file"},
       {write(dir, "broken.yaml", "image_width: [1, 2\n"), "cam0", "not valid YAML", ""},
       {dir.file("absent.yaml"), "cam0", "cannot open", ""},
+      // OpenCV FileStorage files (read with yaml-cpp: OpenCV's own parser hung on a fuzzed file).
+      {write(dir, "cv_count.yaml",
+             "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nK: !!opencv-matrix\n  rows: 3\n  cols: 3\n"
+             "  dt: d\n  data: [500, 0, 320, 0, 500, 240, 0, 0]\nD: [0.1, 0, 0, 0, 0]\n"),
+       "cam0", "'K.data'", "expected 3x3 = 9 numbers, got 8"},
+      {write(dir, "cv_rows.yaml",
+             "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nK: !!opencv-matrix\n  rows: 100000\n  cols: 3\n"
+             "  dt: d\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\nD: [0.1, 0, 0, 0, 0]\n"),
+       "cam0", "'K'", "rows and cols in 1..64, got 100000x3"},
+      {write(dir, "cv_dt.yaml",
+             "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nK: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
+             "D: !!opencv-matrix\n  rows: 1\n  cols: 2\n  dt: 2d\n  data: [0.1, 0, 0, 0]\n"),
+       "cam0", "'D.dt'", "expected a one-channel element type"},
+      {write(dir, "cv_width.yaml",
+             "%YAML:1.0\n---\nimage_width: wide\nimage_height: 480\nK: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
+             "D: [0.1, 0, 0, 0, 0]\n"),
+       "cam0", "'image_width'", "expected an integer"},
+      {write(dir, "cv_list.yaml", "%YAML:1.0\n---\n- K\n"), "cam0", "'(top level)'", "expected a mapping"},
   };
   for (const Expect& e : cases) {
     const std::string message = load_error(e.path, e.camera);
