@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 # Measures a detector model the way its card reports it (models/wingman-small.md): wingman val on the clip-disjoint
 # Halmstad val clips (drone clips; airplane, bird and helicopter clips as negatives, false positives per image), on
-# the synthetic val split it was trained beside, and on a synthetic 1280x720 set up to 30 m; and its speed
+# the synthetic val split it was trained beside, on a synthetic 1280x720 set up to 30 m, and on the follower's view
+# of the formation flights (1280x720, 90 deg, the target on the horizon at 4-20 m, never trained on); and its speed
 # (wingman bench detector). Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
 #
 # Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
@@ -51,6 +52,40 @@ if [ ! -f "$data/synth720/data.yaml" ]; then
     --meshes "$src/../shared/meshes"
 fi
 val synth720_val "$data/synth720/data.yaml"
+# The follower's view (config/scenarios/formation_2d.yaml's camera: 1280x720, fx 640, ideal pinhole): the leader at
+# the camera's height on the horizon, in front of the treeline, 4-20 m, the shared meshes; seed 31: never trained on.
+if [ ! -f "$data/followview/data.yaml" ]; then
+  rm -rf "$data/followview"
+  cat > "$data/followview.yaml" <<'EOF'
+synth:
+  width: 1280
+  height: 720
+  hfov_min_deg: 90.0
+  hfov_max_deg: 90.0
+  fisheye_fraction: 0.0
+  radtan_k1_min: 0.0
+  radtan_k1_max: 0.0
+  range_min_m: 4.0
+  range_max_m: 20.0
+  mesh_fraction: 1.0
+  camera_height_min_m: 5.0
+  camera_height_max_m: 20.0
+  camera_pitch_min_deg: -3.0
+  camera_pitch_max_deg: 3.0
+  camera_roll_max_deg: 3.0
+  target_tilt_max_deg: 10.0
+  horizon_fraction: 1.0
+  horizon_elevation_max_deg: 2.0
+  val_fraction: 1.0
+  image_format: "jpg"
+  jpeg_quality: 92
+render:
+  supersampling: 1
+EOF
+  "$bin/wingman" dataset synth --out "$data/followview" --count 200 --seed 31 --config "$data/followview.yaml" \
+    --meshes "$src/../shared/meshes"
+fi
+val followview_val "$data/followview/data.yaml"
 if $bench; then
   POCL_AFFINITY=1 "$bin/wingman" bench detector --cfg "$cfg" --weights "$weights" --sizes 416 --threads 1,2 \
     --repetitions 15 > "$out/bench.txt" 2>&1
@@ -65,7 +100,8 @@ def recall_at_precision(c, p_min):
 lines = ["| set | images | truths | criterion | AP@0.5 | precision / recall at conf 0.2 | recall at precision >= 0.90 | mean IoU |",
          "|---|---|---|---|---|---|---|---|"]
 for name, label in [("halmstad_val", "Halmstad val clips (all)"), ("halmstad_val_DRONE", "Halmstad val, drone clips"),
-                    ("synth_val", "synthetic val (960x540, as trained)"), ("synth720_val", "synthetic 1280x720, <= 30 m")]:
+                    ("synth_val", "synthetic val (960x540, as trained)"), ("synth720_val", "synthetic 1280x720, <= 30 m"),
+                    ("followview_val", "follower's view, 1280x720, horizon, 4-20 m")]:
     r = load(name)
     for crit in ("iou", "centre"):
         a = r[crit]["all"]

@@ -4,10 +4,14 @@
 reads the LCM log format and decodes status_t, detections_t and image_t itself).
 
 Usage:
-  load_summary.py realtime LOG --cameras N [--proc-csv CSV] [--max-p99-s S] [--udp-rcvbuf-errors N] [--json FILE]
+  load_summary.py realtime LOG --cameras N [--proc-csv CSV] [--max-p99-s S] [--udp-rcvbuf-errors N] [--report-only]
+                  [--json FILE]
   load_summary.py replay IMAGES_LOG DETECTIONS_LOG... [--json FILE]
-  load_summary.py soak LOG --proc-csv CSV --warmup-s S [--max-rss-growth-pct P] [--json FILE]
-Prints the figures; exits 1 (one line per failed check) when a check fails, 2 on unreadable input."""
+  load_summary.py soak LOG --proc-csv CSV --warmup-s S [--max-rss-growth-pct P] [--report-only] [--json FILE]
+Prints the figures; exits 1 (one line per failed check) when a check fails, 2 on unreadable input.
+--report-only: the bounds on speed and memory (end-to-end p99, latency growth, RSS growth) are reported as
+"beyond the bound" lines, not failures; the checks that every frame is accounted for and that every process ran
+stay checks. CI's load tests use it (speed and memory are measured on a shared machine, not asserted there)."""
 import argparse
 import csv
 import json
@@ -144,6 +148,15 @@ def latency_series(log, cameras):
     return out
 
 
+def bound(a, failures, result, line):
+    """A speed or memory bound exceeded: a failure, or with --report-only a reported line."""
+    if a.report_only:
+        result.setdefault("beyond_bounds", []).append(line)
+        print(f"load_summary: beyond the bound (reported only): {line}")
+    else:
+        failures.append(line)
+
+
 def realtime(a):
     failures, result = [], {"cameras": []}
     st = statuses(a.log)
@@ -229,12 +242,12 @@ def realtime(a):
                   f"second half {s['p50'] * 1e3:.0f}/{s['p99'] * 1e3:.0f} ms")
             # Generous: the newest-frame policy keeps latency flat; a queue that grows would double it and more.
             if s["p50"] > 2 * f["p50"] + 0.5:
-                failures.append(f"end-to-end latency grows: p50 {f['p50']:.2f} s in the first half, "
-                                f"{s['p50']:.2f} s in the second")
+                bound(a, failures, result, f"end-to-end latency grows: p50 {f['p50']:.2f} s in the first half, "
+                                           f"{s['p50']:.2f} s in the second")
     if not e2e:
         failures.append("no detections arrived")
     elif result["end_to_end_s"][99] > a.max_p99_s:
-        failures.append(f"end-to-end p99 {result['end_to_end_s'][99]:.2f} s above the bound {a.max_p99_s} s")
+        bound(a, failures, result, f"end-to-end p99 {result['end_to_end_s'][99]:.2f} s above the bound {a.max_p99_s} s")
     # Heartbeat latencies (what each process measures itself) and CPU.
     print("load: heartbeat latency (each process's own p50/p99 over its last 256 handled messages, last "
           "heartbeat before STOPPING), CPU % of one core (from /proc, whole run)")
@@ -328,8 +341,8 @@ def soak(a):
         print(f"  {p:18s} {w / 1024:17.1f} {e / 1024:9.1f} {growth:10.2f} {last / 1024:17.1f} "
               f"{cpu.get(p, float('nan')):7.0f}")
         if growth > a.max_rss_growth_pct:
-            failures.append(f"{p}: RSS grew {growth:.1f} % after the warm-up (peak {w} -> {e} KiB), "
-                            f"above {a.max_rss_growth_pct} %")
+            bound(a, failures, result, f"{p}: RSS grew {growth:.1f} % after the warm-up (peak {w} -> {e} KiB), "
+                                       f"above {a.max_rss_growth_pct} %")
     # Latency trend over the time the detections flowed (first to last arrival, so start-up and shutdown are out):
     # heartbeat p50/p99 (process-measured) and end-to-end, first vs last third.
     series = latency_series(a.log, 16)
@@ -378,6 +391,7 @@ def main():
     r.add_argument("--proc-csv")
     r.add_argument("--max-p99-s", type=float, default=5.0)
     r.add_argument("--udp-rcvbuf-errors", type=int)
+    r.add_argument("--report-only", action="store_true")
     r.add_argument("--json")
     p = sub.add_parser("replay")
     p.add_argument("images_log")
@@ -388,6 +402,7 @@ def main():
     s.add_argument("--proc-csv", required=True)
     s.add_argument("--warmup-s", type=float, required=True)
     s.add_argument("--max-rss-growth-pct", type=float, default=5.0)
+    s.add_argument("--report-only", action="store_true")
     s.add_argument("--json")
     a = ap.parse_args()
     return {"realtime": realtime, "replay": replay, "soak": soak}[a.cmd](a)

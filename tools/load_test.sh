@@ -11,7 +11,7 @@
 #
 # Usage: tools/load_test.sh [--mode realtime|replay] [--duration S] [--out DIR] [--cameras N]
 #                           [--soak] [--warmup S] [--sample-period S] [--replay-frames N] [--max-p99-s S]
-#                           [--max-rss-growth-pct P]
+#                           [--max-rss-growth-pct P] [--report-only]
 #   --mode           realtime (default): cameras paced at 30 fps, detectors keep the newest frame when busy
 #                    (input.mode realtime, drops counted); checks that every frame a detector received is processed
 #                    or counted as dropped (at most one in flight at the end), that frames lost on the bus (published
@@ -37,6 +37,9 @@
 #   --replay-frames  replay: frames per camera (default 10; each 1280x720 BGR frame is 2.7 MB in the log)
 #   --max-p99-s      realtime: bound on the end-to-end p99, seconds (default 5)
 #   --max-rss-growth-pct  soak: bound on RSS growth after the warm-up, percent (default 5)
+#   --report-only    the speed and memory bounds (p99, latency growth, RSS growth) are reported, not checked; the
+#                    frame accounting and the processes' statuses stay checks (CI's load tests: speed and memory are
+#                    not asserted in timed tests on a shared machine; docs/benchmarks.md, docs/reliability.md)
 # Environment: WINGMAN_BIN_DIR (default build/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -44,7 +47,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 mode=realtime duration="" out="" cameras=4 soak=false warmup="" sample_period=2 replay_frames=10 max_p99_s=5
-max_rss_growth_pct=5
+max_rss_growth_pct=5 report_only=()
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -58,6 +61,7 @@ while [ $# -gt 0 ]; do
     --replay-frames) replay_frames="$2"; shift 2 ;;
     --max-p99-s) max_p99_s="$2"; shift 2 ;;
     --max-rss-growth-pct) max_rss_growth_pct="$2"; shift 2 ;;
+    --report-only) report_only=(--report-only); shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "load_test: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -274,11 +278,11 @@ done
 echo
 rc=0
 "${summary[@]}" realtime "$log" --cameras "$cameras" --proc-csv "$proc_csv" --max-p99-s "$max_p99_s" \
-  --udp-rcvbuf-errors "$rcvbuf_errors" --json "$out/summary.json" || rc=1
+  --udp-rcvbuf-errors "$rcvbuf_errors" "${report_only[@]}" --json "$out/summary.json" || rc=1
 if [ "$soak" = true ]; then
   echo
   "${summary[@]}" soak "$log" --proc-csv "$proc_csv" --warmup-s "$warmup" --max-rss-growth-pct "$max_rss_growth_pct" \
-    --json "$out/soak.json" || rc=1
+    "${report_only[@]}" --json "$out/soak.json" || rc=1
 fi
 echo "load_test: log $log, samples $proc_csv, figures $out/summary.json"
 exit "$rc"

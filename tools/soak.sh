@@ -9,8 +9,9 @@
 # checks of tools/load_test.sh.
 #
 # Usage: tools/soak.sh [--duration S] [--out DIR] [--cameras N] [--warmup S] [--sample-period S]
-#                      [--max-rss-growth-pct P]
-#   --duration  seconds (default 600; CI runs 90)
+#                      [--max-rss-growth-pct P] [--report-only]
+#   --duration  seconds (default 600; CI runs 90 with --report-only: the RSS and latency figures are printed, not
+#               checked, there)
 #   --warmup    seconds excluded from the RSS reference (default 30 up to 180 s runs, else 60; see load_test.sh)
 #   the others as in tools/load_test.sh --help
 set -euo pipefail
