@@ -2,9 +2,9 @@
 # SPDX-License-Identifier: MIT
 # Reproduces the shipped detector model (models/wingman-small.weights, card: models/wingman-small.md) on the CPU:
 # imports the Halmstad videos (real, clip-split, tightened boxes, hard negatives), renders the synthetic sets with
-# the simulator, and trains models/wingman-small.cfg on Halmstad + synth with the card's schedule (stage 1; the
-# shipped weights are its iteration 1000). With --stage2-batches N it then fine-tunes those weights with the
-# follower's-view set (drones on the horizon) added (stage 2: in progress, not shipped yet; see the card).
+# the simulator, and trains models/wingman-small.cfg on Halmstad + synth with the card's schedule (stage 1), then
+# fine-tunes stage 1's iteration-1000 weights for 400 iterations with the follower's-view set (drones on the
+# horizon) added (stage 2). The shipped weights are stage 2's final ones (OUT/stage2/wingman-small_final.weights).
 # Resumable: run it again after an interruption and it continues from the last checkpoint (datasets are kept once
 # complete; a finished stage is not trained again).
 #
@@ -14,14 +14,14 @@
 #                     (default build/train-wingman-small)
 #   --threads         libtorch threads (default 2)
 #   --max-batches     stage 1 iterations (default 1500; the schedule scales with it)
-#   --stage2-batches  stage 2 iterations (default 0 = stage 1 only; 400 was tried). Stage 2 starts from stage 1's
-#                     iteration-1000 weights (or its final ones when it is shorter)
+#   --stage2-batches  stage 2 iterations (default 400, the shipped model's; 0 = stage 1 only). Stage 2 starts from
+#                     stage 1's iteration-1000 weights (or its final ones when it is shorter)
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
-data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=0
+data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
