@@ -251,7 +251,11 @@ class FileSizeLimit {
 
 TEST(RecorderTest, AFailingWriteKeepsTheSegmentReadableDropsAndCountsAndRecoversInANewSegment) {
   TempDir dir;
-  Recorder rec(options_in(dir.path()));
+  RecorderOptions o = options_in(dir.path());
+  // The 20 sends below must all fall before the retry; at 0.2 s a clean-clone ASan run under load retried in
+  // between (a second segment, 11 written). 3 s leaves room for any slowdown; the recovery below waits for it.
+  o.retry_period_s = 3.0;
+  Recorder rec(o);
   FileSizeLimit limit(10000);  // 1000-byte payloads: event 10 crosses the limit part-way
   int sent = 0;
   auto send = [&](int n) {
