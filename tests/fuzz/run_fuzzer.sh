@@ -5,8 +5,9 @@
 # Fails on any finding: crash, sanitizer report, an input over 10 s (-timeout), an allocation over 512 MB
 # (-malloc_limit_mb) or RSS over 2 GB (-rss_limit_mb). The crashing input lands in ARTIFACT_DIR; reproduce with
 # `FUZZER ARTIFACT_DIR/crash-...`. Prints libFuzzer's final stats (executions, exec/s).
-# The random seed is WINGMAN_FUZZ_SEED (default 1), so a CI run explores the same inputs each time (how far depends
-# on the machine's speed); set WINGMAN_FUZZ_SEED=0 for a random seed, as in long runs by hand.
+# The random seed is WINGMAN_FUZZ_SEED (default 1), so a CI run explores the same inputs each time; with -runs=N among
+# the extra flags (ctest passes WINGMAN_FUZZ_RUNS) it also stops at the same input on any machine that finishes
+# within SECONDS. Set WINGMAN_FUZZ_SEED=0 for a random seed, as in long runs by hand.
 set -euo pipefail
 if [[ $# -lt 4 ]]; then
   echo "usage: $0 FUZZER CORPUS_DIR SECONDS ARTIFACT_DIR [libFuzzer flags...]" >&2
