@@ -26,3 +26,10 @@ wingman_add_test(test_sim_dataset_synth
 target_include_directories(test_sim_dataset_synth PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
 target_compile_definitions(test_sim_dataset_synth PRIVATE WINGMAN_EXE="$<TARGET_FILE:wingman>")
 add_dependencies(test_sim_dataset_synth wingman)
+
+# `wingman dataset from-log`: flight logs (real LCM log files) to a YOLO dataset, read back with the trainer's reader.
+wingman_add_test(test_sim_dataset_from_log
+  SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_dataset_from_log.cpp
+  LIBS wingman::tools wingman::training_data wingman::test_support opencv_imgcodecs
+  LABEL sim
+  TIMEOUT 60)

@@ -2,6 +2,8 @@
 // `wingman dataset synth`: rendered, labelled training images with domain randomization, in the YOLO layout.
 #include "wingman/tools/dataset_synth.hpp"
 
+#include "wingman/tools/dataset_from_log.hpp"
+
 #include <wingman/common/config.hpp>
 #include <wingman/localizer/camera_model.hpp>
 #include <wingman/sim/drone_model.hpp>
@@ -505,10 +507,14 @@ struct DatasetVerbs::State {
   CLI::App* synth = nullptr;
   DatasetSynthRequest request;
   bool print_config = false;
+  CLI::App* from_log = nullptr;
+  DatasetFromLogRequest from_log_request;
+  bool skip_negatives = false;
 };
 
 DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
-  CLI::App* dataset = app.add_subcommand("dataset", "Datasets: render synthetic training images");
+  CLI::App* dataset = app.add_subcommand(
+      "dataset", "Datasets: render synthetic training images, or take them from a simulated flight's log");
   dataset->require_subcommand(1);
   s_->synth = dataset->add_subcommand(
       "synth",
@@ -521,11 +527,42 @@ DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->synth->add_option("--meshes", s_->request.meshes,
                         "Airframe mesh file or folder (repeatable), e.g. ../shared/meshes");
   s_->synth->add_flag("--print-config", s_->print_config, "Print the effective configuration and exit");
+
+  DatasetFromLogRequest& f = s_->from_log_request;
+  s_->from_log = dataset->add_subcommand(
+      "from-log",
+      "Camera frames of simulated flights' logs (tools/fly.sh --record-images) with the renderer's ground-truth "
+      "boxes, as a YOLO dataset");
+  s_->from_log->add_option("logs", f.logs, "LCM logs with images and GROUND_TRUTH")->required();
+  s_->from_log->add_option("--out", f.out_dir, "Dataset folder (created, or extended with more logs)")->required();
+  s_->from_log->add_option("--split", f.split, "train or val: where all images of these logs go (default train)");
+  s_->from_log->add_option("--every", f.every, "Keep every Nth image of each log (default 1)");
+  s_->from_log->add_option("--min-box-px", f.min_box_px,
+                           "Drop visible boxes narrower or lower than this after clipping, pixels (default 2)");
+  s_->from_log->add_flag("--skip-negatives", s_->skip_negatives, "Leave out frames without a visible drone");
+  s_->from_log->add_option("--format", f.image_format, "Image format: jpg (default) or png");
+  s_->from_log->add_option("--jpeg-quality", f.jpeg_quality, "JPEG quality 1..100 (default 92)");
+  s_->from_log->add_option("--image-channel", f.image_channel, "image_t channel (default IMAGE_CAM0)");
+  s_->from_log->add_option("--truth-channel", f.truth_channel, "ground_truth_t channel (default GROUND_TRUTH)");
 }
 
 DatasetVerbs::~DatasetVerbs() = default;
 
 int DatasetVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (*s_->from_log) {
+    try {
+      s_->from_log_request.keep_negatives = !s_->skip_negatives;
+      const DatasetFromLogSummary summary = run_dataset_from_log(s_->from_log_request, err);
+      out << summary.one_line() << std::endl;
+      return 0;
+    } catch (const std::invalid_argument& e) {
+      err << "wingman dataset from-log: error: " << e.what() << std::endl;
+      return 2;
+    } catch (const std::exception& e) {
+      err << "wingman dataset from-log: error: " << e.what() << std::endl;
+      return 1;
+    }
+  }
   if (!*s_->synth) return -1;
   try {
     if (s_->print_config) {

@@ -130,15 +130,15 @@ struct DatasetSynthSummary {
 /// Throws common::ConfigError for a bad config, std::runtime_error naming the file or folder for I/O problems.
 DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress);
 
-/// Adds `dataset synth` to the CLI and runs it when chosen.
+/// Adds `dataset synth` and `dataset from-log` to the CLI and runs the one chosen.
 class DatasetVerbs {
  public:
-  /// Registers `dataset` and its subcommand `synth` with their options on `app`.
+  /// Registers `dataset` and its subcommands `synth` and `from-log` with their options on `app`.
   explicit DatasetVerbs(CLI::App& app);
   ~DatasetVerbs();
 
-  /// After parsing: runs `dataset synth` when chosen and returns its exit code (0 ok, 1 failure, 2 bad config), or
-  /// -1 when it was not chosen. The summary goes to `out`, progress and errors to `err`.
+  /// After parsing: runs `dataset synth` or `dataset from-log` when chosen and returns its exit code (0 ok,
+  /// 1 failure, 2 bad config or arguments), or -1 when neither was chosen. The summary goes to `out`, progress and errors to `err`.
   int run_if_chosen(std::ostream& out, std::ostream& err);
 
  private:
