@@ -3,8 +3,8 @@
 # Measures a detector model the way its card reports it (models/wingman-small.md): wingman val on the clip-disjoint
 # Halmstad val clips (drone clips; airplane, bird and helicopter clips as negatives, false positives per image), on
 # the synthetic val split it was trained beside, on a synthetic 1280x720 set up to 30 m, and on the follower's view
-# of the formation flights (1280x720, 90 deg, the target on the horizon at 4-20 m, never trained on); and its speed
-# (wingman bench detector). Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
+# of the formation flights (1280x720, 90 deg, the target on the horizon at 4-20 m, never trained on), on the held-out
+# training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size). Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
 #
 # Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
@@ -86,22 +86,31 @@ EOF
     --meshes "$src/../shared/meshes"
 fi
 val followview_val "$data/followview/data.yaml"
+# The held-out training flight (tools/train_model.sh stage 3: flight 7 of seed 1, never trained on), when present.
+flights=false
+if [ -f "$data/flights/.complete" ]; then
+  flights=true
+  val flights_val "$data/flights/data.yaml"
+fi
 if $bench; then
-  POCL_AFFINITY=1 "$bin/wingman" bench detector --cfg "$cfg" --weights "$weights" --sizes 416 --threads 1,2 \
+  POCL_AFFINITY=1 "$bin/wingman" bench detector --cfg "$cfg" --weights "$weights" --sizes cfg --threads 1,2 \
     --repetitions 15 > "$out/bench.txt" 2>&1
 fi
-PYENV_VERSION=system python3 - "$out" <<'PY'
+PYENV_VERSION=system python3 - "$out" "$flights" <<'PY'
 import json, os, sys
 out = sys.argv[1]
+sets = [("halmstad_val", "Halmstad val clips (all)"), ("halmstad_val_DRONE", "Halmstad val, drone clips"),
+        ("synth_val", "synthetic val (960x540, as trained)"), ("synth720_val", "synthetic 1280x720, <= 30 m"),
+        ("followview_val", "follower's view, 1280x720, horizon, 4-20 m")]
+if sys.argv[2] == "true":
+    sets.append(("flights_val", "held-out training flight, 1280x720, 3-30 m"))
 def load(n):
     return json.load(open(os.path.join(out, n + ".json")))
 def recall_at_precision(c, p_min):
     return max([r for r, p, _ in c["pr_curve"] if p >= p_min] or [0.0])
 lines = ["| set | images | truths | criterion | AP@0.5 | precision / recall at conf 0.2 | recall at precision >= 0.90 | mean IoU |",
          "|---|---|---|---|---|---|---|---|"]
-for name, label in [("halmstad_val", "Halmstad val clips (all)"), ("halmstad_val_DRONE", "Halmstad val, drone clips"),
-                    ("synth_val", "synthetic val (960x540, as trained)"), ("synth720_val", "synthetic 1280x720, <= 30 m"),
-                    ("followview_val", "follower's view, 1280x720, horizon, 4-20 m")]:
+for name, label in sets:
     r = load(name)
     for crit in ("iou", "centre"):
         a = r[crit]["all"]

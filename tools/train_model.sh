@@ -22,6 +22,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
+stage3_batches=240
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -29,12 +30,14 @@ while [ $# -gt 0 ]; do
     --threads) threads="$2"; shift 2 ;;
     --max-batches) max_batches="$2"; shift 2 ;;
     --stage2-batches) stage2_batches="$2"; shift 2 ;;
+    --stage3-batches) stage3_batches="$2"; shift 2 ;;
     -h|--help) sed -n 3,18p "$0"; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 case "$max_batches" in ''|*[!0-9]*) echo "train_model: --max-batches '$max_batches': expected a positive integer" >&2; exit 2 ;; esac
 case "$stage2_batches" in ''|*[!0-9]*) echo "train_model: --stage2-batches '$stage2_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+case "$stage3_batches" in ''|*[!0-9]*) echo "train_model: --stage3-batches '$stage3_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 halmstad_src="$src/../shared/datasets/halmstad"
 [ -d "$halmstad_src" ] || { echo "train_model: $halmstad_src is missing (the Halmstad videos)" >&2; exit 2; }
 "$bin/wingman" train --help > /dev/null 2>&1 ||
@@ -106,8 +109,12 @@ val: halmstad/images/val
 nc: 1
 names: [drone]
 EOF
-common=(--cfg "$src/models/wingman-small.cfg" --threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1
-  --blur 0.1 --noise 0.1 --checkpoint-interval 25 --log-interval 10 --val-max-images 400)
+# Stages 1 and 2 train the network at 416x416 (the .cfg with that input size); stage 3 at the .cfg's own 640x352.
+sed 's/^width=.*/width=416/; s/^height=.*/height=416/' "$src/models/wingman-small.cfg" > "$out/wingman-small-416.cfg"
+augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 --blur 0.1 --noise 0.1
+  --checkpoint-interval 25 --log-interval 10 --val-max-images 400)
+common=(--cfg "$out/wingman-small-416.cfg" "${augment[@]}")
+common640=(--cfg "$src/models/wingman-small.cfg" "${augment[@]}")
 # 3. Stage 1: Table 2's rate steps, scaled to the run's length; warm-up 100 iterations.
 if [ ! -f "$out/wingman-small_final.weights" ]; then
   s1=$((max_batches * 53 / 100)) s2=$((max_batches * 77 / 100)) s3=$((max_batches * 90 / 100))
@@ -118,11 +125,59 @@ if [ ! -f "$out/wingman-small_final.weights" ]; then
 fi
 [ "$stage2_batches" -gt 0 ] || exit 0
 # 4. Stage 2: fine-tune iteration 1000's weights at the rate stage 1 had there (1e-3), then Table 2's later steps.
-init="$out/wingman-small_1000.weights"
-[ -f "$init" ] || init="$out/wingman-small_final.weights"
-t1=$((stage2_batches / 2)) t2=$((stage2_batches * 8 / 10)) t3=$((stage2_batches * 9 / 10))
+if [ ! -f "$out/stage2/wingman-small_final.weights" ]; then
+  init="$out/wingman-small_1000.weights"
+  [ -f "$init" ] || init="$out/wingman-small_final.weights"
+  t1=$((stage2_batches / 2)) t2=$((stage2_batches * 8 / 10)) t3=$((stage2_batches * 9 / 10))
+  resume=()
+  [ -f "$out/stage2/checkpoint.pt" ] && resume=(--resume)
+  "$bin/wingman" train "${common[@]}" --data "$data/combined-horizon.yaml" --out "$out/stage2" --weights "$init" \
+    --max-batches "$stage2_batches" --burn-in 50 --learning-rate 0.001 --steps "$t1,$t2,$t3" --weights-interval 100 \
+    "${resume[@]}"
+fi
+[ "$stage3_batches" -gt 0 ] || exit 0
+
+# 5. Stage 3 data: the flights' own view. Eight training flights (tools/make_training_flights.py, seed 1: a hovering
+# camera, the leader on random waypoints 3-30 m ahead, 40 s each; not the evaluation scenarios) flown through the
+# real pipeline with ground-truth detections, every frame recorded; every 5th frame kept with the renderer's
+# silhouette boxes (`wingman dataset from-log`); flights 0-6 train, flight 7 val. The 3 GB logs are deleted after;
+# an interrupted run keeps the flights it finished.
+if [ ! -f "$data/flights/.complete" ]; then
+  python3 "$src/tools/make_training_flights.py" --out "$data/flight-logs/scenarios" --count 8 --seed 1 --duration 40
+  for k in 0 1 2 3 4 5 6 7; do
+    name=$(printf 'train_flight_%02d' "$k")
+    [ -f "$data/flight-logs/$name.done" ] && continue  # kept from an interrupted run
+    rm -rf "$data/flight-logs/$name"
+    rm -f "$data"/flights/images/*/"$name"_* "$data"/flights/labels/*/"$name"_*
+    WINGMAN_BIN_DIR="$bin" "$src/tools/fly.sh" --scenario "$data/flight-logs/scenarios/$name.yaml" \
+      --out "$data/flight-logs/$name" --detections truth --truth-box silhouette --render --record-images \
+      > "$data/flight-logs/$name.log" 2>&1 ||
+      { echo "train_model: the training flight $name failed (log: $data/flight-logs/$name.log)" >&2; exit 1; }
+    mv "$data/flight-logs/$name/flight.lcmlog" "$data/flight-logs/$name/$name.lcmlog"
+    split=train
+    [ "$k" = 7 ] && split=val
+    "$bin/wingman" dataset from-log "$data/flight-logs/$name/$name.lcmlog" --out "$data/flights" --split "$split" \
+      --every 5
+    rm -f "$data/flight-logs/$name/$name.lcmlog"
+    touch "$data/flight-logs/$name.done"
+  done
+  touch "$data/flights/.complete"
+fi
+cat > "$data/combined-flights.yaml" <<EOF
+# Stage 3 mix: stage 2's plus the training flights' frames; validation: the clip-disjoint Halmstad val clips.
+path: $data
+train: [halmstad/images/train, synth/images/train, horizon/images/train, flights/images/train]
+val: halmstad/images/val
+nc: 1
+names: [drone]
+EOF
+# 6. Stage 3 (the shipped weights): stage 2's final weights fine-tuned at the shipped input size, 640x352 (the .cfg
+# as it is: a 16:9 frame keeps 0.49 of its rows instead of the 416x416 stretch's 0.58 and 0.50 of its columns
+# instead of 0.33), at Table 2's 1e-3, 5e-4, 1e-4, 5e-5.
+[ -f "$out/stage3/wingman-small_final.weights" ] && exit 0
+u1=$((stage3_batches / 2)) u2=$((stage3_batches * 8 / 10)) u3=$((stage3_batches * 9 / 10))
 resume=()
-[ -f "$out/stage2/checkpoint.pt" ] && resume=(--resume)
-exec "$bin/wingman" train "${common[@]}" --data "$data/combined-horizon.yaml" --out "$out/stage2" --weights "$init" \
-  --max-batches "$stage2_batches" --burn-in 50 --learning-rate 0.001 --steps "$t1,$t2,$t3" --weights-interval 100 \
-  "${resume[@]}"
+[ -f "$out/stage3/checkpoint.pt" ] && resume=(--resume)
+exec "$bin/wingman" train "${common640[@]}" --data "$data/combined-flights.yaml" --out "$out/stage3" \
+  --weights "$out/stage2/wingman-small_final.weights" --max-batches "$stage3_batches" --burn-in 30 \
+  --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 40 "${resume[@]}"

@@ -98,9 +98,9 @@ std::string write_flight(const wingman::testing::TempDir& dir, const std::string
   log.write("GROUND_TRUTH", truth(1, {box(20, 10, 8, 4), box(50, 30, 6, 6)}));
   log.write("GROUND_TRUTH", truth(2, {box(16, 16, 12, 12)}));
   log.write("IMAGE_CAM0", frame(2));
-  log.raw("IMAGE_CAM0", {1, 2, 3});        // not an image_t
-  log.raw("GROUND_TRUTH", {9, 9, 9, 9});   // not a ground_truth_t
-  log.write("OTHER", frame(99));           // other channels are ignored
+  log.raw("IMAGE_CAM0", {1, 2, 3});       // not an image_t
+  log.raw("GROUND_TRUTH", {9, 9, 9, 9});  // not a ground_truth_t
+  log.write("OTHER", frame(99));          // other channels are ignored
   log.write("IMAGE_CAM0", frame(3));
   log.write("GROUND_TRUTH", truth(3, {box(32, 24, 10, 6, false), box(32, 24, 10, 6, true, 7)}));
   log.write("IMAGE_CAM0", frame(4));

@@ -67,11 +67,35 @@ std::string cpu_model_name() {
   return "(unknown)";
 }
 
-/// The network (`o.cfg`, the thesis network by default) at `size` x `size`: its cfg with [net] width/height changed.
-DarknetModel bench_model(int size, const BenchDetectorOptions& o) {
+/// A size option ("416", "640x352" or "cfg") as width x height; {0, 0} for "cfg"; {-1, -1} when malformed.
+cv::Size parse_size(const std::string& text) {
+  if (text == "cfg") return {0, 0};
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  std::istringstream in(text);
+  if (!(in >> w)) return {-1, -1};
+  if (in >> x) {
+    if (x != 'x' || !(in >> h) || (in >> extra)) return {-1, -1};
+  } else {
+    h = w;
+  }
+  return {w, h};
+}
+
+/// "416" for a square input, else "640x352".
+std::string size_label(int width, int height) {
+  return width == height ? std::to_string(width) : fmt::format("{}x{}", width, height);
+}
+
+/// The network (`o.cfg`, the thesis network by default) at `size` ("N", "WxH" or "cfg"): its cfg with [net]
+/// width/height changed (kept for "cfg").
+DarknetModel bench_model(const std::string& size, const BenchDetectorOptions& o) {
   DarknetModel m = detector::load_cfg(o.cfg);
-  m.net.width = size;
-  m.net.height = size;
+  if (size != "cfg") {
+    const cv::Size net = parse_size(size);
+    m.net.width = net.width;
+    m.net.height = net.height;
+  }
   detector::compute_shapes(m);
   if (o.weights.empty())
     detector::randomize_weights(m, o.seed);
@@ -158,7 +182,7 @@ std::string json_timing(const TimingMs& t) {
                      t.runs);
 }
 
-ForwardResult forward_row(const std::string& backend, int size, int threads, const std::string& note) {
+ForwardResult forward_row(const std::string& backend, const std::string& size, int threads, const std::string& note) {
   ForwardResult r;
   r.backend = backend;
   r.size = size;
@@ -182,8 +206,12 @@ int pocl_threads(int cores) {
 std::vector<std::string> BenchDetectorOptions::validate() const {
   std::vector<std::string> p;
   if (sizes.empty()) p.push_back("sizes = (empty): give at least one size");
-  for (const int s : sizes)
-    if (s < 32 || s % 32 != 0) p.push_back(fmt::format("sizes = {}: each must be a multiple of 32, >= 32", s));
+  for (const std::string& s : sizes) {
+    if (s == "cfg") continue;
+    const cv::Size net = parse_size(s);
+    if (net.width < 32 || net.width % 32 != 0 || net.height < 32 || net.height % 32 != 0)
+      p.push_back(fmt::format("sizes = {}: expected N or WxH (each a multiple of 32, >= 32) or cfg", s));
+  }
   if (threads.empty()) p.push_back("threads = (empty): give at least one thread count");
   for (const int t : threads)
     if (t < 1) p.push_back(fmt::format("threads = {}: each must be >= 1", t));
@@ -226,12 +254,13 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
   std::vector<cv::Mat> stream;
   for (int i = 0; i < 8; ++i) stream.push_back(synthetic_frame(o.stream_width, o.stream_height, i));
 
-  for (const int size : o.sizes) {
-    const DarknetModel model = bench_model(size, o);
+  for (const std::string& size_option : o.sizes) {
+    const DarknetModel model = bench_model(size_option, o);
     const double flops = model.flops();
-    const cv::Size net(size, size);
+    const cv::Size net(model.net.width, model.net.height);
+    const std::string size = size_label(net.width, net.height);
     // The same frame for every backend: our CHW input, and the net-sized BGR image for bare cv::dnn.
-    std::vector<float> chw(static_cast<size_t>(3) * size * size);
+    std::vector<float> chw(static_cast<size_t>(3) * net.area());
     cv::Mat resized;
     detector::to_network_input(stream[0], cv::Rect(0, 0, o.stream_width, o.stream_height), net, resized, chw.data());
     cv::Mat net_bgr;
@@ -377,8 +406,9 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
 
   // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on.
   cv::setNumThreads(max_threads);
-  for (const int size : o.pipeline ? o.sizes : std::vector<int>{}) {
-    const DarknetModel model = bench_model(size, o);
+  for (const std::string& size_option : o.pipeline ? o.sizes : std::vector<std::string>{}) {
+    const DarknetModel model = bench_model(size_option, o);
+    const std::string size = size_label(model.net.width, model.net.height);
     for (const std::string kind : {"opencl", "cpu"}) {
       for (const bool zoom : {false, true}) {
         PipelineResult r;
@@ -440,14 +470,14 @@ std::string BenchDetectorReport::table() const {
   s << fmt::format("POCL_AFFINITY={}  POCL_MAX_PTHREAD_COUNT={}\n", machine.pocl_affinity,
                    machine.pocl_max_pthread_count);
   s << fmt::format("{} warm-up + {} timed runs per row; ms per frame (batch 1)\n\n", warmup, repetitions);
-  s << fmt::format("{:<11} {:>5} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8}\n", "backend", "size", "threads", "median", "min",
+  s << fmt::format("{:<11} {:>7} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8}\n", "backend", "size", "threads", "median", "min",
                    "max", "GFLOP/s", "vs DNN");
   for (const ForwardResult& r : forward) {
     if (!r.error.empty()) {
-      s << fmt::format("{:<11} {:>5} {:>7}  error: {}\n", r.backend, r.size, r.threads, r.error);
+      s << fmt::format("{:<11} {:>7} {:>7}  error: {}\n", r.backend, r.size, r.threads, r.error);
       continue;
     }
-    s << fmt::format("{:<11} {:>5} {:>6}{} {:>9.2f} {:>9.2f} {:>9.2f} {:>8.2f} {:>7.2f}x\n", r.backend, r.size,
+    s << fmt::format("{:<11} {:>7} {:>6}{} {:>9.2f} {:>9.2f} {:>9.2f} {:>8.2f} {:>7.2f}x\n", r.backend, r.size,
                      r.threads, r.backend == "opencl" ? "*" : " ", r.ms.median, r.ms.min, r.ms.max, r.gflop_per_s,
                      r.speedup_vs_dnn);
   }
@@ -457,11 +487,12 @@ std::string BenchDetectorReport::table() const {
        "  GFLOP/s = DarknetModel::flops() (convolutions) / median. Rows take turns: one forward each per round.\n\n";
   if (!layers.empty()) {
     s << "OpenCL per layer: device time of each command (OpenCL profiling events), medians of the profiled runs\n";
-    s << fmt::format("{:>5} {:>9} {:>9} {:>8} {:>7}  {}\n", "size", "median", "min", "GFLOP/s", "share", "command");
-    int last_size = 0;
+    s << fmt::format("{:>7} {:>9} {:>9} {:>8} {:>7}  {}\n", "size", "median", "min", "GFLOP/s", "share", "command");
+    std::string last_size;
     double sum = 0;
     auto total_line = [&] {
-      if (last_size) s << fmt::format("{:>5} {:>9.3f} {:>9} {:>8} {:>7}  sum of medians\n", last_size, sum, "", "", "");
+      if (!last_size.empty())
+        s << fmt::format("{:>7} {:>9.3f} {:>9} {:>8} {:>7}  sum of medians\n", last_size, sum, "", "", "");
     };
     for (const LayerResult& l : layers) {
       if (l.size != last_size) {
@@ -470,7 +501,7 @@ std::string BenchDetectorReport::table() const {
         sum = 0;
       }
       sum += l.ms.median;
-      s << fmt::format("{:>5} {:>9.3f} {:>9.3f} {:>8.1f} {:>6.1f}%  {}\n", l.size, l.ms.median, l.ms.min, l.gflop_per_s,
+      s << fmt::format("{:>7} {:>9.3f} {:>9.3f} {:>8.1f} {:>6.1f}%  {}\n", l.size, l.ms.median, l.ms.min, l.gflop_per_s,
                        100.0 * l.share, l.what);
     }
     total_line();
@@ -479,16 +510,16 @@ std::string BenchDetectorReport::table() const {
   if (pipeline.empty()) return s.str();
   s << fmt::format("pipeline: DetectionPipeline::detect() on a synthetic {}x{} BGR stream (default options)\n",
                    stream_width, stream_height);
-  s << fmt::format("{:<8} {:>5} {:>7} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend", "size",
+  s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend", "size",
                    "threads", "zoom", "median", "min", "max", "fps", "forwards", "images", "boxes", "not-fwd %");
   for (const PipelineResult& r : pipeline) {
     if (!r.error.empty()) {
-      s << fmt::format("{:<8} {:>5} {:>7} {:>5}  error: {}\n", r.backend, r.size, r.threads, r.zoom_in ? "on" : "off",
+      s << fmt::format("{:<8} {:>7} {:>7} {:>5}  error: {}\n", r.backend, r.size, r.threads, r.zoom_in ? "on" : "off",
                        r.error);
       continue;
     }
     s << fmt::format(
-        "{:<8} {:>5} {:>7} {:>5} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} {:>9.1f}%\n", r.backend,
+        "{:<8} {:>7} {:>7} {:>5} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} {:>9.1f}%\n", r.backend,
         r.size, r.threads, r.zoom_in ? "on" : "off", r.ms.median, r.ms.min, r.ms.max, r.frames_per_s,
         r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, 100.0 * r.non_forward_share);
   }
@@ -515,7 +546,7 @@ std::string BenchDetectorReport::json() const {
       << fmt::format(
              "{{\"backend\": {}, \"device\": {}, \"size\": {}, \"threads\": {}, \"threads_note\": {}, "
              "\"ms\": {}, \"gflop_per_s\": {:.4f}, \"speedup_vs_dnn\": {:.4f}, \"error\": {}}}",
-             json_string(r.backend), json_string(r.device), r.size, r.threads, json_string(r.threads_note),
+             json_string(r.backend), json_string(r.device), json_string(r.size), r.threads, json_string(r.threads_note),
              json_timing(r.ms), r.gflop_per_s, r.speedup_vs_dnn, json_string(r.error));
   }
   s << "],\n \"layers\": [";
@@ -524,7 +555,7 @@ std::string BenchDetectorReport::json() const {
     s << (i ? ",\n  " : "\n  ")
       << fmt::format(
              "{{\"size\": {}, \"layer\": {}, \"what\": {}, \"ms\": {}, \"gflop_per_s\": {:.4f}, \"share\": {:.4f}}}",
-             l.size, l.layer, json_string(l.what), json_timing(l.ms), l.gflop_per_s, l.share);
+             json_string(l.size), l.layer, json_string(l.what), json_timing(l.ms), l.gflop_per_s, l.share);
   }
   s << "],\n \"pipeline\": [";
   for (size_t i = 0; i < pipeline.size(); ++i) {
@@ -534,8 +565,8 @@ std::string BenchDetectorReport::json() const {
              "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"ms\": {}, "
              "\"frames_per_s\": {:.4f}, \"forwards_per_frame\": {:.4f}, \"images_per_frame\": {:.4f}, "
              "\"detections_per_frame\": {:.4f}, \"non_forward_share\": {:.4f}, \"error\": {}}}",
-             json_string(r.backend), r.size, r.threads, r.zoom_in ? "true" : "false", json_timing(r.ms), r.frames_per_s,
-             r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, r.non_forward_share,
+             json_string(r.backend), json_string(r.size), r.threads, r.zoom_in ? "true" : "false", json_timing(r.ms),
+             r.frames_per_s, r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, r.non_forward_share,
              json_string(r.error));
   }
   s << "]}\n";

@@ -114,9 +114,10 @@ DatasetFromLogSummary run_dataset_from_log(const DatasetFromLogRequest& request,
       const fs::path image_path = out / "images" / request.split / (name + "." + request.image_format);
       const fs::path label_path = out / "labels" / request.split / (name + ".txt");
       if (fs::exists(image_path) || fs::exists(label_path))
-        throw std::runtime_error(fmt::format("{}: already exists (a log of the same name was added before); "
-                                             "rename the log or choose a new --out",
-                                             image_path.string()));
+        throw std::runtime_error(
+            fmt::format("{}: already exists (a log of the same name was added before); "
+                        "rename the log or choose a new --out",
+                        image_path.string()));
       if (!cv::imwrite(image_path.string(), bgr, params))
         throw std::runtime_error(image_path.string() + ": cannot write the image");
       training::write_yolo_labels(label_path.string(), labels);
@@ -179,9 +180,9 @@ DatasetFromLogSummary run_dataset_from_log(const DatasetFromLogRequest& request,
           log_path, images_seen, request.image_channel, request.truth_channel));
     }
     if (images_seen == 0) {
-      throw std::runtime_error(fmt::format(
-          "{}: no image_t on {}: record the camera images (tools/fly.sh --record-images)", log_path,
-          request.image_channel));
+      throw std::runtime_error(
+          fmt::format("{}: no image_t on {}: record the camera images (tools/fly.sh --record-images)", log_path,
+                      request.image_channel));
     }
     progress << fmt::format("wingman dataset from-log: {}: {} of {} images written", log_path, written_here,
                             images_seen)

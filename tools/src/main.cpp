@@ -154,7 +154,9 @@ int main(int argc, char** argv) {
   auto* bd = be->add_subcommand("detector",
                                 "A network (default: the thesis network) per frame: OpenCL vs CpuBackend vs bare "
                                 "OpenCV DNN, and the whole pipeline");
-  bd->add_option("--sizes", bench_detector.sizes, "Network input sizes, multiples of 32 (default 416,320,256)")
+  bd->add_option(
+        "--sizes", bench_detector.sizes,
+        "Network input sizes: N (N x N) or WxH, multiples of 32, or cfg (the network's own) (default 416,320,256)")
       ->delimiter(',');
   bd->add_option("--threads", bench_detector.threads,
                  "OpenCV thread counts (default 1,2); OpenCL: POCL_MAX_PTHREAD_COUNT")

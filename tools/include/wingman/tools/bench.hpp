@@ -11,7 +11,9 @@ namespace wingman::tools {
 
 /// Options of `wingman bench detector`. A benchmark, not a test: nothing here is asserted.
 struct BenchDetectorOptions {
-  std::vector<int> sizes{416, 320, 256};         ///< network input sizes (square), pixels; each a multiple of 32, >= 32
+  /// Network input sizes: "N" (N x N) or "WxH", pixels, each side a multiple of 32 and >= 32; "cfg" = the
+  /// network's own [net] width x height.
+  std::vector<std::string> sizes{"416", "320", "256"};
   std::vector<int> threads{1, 2};                ///< CPU thread counts for OpenCV (cv::setNumThreads), each >= 1
   int repetitions = 7;                           ///< timed runs per measurement (median/min/max over these), >= 1
   int warmup = 2;                                ///< untimed runs before each measurement, >= 0
@@ -41,7 +43,7 @@ struct TimingMs {
 struct ForwardResult {
   std::string backend;        ///< "opencl", "cpu" (CpuBackend) or "opencv-dnn" (bare cv::dnn)
   std::string device;         ///< backend's own name (OpenCL device) or ""
-  int size = 0;               ///< network input, pixels (square)
+  std::string size;           ///< network input: "416" (square) or "640x352" (width x height)
   int threads = 0;            ///< threads it ran with (OpenCL: the environment's, see `threads_note`)
   std::string threads_note;   ///< how `threads` was set: "cv::setNumThreads" or "POCL_MAX_PTHREAD_COUNT=..."
   TimingMs ms;                ///< per frame
@@ -52,7 +54,7 @@ struct ForwardResult {
 
 /// One command of the OpenCL backend's forward (a layer's kernel, or moving the input or output), batch 1.
 struct LayerResult {
-  int size = 0;            ///< network input, pixels (square)
+  std::string size;        ///< network input: "416" (square) or "640x352" (width x height)
   int layer = -1;          ///< model layer index, -1 for input/output commands
   std::string what;        ///< e.g. "layer 13 [convolutional] (cfg line 123)"
   TimingMs ms;             ///< device time (OpenCL profiling events) per forward
@@ -63,7 +65,7 @@ struct LayerResult {
 /// DetectionPipeline::detect() on the synthetic stream, one backend, zoom-in on or off.
 struct PipelineResult {
   std::string backend;              ///< "opencl" or "cpu"
-  int size = 0;                     ///< network input, pixels (square)
+  std::string size;                 ///< network input: "416" (square) or "640x352" (width x height)
   int threads = 0;                  ///< threads (as in ForwardResult)
   bool zoom_in = false;             ///< DetectorPipelineOptions::zoom_in
   TimingMs ms;                      ///< per frame (one detect() call)

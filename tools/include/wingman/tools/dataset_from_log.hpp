@@ -15,11 +15,11 @@ struct DatasetFromLogRequest {
   std::string out_dir;            ///< dataset folder; created, or extended when it already holds from-log images
   std::string split = "train";    ///< train or val: every image of these logs goes there (neighbouring frames
                                   ///< are near-duplicates, so a flight is never split between train and val)
-  std::string image_channel = "IMAGE_CAM0";   ///< image_t channel
+  std::string image_channel = "IMAGE_CAM0";    ///< image_t channel
   std::string truth_channel = "GROUND_TRUTH";  ///< ground_truth_t channel (boxes of the rendered frames)
-  int every = 1;                 ///< keep every Nth image of each log (>= 1), counted by image
-  double min_box_px = 2.0;       ///< a visible box narrower or lower than this (pixels, after clipping) is dropped
-  bool keep_negatives = true;    ///< write frames without a visible drone too (empty label files)
+  int every = 1;                               ///< keep every Nth image of each log (>= 1), counted by image
+  double min_box_px = 2.0;           ///< a visible box narrower or lower than this (pixels, after clipping) is dropped
+  bool keep_negatives = true;        ///< write frames without a visible drone too (empty label files)
   std::string image_format = "jpg";  ///< jpg or png
   int jpeg_quality = 92;             ///< 1..100
 };
@@ -27,12 +27,12 @@ struct DatasetFromLogRequest {
 /// What a run wrote.
 struct DatasetFromLogSummary {
   std::string out_dir;
-  int images = 0;          ///< images written
-  int boxes = 0;           ///< boxes written over those images
-  int negatives = 0;       ///< of the images, those without a box
-  int skipped = 0;         ///< images passed over by --every, or negatives when keep_negatives is false
-  int unmatched = 0;       ///< images whose ground truth (same image seq) is not in the log
-  int undecodable = 0;     ///< messages on the two channels that did not decode or validate (dropped, counted)
+  int images = 0;       ///< images written
+  int boxes = 0;        ///< boxes written over those images
+  int negatives = 0;    ///< of the images, those without a box
+  int skipped = 0;      ///< images passed over by --every, or negatives when keep_negatives is false
+  int unmatched = 0;    ///< images whose ground truth (same image seq) is not in the log
+  int undecodable = 0;  ///< messages on the two channels that did not decode or validate (dropped, counted)
   double seconds = 0.0;
   /// "wrote 120 images (118 boxes, 2 negatives) to DIR/images/train from 1 log in 12.3 s (480 skipped, 0 unmatched,
   /// 0 undecodable)".

@@ -138,7 +138,8 @@ class DatasetVerbs {
   ~DatasetVerbs();
 
   /// After parsing: runs `dataset synth` or `dataset from-log` when chosen and returns its exit code (0 ok,
-  /// 1 failure, 2 bad config or arguments), or -1 when neither was chosen. The summary goes to `out`, progress and errors to `err`.
+  /// 1 failure, 2 bad config or arguments), or -1 when neither was chosen. The summary goes to `out`, progress and
+  /// errors to `err`.
   int run_if_chosen(std::ostream& out, std::ostream& err);
 
  private:
