@@ -2,27 +2,32 @@
 # SPDX-License-Identifier: MIT
 # Reproduces the shipped detector model (models/wingman-small.weights, card: models/wingman-small.md) on the CPU:
 # imports the Halmstad videos (real, clip-split, tightened boxes, hard negatives), renders the synthetic sets with
-# the simulator, and trains models/wingman-small.cfg on Halmstad + synth with the card's schedule (stage 1), then
-# fine-tunes stage 1's iteration-1000 weights for 400 iterations with the follower's-view set (drones on the
-# horizon) added (stage 2). The shipped weights are stage 2's final ones (OUT/stage2/wingman-small_final.weights).
+# the simulator, and trains models/wingman-small.cfg at 416x416 on Halmstad + synth with the card's schedule
+# (stage 1), then fine-tunes stage 1's iteration-1000 weights for 400 iterations with the follower's-view set
+# (drones on the horizon) added (stage 2), then flies eight training flights through the pipeline, takes their
+# frames with the renderer's boxes, and fine-tunes stage 2 at the cfg's 640x352 with them added (stage 3). The
+# shipped weights are stage 3's final ones (OUT/stage3/wingman-small_final.weights).
 # Resumable: run it again after an interruption and it continues from the last checkpoint (datasets are kept once
 # complete; a finished stage is not trained again).
 #
 # Usage: tools/train_model.sh [--data DIR] [--out DIR] [--threads N] [--max-batches N] [--stage2-batches N]
+#                             [--stage3-batches N]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
-#   --out             training output: checkpoint.pt, progress.csv, *.weights; stage 2's in OUT/stage2
+#   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 and 3 in OUT/stage2, OUT/stage3
 #                     (default build/train-wingman-small)
 #   --threads         libtorch threads (default 2)
 #   --max-batches     stage 1 iterations (default 1500; the schedule scales with it)
 #   --stage2-batches  stage 2 iterations (default 400, the shipped model's; 0 = stage 1 only). Stage 2 starts from
 #                     stage 1's iteration-1000 weights (or its final ones when it is shorter)
-# Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON.
+#   --stage3-batches  stage 3 iterations (default 400, the shipped model's; 0 = stop after stage 2)
+# Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
+# flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
-stage3_batches=240
+stage3_batches=400
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -31,7 +36,7 @@ while [ $# -gt 0 ]; do
     --max-batches) max_batches="$2"; shift 2 ;;
     --stage2-batches) stage2_batches="$2"; shift 2 ;;
     --stage3-batches) stage3_batches="$2"; shift 2 ;;
-    -h|--help) sed -n 3,18p "$0"; exit 0 ;;
+    -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

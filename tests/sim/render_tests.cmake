@@ -33,3 +33,5 @@ wingman_add_test(test_sim_dataset_from_log
   LIBS wingman::tools wingman::training_data wingman::test_support opencv_imgcodecs
   LABEL sim
   TIMEOUT 60)
+target_compile_definitions(test_sim_dataset_from_log PRIVATE WINGMAN_EXE="$<TARGET_FILE:wingman>")
+add_dependencies(test_sim_dataset_from_log wingman)

@@ -244,5 +244,26 @@ TEST(DatasetFromLog, ErrorsNameTheLogAndWhatWasExpected) {
   EXPECT_THROW(run_dataset_from_log(r, progress), std::invalid_argument);
 }
 
+TEST(DatasetFromLog, CommandLineWritesTheDatasetAndExitsTwoOnABadArgumentOneOnABadLog) {
+  wingman::testing::TempDir dir;
+  const std::string wingman = WINGMAN_EXE;
+  const std::string log = write_flight(dir);
+  const auto ok = wingman::testing::run(
+      {wingman, "dataset", "from-log", log, "--out", dir.file("ds"), "--every", "2", "--format", "png"});
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("wrote 3 images (3 boxes, 0 negatives)"), std::string::npos) << ok.out;
+  EXPECT_TRUE(fs::exists(dir.file("ds/images/train/flight_0000004.png")));
+  const auto bad_split =
+      wingman::testing::run({wingman, "dataset", "from-log", log, "--out", dir.file("ds2"), "--split", "test"});
+  EXPECT_EQ(bad_split.exit_code, 2);
+  EXPECT_NE(bad_split.err.find("wingman dataset from-log: error: --split 'test': expected train or val"),
+            std::string::npos)
+      << bad_split.err;
+  const auto missing =
+      wingman::testing::run({wingman, "dataset", "from-log", dir.file("none.lcmlog"), "--out", dir.file("ds3")});
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("none.lcmlog: cannot open LCM log for reading"), std::string::npos) << missing.err;
+}
+
 }  // namespace
 }  // namespace wingman::tools

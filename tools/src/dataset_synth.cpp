@@ -20,6 +20,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <stdexcept>
 
@@ -548,42 +549,45 @@ DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
 
 DatasetVerbs::~DatasetVerbs() = default;
 
+namespace {
+
+/// Runs one `dataset` verb: its exit code, 0 when `body` returns; 2 for a bad config or argument
+/// (common::ConfigError, std::invalid_argument), 1 for any other failure, with one error line naming the verb.
+int run_verb(const char* verb, std::ostream& err, const std::function<void()>& body) {
+  try {
+    body();
+    return 0;
+  } catch (const common::ConfigError& e) {
+    err << "wingman dataset " << verb << ": error: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    err << "wingman dataset " << verb << ": error: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::exception& e) {
+    err << "wingman dataset " << verb << ": error: " << e.what() << std::endl;
+    return 1;
+  }
+}
+
+}  // namespace
+
 int DatasetVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   if (*s_->from_log) {
-    try {
+    return run_verb("from-log", err, [&] {
       s_->from_log_request.keep_negatives = !s_->skip_negatives;
-      const DatasetFromLogSummary summary = run_dataset_from_log(s_->from_log_request, err);
-      out << summary.one_line() << std::endl;
-      return 0;
-    } catch (const std::invalid_argument& e) {
-      err << "wingman dataset from-log: error: " << e.what() << std::endl;
-      return 2;
-    } catch (const std::exception& e) {
-      err << "wingman dataset from-log: error: " << e.what() << std::endl;
-      return 1;
-    }
+      out << run_dataset_from_log(s_->from_log_request, err).one_line() << std::endl;
+    });
   }
   if (!*s_->synth) return -1;
-  try {
+  return run_verb("synth", err, [&] {
     if (s_->print_config) {
       DatasetSynthConfig config;
       if (!s_->request.config.empty()) config = common::load_options<DatasetSynthConfig>(s_->request.config);
       out << common::print_options(config, "wingman dataset synth: effective configuration");
-      return 0;
+      return;
     }
-    const DatasetSynthSummary summary = run_dataset_synth(s_->request, err);
-    out << summary.one_line() << std::endl;
-    return 0;
-  } catch (const common::ConfigError& e) {
-    err << "wingman dataset synth: error: " << e.what() << std::endl;
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    err << "wingman dataset synth: error: " << e.what() << std::endl;
-    return 2;
-  } catch (const std::exception& e) {
-    err << "wingman dataset synth: error: " << e.what() << std::endl;
-    return 1;
-  }
+    out << run_dataset_synth(s_->request, err).one_line() << std::endl;
+  });
 }
 
 }  // namespace wingman::tools
