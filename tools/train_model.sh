@@ -115,10 +115,13 @@ nc: 1
 names: [drone]
 EOF
 # Stages 1 and 2 train the network at 416x416 (the .cfg with that input size); stage 3 at the .cfg's own 640x352.
-sed 's/^width=.*/width=416/; s/^height=.*/height=416/' "$src/models/wingman-small.cfg" > "$out/wingman-small-416.cfg"
+# The copy keeps the name wingman-small.cfg (the trainer names its files after the cfg: wingman-small_*.weights) in
+# a folder of its own (the trainer copies its cfg into OUT).
+mkdir -p "$out/cfg-416"
+sed 's/^width=.*/width=416/; s/^height=.*/height=416/' "$src/models/wingman-small.cfg" > "$out/cfg-416/wingman-small.cfg"
 augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 --blur 0.1 --noise 0.1
   --checkpoint-interval 25 --log-interval 10 --val-max-images 400)
-common=(--cfg "$out/wingman-small-416.cfg" "${augment[@]}")
+common=(--cfg "$out/cfg-416/wingman-small.cfg" "${augment[@]}")
 common640=(--cfg "$src/models/wingman-small.cfg" "${augment[@]}")
 # 3. Stage 1: Table 2's rate steps, scaled to the run's length; warm-up 100 iterations.
 if [ ! -f "$out/wingman-small_final.weights" ]; then
