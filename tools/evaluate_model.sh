@@ -4,7 +4,8 @@
 # Halmstad val clips (drone clips; airplane, bird and helicopter clips as negatives, false positives per image), on
 # the synthetic val split it was trained beside, on a synthetic 1280x720 set up to 30 m, and on the follower's view
 # of the formation flights (1280x720, 90 deg, the target on the horizon at 4-20 m, never trained on), on the held-out
-# training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size). Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
+# training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size).
+# Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
 #
 # Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there

@@ -67,9 +67,8 @@ std::string cpu_model_name() {
   return "(unknown)";
 }
 
-/// A size option ("416", "640x352" or "cfg") as width x height; {0, 0} for "cfg"; {-1, -1} when malformed.
+/// A size option other than "cfg" ("416" or "640x352") as width x height; {-1, -1} when malformed.
 cv::Size parse_size(const std::string& text) {
-  if (text == "cfg") return {0, 0};
   int w = 0, h = 0;
   char x = 0, extra = 0;
   std::istringstream in(text);
