@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // wingman-detector: camera images in, drone detections out (Algorithm 2 on an OpenCL or CPU backend).
-#include "wingman/detector/detection_pipeline.hpp"
 #include "wingman/detector/detector_options.hpp"
 #include "wingman/detector/model_loader.hpp"
 #include "wingman/detector/preprocess.hpp"
+#include "wingman/detector/sized_detector.hpp"
 
 #include <wingman/common/runtime.hpp>
 #include <wingman/common/sequence_gaps.hpp>
@@ -41,20 +41,32 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   rt.status().declare_output(o.output_channel);
   if (o.weights.empty()) return run_without_model(rt, o, limits);
 
-  const detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
-  std::string why;
-  const auto t_backend = std::chrono::steady_clock::now();
+  detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
+  const detector::InputSize input_size = *detector::InputSize::parse(o.input_size);  // validated with the options
   // model.backend = opencl: no usable OpenCL device, or a kernel that fails to build, throws here (exit 1, one line).
-  auto backend = detector::make_backend(o.backend, model, o.opencl, o.opencl.max_batch, &why);
-  const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
-  if (why.find("no usable OpenCL device") != std::string::npos) {
-    spdlog::warn("{}; running on the CPU (chosen in {:.2f} s)", why, backend_s);  // auto fell back
-  } else {
-    spdlog::info("{} (chosen in {:.2f} s)", why, backend_s);
-  }
-  // The heartbeat says which backend runs, and why, for as long as nothing else needs saying.
-  rt.status().set_state(status_t::STATE_OK, why);
-  detector::DetectionPipeline pipeline(o.detection, std::move(backend), model);
+  // The first network is built at start-up (the cfg's size, or model.input_size's WxH); with input_size auto,
+  // frames of another aspect build another one when the first of them arrives.
+  auto make_backend = [&](const detector::DarknetModel& sized) {
+    std::string why;
+    const auto t_backend = std::chrono::steady_clock::now();
+    auto backend = detector::make_backend(o.backend, sized, o.opencl, o.opencl.max_batch, &why);
+    const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
+    const std::string net = fmt::format("network input {}x{}", sized.net.width, sized.net.height);
+    if (why.find("no usable OpenCL device") != std::string::npos) {
+      spdlog::warn("{}; running on the CPU (chosen in {:.2f} s; {})", why, backend_s, net);  // auto fell back
+    } else {
+      spdlog::info("{} (chosen in {:.2f} s; {})", why, backend_s, net);
+    }
+    // The heartbeat says which backend runs, and why, for as long as nothing else needs saying.
+    rt.status().set_state(status_t::STATE_OK, why);
+    return backend;
+  };
+  auto on_build = [&](cv::Size net, cv::Size image) {
+    if (image.empty()) return;  // the start-up build: make_backend said it
+    spdlog::info("model.input_size {}: network input {}x{} for {}x{} images", input_size.to_string(), net.width,
+                 net.height, image.width, image.height);
+  };
+  detector::SizedDetector pipeline(o.detection, std::move(model), input_size, make_backend, on_build);
 
   auto detect_and_publish = [&](const image_t& img) {
     std::string error;

@@ -2,6 +2,8 @@
 // Validation of DetectorOptions.
 #include "wingman/detector/detector_options.hpp"
 
+#include "wingman/detector/input_size.hpp"
+
 #include <wingman/common/config.hpp>
 
 namespace wingman::detector {
@@ -16,6 +18,8 @@ std::vector<std::string> DetectorOptions::validate() const {
   if (mode != "realtime" && mode != "replay") p.push_back(problem("input.mode", mode, "must be realtime or replay"));
   if (backend != "auto" && backend != "opencl" && backend != "cpu")
     p.push_back(problem("model.backend", backend, "must be auto, opencl or cpu"));
+  if (!InputSize::parse(input_size))
+    p.push_back(problem("model.input_size", input_size, "expected auto, cfg or WxH (multiples of 32, 32..4096)"));
   if (cfg.empty())
     p.push_back(problem("model.cfg", cfg, "must be a .cfg path, builtin:wingman-small or builtin:tiny-yolo-thesis"));
   for (const auto& part : {detection.validate(), opencl.validate()}) p.insert(p.end(), part.begin(), part.end());

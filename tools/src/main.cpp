@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
   pr->add_option("--weights", predict.weights,
                  "Darknet .weights, or builtin:wingman-small (default: the shipped model, models/wingman-small.md)");
   pr->add_option("--backend", predict.backend, "Inference backend: auto (default), opencl or cpu");
+  pr->add_option("--input-size", predict.input_size,
+                 "Network input: auto (default: the cfg's longer side, the other fitted to each image's aspect), cfg "
+                 "or WxH");
   pr->add_option("--out", predict.out_dir, "Output folder for <stem>.txt (default predictions)");
   pr->add_flag("--draw", predict.draw, "Also write <stem>.pred.jpg with the boxes drawn");
   pr->add_option("--p-thresh", predict.detection.p_thresh, "Confidence threshold (default 0.2)");

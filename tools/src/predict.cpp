@@ -5,7 +5,9 @@
 #include <fmt/format.h>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
+#include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
+#include <wingman/detector/sized_detector.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -13,6 +15,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 
 namespace wingman::tools {
@@ -45,6 +48,12 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
     err << prefix << fmt::format("--backend = '{}': must be auto, opencl or cpu", options.backend) << "\n";
     return 2;
   }
+  std::string size_error;
+  const std::optional<detector::InputSize> input_size = detector::InputSize::parse(options.input_size, &size_error);
+  if (!input_size) {
+    err << prefix << "--input-size = " << size_error << "\n";
+    return 2;
+  }
   std::vector<fs::path> images;
   for (const std::string& in : options.inputs) {
     std::error_code ec;
@@ -66,14 +75,17 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
     return 2;
   }
 
-  std::unique_ptr<detector::DetectionPipeline> pipeline;
+  std::unique_ptr<detector::SizedDetector> pipeline;
   try {
-    const detector::DarknetModel model = detector::load_model(options.cfg, options.weights);
     const int batch = options.detection.zoom_in ? std::min(8, options.detection.max_detections) : 1;
-    std::string why;
-    auto backend = detector::make_backend(options.backend, model, detector::OpenClOptions{}, batch, &why);
-    err << "wingman predict: " << why << "\n";
-    pipeline = std::make_unique<detector::DetectionPipeline>(options.detection, std::move(backend), model);
+    auto make_backend = [&](const detector::DarknetModel& sized) {
+      std::string why;
+      auto backend = detector::make_backend(options.backend, sized, detector::OpenClOptions{}, batch, &why);
+      err << fmt::format("wingman predict: {} (network input {}x{})", why, sized.net.width, sized.net.height) << "\n";
+      return backend;
+    };
+    pipeline = std::make_unique<detector::SizedDetector>(
+        options.detection, detector::load_model(options.cfg, options.weights), *input_size, make_backend);
     fs::create_directories(options.out_dir);
   } catch (const std::exception& e) {
     err << prefix << e.what() << "\n";
@@ -88,7 +100,14 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
       ++failures;
       continue;
     }
-    const std::vector<detector::Box> boxes = pipeline->detect(bgr);
+    std::vector<detector::Box> boxes;
+    try {
+      boxes = pipeline->detect(bgr);  // a new image aspect may build a network first (input size auto)
+    } catch (const std::exception& e) {
+      err << prefix << fmt::format("{}: {}", path.string(), e.what()) << "\n";
+      ++failures;
+      continue;
+    }
     const fs::path txt = fs::path(options.out_dir) / (path.stem().string() + ".txt");
     std::ofstream f(txt);
     const double W = bgr.cols, H = bgr.rows;

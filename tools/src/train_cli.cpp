@@ -163,6 +163,9 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                 "Darknet .weights or builtin:wingman-small (the shipped model): run the detector (Algorithm 2)");
   v->add_option("--cfg", vo.cfg, "Darknet .cfg, or builtin:wingman-small (default) or builtin:tiny-yolo-thesis");
   v->add_option("--backend", vo.backend, "Detector backend: cpu (default), opencl or auto");
+  v->add_option("--input-size", vo.input_size,
+                "Network input: auto (default: the cfg's longer side, the other fitted to each image's aspect), cfg "
+                "or WxH");
   v->add_option("--predictions", vo.predictions, "Instead of --weights: folder of `wingman predict` <stem>.txt files");
   v->add_option("--conf", vo.metrics.conf_thresh,
                 "Operating confidence for precision / recall / mean IoU (default 0.2)");

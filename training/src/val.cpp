@@ -4,7 +4,9 @@
 
 #include "wingman/training/yolo_dataset.hpp"
 
+#include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
+#include <wingman/detector/sized_detector.hpp>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -32,6 +34,7 @@ std::vector<std::string> ValOptions::validate() const {
     p.push_back("weights / predictions: give exactly one (run the detector, or read saved predictions)");
   if (backend != "auto" && backend != "opencl" && backend != "cpu")
     p.push_back(fmt::format("backend = '{}': must be auto, opencl or cpu", backend));
+  if (std::string why; !detector::InputSize::parse(input_size, &why)) p.push_back("input_size = " + why);
   if (class_id < 0) p.push_back(fmt::format("class_id = {}: must be >= 0", class_id));
   if (max_images < 0) p.push_back(fmt::format("max_images = {}: must be >= 0", max_images));
   for (const auto& s : detection.validate()) p.push_back(s);
@@ -51,14 +54,17 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
   const std::vector<size_t> chosen = evenly_spaced(ds.images.size(), static_cast<size_t>(o.max_images));
   const size_t n = chosen.size();
 
-  std::unique_ptr<detector::DetectionPipeline> pipeline;
+  std::unique_ptr<detector::SizedDetector> pipeline;
   std::map<std::string, std::string> stems;  // predictions mode: stem -> image, to refuse ambiguous stems
   if (!o.weights.empty()) {
-    const detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
-    std::string why;
-    auto backend = detector::make_backend(o.backend, model, detector::OpenClOptions{}, 1, &why);
-    if (log) log(why);
-    pipeline = std::make_unique<detector::DetectionPipeline>(o.detection, std::move(backend), model);
+    auto make_backend = [&](const detector::DarknetModel& sized) {
+      std::string why;
+      auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why);
+      if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
+      return backend;
+    };
+    pipeline = std::make_unique<detector::SizedDetector>(o.detection, detector::load_model(o.cfg, o.weights),
+                                                         *detector::InputSize::parse(o.input_size), make_backend);
   } else {
     if (!fs::is_directory(o.predictions))
       throw DatasetError(fmt::format("{}: the predictions folder does not exist", o.predictions));

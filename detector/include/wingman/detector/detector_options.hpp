@@ -30,6 +30,11 @@ struct DetectorOptions {
   /// opencl: OpenCL or nothing (no usable device: exit 1 with one line). cpu: OpenCV DNN.
   /// The backend that runs, and why, is the heartbeat's detail.
   std::string backend = "auto";
+  /// Network input size (InputSize::parse): auto (default) keeps the cfg's longer side and fits the other to the
+  /// camera's aspect, rounded to a multiple of 32 (640x352 for 1280x720 frames, 640x512 for 640x512 ones; the
+  /// network is built at the cfg's size at start-up and again on the first frame that needs another); cfg: the
+  /// cfg's [net] size; WxH: that size.
+  std::string input_size = "auto";
   DetectorPipelineOptions detection;
   OpenClOptions opencl;
 
@@ -47,6 +52,9 @@ struct DetectorOptions {
     v("model.backend", backend,
       "auto (OpenCL GPU if any, else the faster of opencl/cpu here; no usable OpenCL device: cpu, with a warning), "
       "opencl (no usable OpenCL device: exit 1) or cpu");
+    v("model.input_size", input_size,
+      "network input: auto (the cfg's longer side, the other fitted to the images' aspect, a multiple of 32), cfg "
+      "(the cfg's size) or WxH (multiples of 32)");
     detection.visit(v);
     opencl.visit(v);
   }

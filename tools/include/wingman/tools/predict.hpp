@@ -17,6 +17,8 @@ struct PredictOptions {
   std::string weights =
       "builtin:wingman-small";                  ///< Darknet .weights path or builtin:wingman-small (the shipped model)
   std::string backend = "auto";                 ///< inference backend: auto, opencl or cpu (OpenCV DNN)
+  /// Network input size (detector::InputSize::parse): auto fits the cfg's size to each image's aspect; cfg; WxH.
+  std::string input_size = "auto";
   std::string out_dir = "predictions";          ///< folder for <stem>.txt (and <stem>.pred.jpg with draw)
   bool draw = false;                            ///< also write each image with its boxes drawn
   detector::DetectorPipelineOptions detection;  ///< p_thresh, o_thresh, subsquare, zoom_in, policy, ...

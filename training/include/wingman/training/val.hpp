@@ -20,6 +20,9 @@ struct ValOptions {
   std::string weights;          ///< run the detector with these .weights (exactly one of weights / predictions)
   std::string predictions;      ///< or read `wingman predict` output: <predictions>/<image stem>.txt per image
   std::string backend = "cpu";  ///< detector backend: auto, opencl or cpu
+  /// Network input size, as the detector's model.input_size (detector::InputSize::parse): auto fits the cfg's size
+  /// to each image's aspect (640x512 for Halmstad's 640x512 frames), cfg keeps the cfg's, WxH is that size.
+  std::string input_size = "auto";
   int class_id = 0;             ///< the class evaluated (truths of other classes are ignored), >= 0
   int max_images = 0;           ///< evaluate at most this many images, spread evenly over the split (0 = all), >= 0
   /// The detector's Algorithm 2 settings. p_thresh is low (0.005) so that the PR curve and AP see nearly every
@@ -35,8 +38,8 @@ struct ValOptions {
 
 /// Evaluates one split: for each image (sorted by path), its truths (class class_id, in pixels) and the
 /// detector's boxes (or the prediction file's, scaled to pixels), then evaluate_detections().
-/// `progress(done, total)` (may be empty) is called after each image; `log` (may be empty) gets one line
-/// on which backend runs. Throws std::invalid_argument listing invalid options; DatasetError naming the file
+/// `progress(done, total)` (may be empty) is called after each image; `log` (may be empty) gets one line per
+/// network built (which backend, at which input size). Throws std::invalid_argument listing invalid options; DatasetError naming the file
 /// for bad labels, a missing or bad prediction file, an unreadable image, or two images with the same stem in
 /// predictions mode; std::runtime_error from loading the model.
 DetectionMetrics run_val(const ValOptions& options, const std::function<void(size_t, size_t)>& progress = {},
