@@ -5,6 +5,8 @@
 # the synthetic val split it was trained beside, on a synthetic 1280x720 set up to 30 m, and on the follower's view
 # of the formation flights (1280x720, 90 deg, the target on the horizon at 4-20 m, never trained on), on the held-out
 # training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size).
+# wingman val runs the detector at its default input size (model.input_size auto: the cfg's 640 columns, the rows
+# fitted to each set's aspect, 640x512 for the Halmstad frames).
 # Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
 #
 # Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]

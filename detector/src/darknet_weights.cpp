@@ -60,8 +60,16 @@ int64_t darknet_weights_header_bytes(const DarknetModel& model) {
   return 12 + (seen_is_64bit(model.major, model.minor) ? 8 : 4);
 }
 
-void load_darknet_weights_from_buffer(DarknetModel& model, const std::vector<char>& bytes,
-                                      const std::string& source_name) {
+namespace {
+
+/// Floats of [convolutional] layer `l`'s parameters in a .weights file.
+int64_t layer_floats(const Layer& l) {
+  return int64_t{l.filters} * (l.batch_normalize ? 4 : 1) + int64_t{l.filters} * l.input.c * l.size * l.size;
+}
+
+/// The reader behind both loaders: with `prefix`, the file may end after any whole [convolutional] layer.
+/// Returns the [convolutional] layers read.
+int load_layers(DarknetModel& model, const std::vector<char>& bytes, const std::string& source_name, bool prefix) {
   if (bytes.size() < 12)
     throw DarknetFormatError(
         fmt::format("{}: {} bytes is too short for a .weights header (16 or 20 bytes)", source_name, bytes.size()));
@@ -72,19 +80,40 @@ void load_darknet_weights_from_buffer(DarknetModel& model, const std::vector<cha
   const size_t header = 12 + (seen_is_64bit(major, minor) ? 8 : 4);
   const int64_t count = model.weight_count();
   const int64_t expected = static_cast<int64_t>(header) + 4 * count;
-  if (static_cast<int64_t>(bytes.size()) != expected)
+  const int64_t size = static_cast<int64_t>(bytes.size());
+  // With a prefix: the layers whose parameters the file holds completely, and where they end.
+  int layers = 0;
+  int64_t end = static_cast<int64_t>(header);
+  int total_layers = 0;
+  for (const Layer& l : model.layers) {
+    if (l.type != LayerType::kConvolutional) continue;
+    ++total_layers;
+    if (end + 4 * layer_floats(l) <= size && layers + 1 == total_layers) {
+      end += 4 * layer_floats(l);
+      ++layers;
+    }
+  }
+  if (!prefix && size != expected)
     throw DarknetFormatError(fmt::format(
         "{}: wrong .weights length for {}: expected {} bytes ({}-byte header (version {}.{}.{}) + {} float32 "
         "values), got {} bytes",
-        source_name, model.cfg_path, expected, header, major, minor, revision, count, bytes.size()));
+        source_name, model.cfg_path, expected, header, major, minor, revision, count, size));
+  if (prefix && (size < static_cast<int64_t>(header) || size != end || layers == 0))
+    throw DarknetFormatError(fmt::format(
+        "{}: {} bytes is not a {}-byte header (version {}.{}.{}) plus the first 1..{} [convolutional] layers of {} "
+        "(the first {} fit in {} bytes; a file of the whole network has {})",
+        source_name, size, header, major, minor, revision, total_layers, model.cfg_path, layers, end, expected));
   const uint64_t seen = seen_is_64bit(major, minor) ? get<uint64_t>(bytes, pos) : get<uint32_t>(bytes, pos);
   auto read = [&](std::vector<float>& v, int64_t n) {
     v.resize(static_cast<size_t>(n));
     std::memcpy(v.data(), bytes.data() + pos, static_cast<size_t>(n) * 4);
     pos += static_cast<size_t>(n) * 4;
   };
+  int read_layers = 0;
   for (Layer& l : model.layers) {
     if (l.type != LayerType::kConvolutional) continue;
+    if (read_layers == layers) break;
+    ++read_layers;
     read(l.biases, l.filters);
     if (l.batch_normalize) {
       read(l.scales, l.filters);
@@ -101,13 +130,28 @@ void load_darknet_weights_from_buffer(DarknetModel& model, const std::vector<cha
   model.minor = minor;
   model.revision = revision;
   model.seen = seen;
+  return layers;
+}
+
+std::vector<char> read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw DarknetFormatError(fmt::format("{}: cannot open the .weights file", path));
+  return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+void load_darknet_weights_from_buffer(DarknetModel& model, const std::vector<char>& bytes,
+                                      const std::string& source_name) {
+  load_layers(model, bytes, source_name, false);
 }
 
 void load_darknet_weights(DarknetModel& model, const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw DarknetFormatError(fmt::format("{}: cannot open the .weights file", path));
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  load_darknet_weights_from_buffer(model, bytes, path);
+  load_layers(model, read_all(path), path, false);
+}
+
+int load_darknet_weights_prefix(DarknetModel& model, const std::string& path) {
+  return load_layers(model, read_all(path), path, true);
 }
 
 std::vector<char> serialize_darknet_weights(const DarknetModel& model) {

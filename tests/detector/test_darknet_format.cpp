@@ -273,6 +273,75 @@ TEST(DarknetWeights, WrongLengthNamesExpectedAndActualSize) {
   EXPECT_NE(msg.find("got " + std::to_string(expected - 8) + " bytes"), std::string::npos) << msg;
 }
 
+/// A two-layer network and the same with two layers appended (a [maxpool] and a second [convolutional]).
+const char* kBase = "[net]\nwidth=16\nheight=16\n[convolutional]\nbatch_normalize=1\nfilters=4\nsize=3\n"
+                    "[convolutional]\nfilters=6\nsize=1\n";
+const char* kExtension = "[maxpool]\nsize=2\nstride=2\n[convolutional]\nbatch_normalize=1\nfilters=5\nsize=3\n";
+
+void write_bytes(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(DarknetWeights, PrefixLoadsTheLayersAFileHoldsAndLeavesTheRest) {
+  testing::TempDir dir;
+  DarknetModel base = parse_darknet_cfg_string(kBase, "base.cfg");
+  base.seen = 4242;
+  randomize_weights(base, 11);
+  save_darknet_weights(base, dir.file("base.weights"));
+
+  DarknetModel grown = parse_darknet_cfg_string(std::string(kBase) + kExtension, "grown.cfg");
+  randomize_weights(grown, 12);
+  const std::vector<float> appended = grown.layers[3].weights;
+  ASSERT_EQ(load_darknet_weights_prefix(grown, dir.file("base.weights")), 2);
+  EXPECT_EQ(grown.seen, 4242u);
+  EXPECT_EQ(grown.layers[0].weights, base.layers[0].weights);
+  EXPECT_EQ(grown.layers[0].rolling_variance, base.layers[0].rolling_variance);
+  EXPECT_EQ(grown.layers[1].biases, base.layers[1].biases);
+  EXPECT_EQ(grown.layers[1].weights, base.layers[1].weights);
+  EXPECT_EQ(grown.layers[3].weights, appended);  // untouched
+  // The strict reader refuses the same file, and a whole-network file loads completely with the prefix reader.
+  DarknetModel strict = parse_darknet_cfg_string(std::string(kBase) + kExtension, "grown.cfg");
+  EXPECT_NE(message_of([&] { load_darknet_weights(strict, dir.file("base.weights")); }).find("wrong .weights length"),
+            std::string::npos);
+  save_darknet_weights(grown, dir.file("grown.weights"));
+  DarknetModel again = parse_darknet_cfg_string(std::string(kBase) + kExtension, "grown.cfg");
+  EXPECT_EQ(load_darknet_weights_prefix(again, dir.file("grown.weights")), 3);
+  EXPECT_EQ(again.layers[3].weights, appended);
+}
+
+TEST(DarknetWeights, PrefixRefusesPartLayersLongerFilesAndHeadersAlone) {
+  testing::TempDir dir;
+  DarknetModel base = parse_darknet_cfg_string(kBase, "base.cfg");
+  randomize_weights(base, 13);
+  const std::vector<char> whole = serialize_darknet_weights(base);
+  DarknetModel grown = parse_darknet_cfg_string(std::string(kBase) + kExtension, "grown.cfg");
+  // Cut inside layer 1: the error names the file, its size and the layers that fit.
+  std::vector<char> cut(whole.begin(), whole.end() - 8);
+  write_bytes(dir.file("cut.weights"), cut);
+  std::string msg = message_of([&] { load_darknet_weights_prefix(grown, dir.file("cut.weights")); });
+  EXPECT_NE(msg.find("cut.weights: " + std::to_string(cut.size()) + " bytes"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("the first 1 fit in"), std::string::npos) << msg;
+  // A header with no layer.
+  write_bytes(dir.file("header.weights"), std::vector<char>(whole.begin(), whole.begin() + 20));
+  EXPECT_NE(message_of([&] { load_darknet_weights_prefix(grown, dir.file("header.weights")); }).find("header.weights"),
+            std::string::npos);
+  // Longer than the whole network.
+  std::vector<char> longer = serialize_darknet_weights([&] {
+    DarknetModel g = parse_darknet_cfg_string(std::string(kBase) + kExtension, "grown.cfg");
+    randomize_weights(g, 14);
+    return g;
+  }());
+  longer.resize(longer.size() + 4);
+  write_bytes(dir.file("long.weights"), longer);
+  msg = message_of([&] { load_darknet_weights_prefix(grown, dir.file("long.weights")); });
+  EXPECT_NE(msg.find("long.weights"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("the first 3 fit in"), std::string::npos) << msg;
+  EXPECT_NE(message_of([&] { load_darknet_weights_prefix(grown, dir.file("missing.weights")); })
+                .find("missing.weights: cannot open"),
+            std::string::npos);
+}
+
 TEST(DarknetWeights, RandomizeIsDeterministicAndRealistic) {
   DarknetModel a = thesis();
   DarknetModel b = thesis();

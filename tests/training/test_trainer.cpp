@@ -330,6 +330,71 @@ TEST_F(TrainerTest, YoloNetworkLossFallsAndTheExportRunsInTheDetector) {
   expect_detector_runs_export(dir_.file("tiny.cfg"), s.weights);
 }
 
+/// kYoloCfg grown by a third head (a 3x3 convolution and a 1x1 output on the second head's input, one new anchor):
+/// its first convolutional layers are kYoloCfg's, so kYoloCfg's .weights are its partial weights.
+std::string grown_yolo_cfg() {
+  std::string cfg = kYoloCfg;
+  for (size_t at = 0; (at = cfg.find("anchors=6,4, 10,7, 14,9, 20,12", at)) != std::string::npos;)
+    cfg.replace(at, 30, "anchors=6,4, 10,7, 14,9, 20,12, 30,20"), at += 30;
+  for (size_t at = 0; (at = cfg.find("num=4", at)) != std::string::npos;) cfg.replace(at, 5, "num=5");
+  return cfg +
+         "[route]\nlayers=-2\n"
+         "[convolutional]\nbatch_normalize=1\nfilters=8\nsize=3\nstride=1\npad=1\nactivation=leaky\n"
+         "[convolutional]\nsize=1\nstride=1\npad=1\nfilters=6\nactivation=linear\n"
+         "[yolo]\nmask=4\nanchors=6,4, 10,7, 14,9, 20,12, 30,20\nclasses=1\nnum=5\njitter=.1\nignore_thresh=.7\n";
+}
+
+TEST_F(TrainerTest, PartialWeightsLoadTheTrainedLayersAndTheGrownNetworkTrains) {
+  TrainOptions base = options_for(dir_, kYoloCfg, "base");
+  base.max_batches = 2;
+  base.val_split = "";
+  const std::string base_weights = Trainer(base).run().weights;
+  const detector::DarknetModel trained = [&] {
+    detector::DarknetModel m = detector::parse_darknet_cfg_string(kYoloCfg, "base.cfg");
+    detector::load_darknet_weights(m, base_weights);
+    return m;
+  }();
+  int base_convs = 0;
+  for (const auto& l : trained.layers) base_convs += l.type == detector::LayerType::kConvolutional;
+
+  const std::string grown = grown_yolo_cfg();
+  TrainOptions o = options_for(dir_, grown.c_str(), "grown");
+  o.max_batches = 20;
+  o.val_split = "";
+  o.init_weights = base_weights;
+  // Without init_partial the file is the wrong length for the grown network.
+  EXPECT_THROW(Trainer{o}, detector::DarknetFormatError);
+  o.init_partial = true;
+  Trainer t(o);
+  EXPECT_EQ(t.init_layers(), base_convs);
+  t.save_weights(dir_.file("grown0.weights"));
+  detector::DarknetModel start = detector::parse_darknet_cfg(dir_.file("tiny.cfg"));
+  detector::load_darknet_weights(start, dir_.file("grown0.weights"));
+  int conv = 0;
+  for (size_t i = 0; i < start.layers.size(); ++i) {
+    if (start.layers[i].type != detector::LayerType::kConvolutional) continue;
+    if (conv++ < base_convs) {
+      EXPECT_EQ(start.layers[i].weights, trained.layers[i].weights) << "layer " << i;
+      EXPECT_EQ(start.layers[i].biases, trained.layers[i].biases) << "layer " << i;
+    } else {
+      float sum = 0;
+      for (float w : start.layers[i].weights) sum += std::fabs(w);
+      EXPECT_GT(sum, 0.0f) << "appended layer " << i << " starts random, not zero";
+    }
+  }
+  EXPECT_EQ(conv, base_convs + 2);
+  const TrainSummary s = t.run();
+  expect_detector_runs_export(dir_.file("tiny.cfg"), s.weights);  // three heads, in OpenCV DNN as in libtorch
+
+  o.init_weights = "";
+  try {
+    Trainer bad(o);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("init_partial"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(TrainerTest, StoppedAndResumedRunEqualsAnUninterruptedOne) {
   TrainOptions o = options_for(dir_, kRegionCfg, "one_go");
   o.max_batches = 8;

@@ -72,6 +72,7 @@ struct TrainingVerbs::State {
   // train: the .cfg gives the defaults; only options given on the command line override them.
   std::string cfg, data, out_dir = "train-out", init_weights, train_split = "train", val_split = "val";
   bool resume = false;
+  bool partial_weights = false;
   int batch = 0, subdivisions = 0, burn_in = 0, threads = 2, checkpoint_interval = 100, weights_interval = 1000,
       log_interval = 1, val_max_images = 0;
   int64_t max_batches = 0;
@@ -102,6 +103,9 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                 "Output folder: checkpoint.pt, <cfg stem>_{last,final,N}.weights (default train-out)");
   t->add_flag("--resume", s.resume, "Continue from <out>/checkpoint.pt (same cfg, data, seed and batch)");
   t->add_option("--weights", s.init_weights, "Start from these Darknet .weights instead of random weights");
+  t->add_flag("--partial-weights", s.partial_weights,
+              "--weights may hold only the first convolutional layers (a trained network the cfg extends with "
+              "appended layers): those are loaded, the others start random");
   t->add_option("--train-split", s.train_split, "Split to train on (default train)");
   t->add_option("--val-split", s.val_split, "Split to validate on at the end; empty: none (default val)");
   t->add_option("--val-max-images", s.val_max_images, "Validate on at most this many images (default all)");
@@ -259,6 +263,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     o.data = s.data;
     o.out_dir = s.out_dir;
     o.init_weights = s.init_weights;
+    o.init_partial = s.partial_weights;
     o.resume = s.resume;
     o.train_split = s.train_split;
     o.val_split = s.val_split;
@@ -277,6 +282,9 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
           "wingman train: {} training images, batch {} in {} subdivisions, {} iterations from {}; "
           "Ctrl-C writes a checkpoint and stops\n",
           trainer.train_images(), o.batch, o.subdivisions, o.max_batches, trainer.iteration());
+      if (o.init_partial && !o.resume)
+        err << fmt::format("wingman train: the first {} convolutional layers from {}; the others start random\n",
+                           trainer.init_layers(), o.init_weights);
       const std::string log_path = (std::filesystem::path(o.out_dir) / "progress.csv").string();
       const bool fresh = !std::filesystem::exists(log_path);
       std::ofstream log(log_path, std::ios::app);

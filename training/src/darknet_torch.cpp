@@ -163,11 +163,13 @@ std::vector<torch::Tensor> DarknetNetImpl::forward(const torch::Tensor& input) {
   return heads;
 }
 
-void DarknetNetImpl::load_weights(const detector::DarknetModel& model) {
+void DarknetNetImpl::load_weights(const detector::DarknetModel& model, int conv_layers) {
   check_same_layers(model_, model);
+  int copied = 0;
   for (size_t i = 0; i < model.layers.size(); ++i) {
     const Layer& l = model.layers[i];
     if (l.type != LayerType::kConvolutional) continue;
+    if (conv_layers >= 0 && copied++ >= conv_layers) break;
     const std::string w = where(model, i);
     copy_into(convs_[i]->weight, l.weights, w + " weights");
     if (l.batch_normalize) {

@@ -17,6 +17,8 @@ std::vector<std::string> TrainOptions::validate() const {
   if (data.empty()) p.push_back("data is empty: a data.yaml or YOLO-layout folder is required");
   if (train_split.empty()) p.push_back("train_split is empty");
   if (out_dir.empty()) p.push_back("out_dir is empty");
+  if (init_partial && init_weights.empty())
+    p.push_back("init_partial is set without init_weights: partial weights need a .weights file");
   if (batch < 1) p.push_back(fmt::format("batch = {}: must be >= 1", batch));
   if (subdivisions < 1 || (batch >= 1 && batch % subdivisions != 0))
     p.push_back(fmt::format("subdivisions = {}: must be >= 1 and divide batch = {}", subdivisions, batch));

@@ -97,6 +97,7 @@ struct Trainer::Impl {
   YoloDataset train;
   YoloDataset val;  // the val_split, read at construction (empty without one)
   DarknetNet net{nullptr};
+  int init_layers = 0;  // [convolutional] layers taken from o.init_weights
   std::unique_ptr<torch::optim::SGD> optimizer;
   int64_t iteration = 0;
   double loss_avg = -1.0;
@@ -270,8 +271,16 @@ Trainer::Trainer(TrainOptions options) : impl_(std::make_unique<Impl>()) {
   s.net = DarknetNet(s.model);
   if (!s.o.init_weights.empty()) {
     detector::DarknetModel m = s.model;
-    detector::load_darknet_weights(m, s.o.init_weights);
-    s.net->load_weights(m);
+    if (s.o.init_partial) {
+      s.init_layers = detector::load_darknet_weights_prefix(m, s.o.init_weights);
+      s.net->load_weights(m, s.init_layers);
+    } else {
+      detector::load_darknet_weights(m, s.o.init_weights);
+      s.net->load_weights(m);
+      s.init_layers = static_cast<int>(std::count_if(m.layers.begin(), m.layers.end(), [](const auto& l) {
+        return l.type == LayerType::kConvolutional;
+      }));
+    }
   }
   std::vector<torch::optim::OptimizerParamGroup> groups;
   groups.emplace_back(s.net->kernel_parameters(),
@@ -293,6 +302,7 @@ Trainer::~Trainer() = default;
 int64_t Trainer::iteration() const { return impl_->iteration; }
 const TrainOptions& Trainer::options() const { return impl_->o; }
 size_t Trainer::train_images() const { return impl_->train.images.size(); }
+int Trainer::init_layers() const { return impl_->init_layers; }
 void Trainer::save_weights(const std::string& path) const { impl_->save_weights(path); }
 
 TrainSummary Trainer::run(const std::function<void(const TrainProgress&)>& progress, const std::atomic<bool>* stop) {

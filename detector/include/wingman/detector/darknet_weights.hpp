@@ -26,6 +26,13 @@ void load_darknet_weights(DarknetModel& model, const std::string& path);
 void load_darknet_weights_from_buffer(DarknetModel& model, const std::vector<char>& bytes,
                                       const std::string& source_name);
 
+/// Like load_darknet_weights, for a file that holds the first [convolutional] layers of `model` only: the .weights of
+/// a network that `model` extends with layers appended to its .cfg (Darknet's partial weights, e.g. a stride-32 head
+/// added to a trained two-head network). The file must end after a whole layer (at least one); the layers it holds
+/// are loaded, the others are left as they are. A whole-network file loads completely. Returns the number of
+/// [convolutional] layers loaded. Throws DarknetFormatError naming the file, its size and how many layers fit.
+int load_darknet_weights_prefix(DarknetModel& model, const std::string& path);
+
 /// The .weights bytes of `model` (header from model.major/minor/revision/seen).
 /// Throws DarknetFormatError if a convolutional layer's weight vectors do not have their .cfg sizes
 /// (e.g. weights were never loaded or randomized).

@@ -53,9 +53,10 @@ class DarknetNetImpl : public torch::nn::Module {
   std::vector<torch::Tensor> forward(const torch::Tensor& input);
 
   /// Copies the weights of `model`'s convolutional layers (loaded with detector::load_darknet_weights or
-  /// randomized) into the module. Throws std::invalid_argument naming the layer when a weight vector does
-  /// not have its .cfg size or the model's layers differ from the ones this module was built from.
-  void load_weights(const detector::DarknetModel& model);
+  /// randomized) into the module; with `conv_layers` >= 0 only the first that many (the rest keep theirs: a
+  /// detector::load_darknet_weights_prefix file). Throws std::invalid_argument naming the layer when a weight vector
+  /// does not have its .cfg size or the model's layers differ from the ones this module was built from.
+  void load_weights(const detector::DarknetModel& model, int conv_layers = -1);
 
   /// Writes the module's weights into `model`'s convolutional layers (biases or beta, gamma, rolling mean,
   /// rolling variance, OIHW weights), ready for detector::save_darknet_weights. `model` must have the

@@ -22,6 +22,9 @@ struct TrainOptions {
   std::string val_split = "val";      ///< split to validate on at the end ("" = none)
   std::string out_dir = "train-out";  ///< checkpoint, .weights and the .cfg copy go here
   std::string init_weights;           ///< start from these Darknet .weights ("" = random initialisation)
+  /// init_weights may hold the first [convolutional] layers only (detector::load_darknet_weights_prefix: a trained
+  /// network that the .cfg extends with appended layers); the others keep their seeded random weights.
+  bool init_partial = false;
   bool resume = false;                ///< continue from out_dir/checkpoint.pt (an error if there is none)
 
   int batch = 64;        ///< [net] batch: images per iteration (per weight update), >= 1

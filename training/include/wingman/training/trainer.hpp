@@ -93,6 +93,9 @@ class Trainer {
   const TrainOptions& options() const;
   /// Images in the training split.
   size_t train_images() const;
+  /// [convolutional] layers taken from init_weights: all of the network's, or with init_partial the first this many;
+  /// 0 without init_weights.
+  int init_layers() const;
 
  private:
   struct Impl;
