@@ -11,7 +11,8 @@
 // solution (the tangency point c - r n projects to (u_l, s)); a few iterations converge.
 //
 // Covariance. The measured quantities are the four edges e = (u_l, u_r, v_t, v_b). The noise model is
-//   S = sigma_e^2 I_4 + sigma_c^2 blockdiag([1 1; 1 1], [1 1; 1 1])
+//   S = diag(s_u^2, s_u^2, s_v^2, s_v^2) + sigma_c^2 blockdiag([1 1; 1 1], [1 1; 1 1]),
+//   s_u^2 = sigma_e^2 + (rel w)^2, s_v^2 = sigma_e^2 + (rel h)^2 (noise.edge_px, noise.edge_rel; w, h the box's size)
 // (independent edge noise plus a common shift of the whole box per axis), propagated to first order:
 //   cov_p = J S J^T,  J = dp/de  (central differences, +-0.05 px).
 // For the exact method the tangency coordinates s are held fixed while differentiating: the constraint
@@ -45,6 +46,8 @@ std::vector<std::string> SphereLocalizerOptions::validate() const {
     p.push_back(problem("range.max_m", max_range_m, fmt::format("must be finite and > range.min_m = {}", min_range_m)));
   if (!(std::isfinite(edge_noise_px) && edge_noise_px > 0))
     p.push_back(problem("noise.edge_px", edge_noise_px, "must be > 0"));
+  if (!(std::isfinite(edge_noise_rel) && edge_noise_rel >= 0))
+    p.push_back(problem("noise.edge_rel", edge_noise_rel, "must be >= 0"));
   if (!(std::isfinite(centre_noise_px) && centre_noise_px >= 0))
     p.push_back(problem("noise.centre_px", centre_noise_px, "must be >= 0"));
   if (!(std::isfinite(border_margin_px) && border_margin_px >= 0))
@@ -312,8 +315,11 @@ LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, cons
     J.col(i) =
         (perturbed_position(i, kJacobianStepPx) - perturbed_position(i, -kJacobianStepPx)) / (2 * kJacobianStepPx);
   const double se2 = options.edge_noise_px * options.edge_noise_px;
+  const double rel_u = options.edge_noise_rel * (edges.e[kRight] - edges.e[kLeft]);
+  const double rel_v = options.edge_noise_rel * (edges.e[kBottom] - edges.e[kTop]);
   const double sc2 = options.centre_noise_px * options.centre_noise_px;
-  Eigen::Matrix4d S = se2 * Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d S = Eigen::Vector4d(se2 + rel_u * rel_u, se2 + rel_u * rel_u, se2 + rel_v * rel_v, se2 + rel_v * rel_v)
+                          .asDiagonal();
   S.block<2, 2>(0, 0).array() += sc2;
   S.block<2, 2>(2, 2).array() += sc2;
   out.cov_p_in_cam = J * S * J.transpose();

@@ -386,6 +386,60 @@ TEST(SphereLocalizerCovariance, MatchesMonteCarloWithin10PercentInEveryEigenvalu
   }
 }
 
+TEST(SphereLocalizerCovariance, RelativeEdgeNoiseMatchesMonteCarlo) {
+  // noise.edge_rel: each edge's standard deviation grows with the box's size, sqrt(edge_px^2 + (rel w)^2) for the
+  // left and right edges (h for top and bottom). 4000 samples, fixed seed, 10 % as above.
+  std::mt19937 rng(777);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const auto cameras = test_cameras();
+  const CameraModel& camera = cameras[0].camera;
+  SphereLocalizerOptions o = options_for("exact");
+  o.edge_noise_px = 0.5;
+  o.edge_noise_rel = 0.04;
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(1.0, 0.5, 8)}) {
+    const PixelBox box = project_sphere(camera, p, kRadius).pixel_box();
+    const LocalizeResult nominal = localize_box(box, camera, o);
+    ASSERT_TRUE(nominal.ok) << nominal.reason;
+    const Eigen::Matrix3d predicted = nominal.measurement.cov_p_in_cam;
+    const double su = std::hypot(o.edge_noise_px, o.edge_noise_rel * box.w);
+    const double sv = std::hypot(o.edge_noise_px, o.edge_noise_rel * box.h);
+    const int n = 4000;
+    std::vector<Eigen::Vector3d> samples;
+    for (int k = 0; k < n; ++k) {
+      const double shift_u = o.centre_noise_px * normal(rng), shift_v = o.centre_noise_px * normal(rng);
+      const double l = box.cx - box.w / 2 + shift_u + su * normal(rng);
+      const double r = box.cx + box.w / 2 + shift_u + su * normal(rng);
+      const double t = box.cy - box.h / 2 + shift_v + sv * normal(rng);
+      const double b = box.cy + box.h / 2 + shift_v + sv * normal(rng);
+      const LocalizeResult s = localize_box({0.5 * (l + r), 0.5 * (t + b), r - l, b - t}, camera, o);
+      ASSERT_TRUE(s.ok) << s.reason;
+      samples.push_back(s.measurement.p_target_in_cam);
+    }
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& s : samples) mean += s;
+    mean /= n;
+    Eigen::Matrix3d sample_cov = Eigen::Matrix3d::Zero();
+    for (const auto& s : samples) sample_cov += (s - mean) * (s - mean).transpose();
+    sample_cov /= n - 1;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(predicted);
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d v = eig.eigenvectors().col(k);
+      EXPECT_NEAR(v.dot(sample_cov * v) / eig.eigenvalues()(k), 1.0, 0.10) << "at " << p.transpose() << ", " << k;
+    }
+    // The relative term dominates the 0.5 px. On the axis the range's relative standard deviation is about
+    // s_u / w: the width's two edges give sqrt(2) s_u / w, and the height measures the range again (a sphere's box
+    // is square there), which takes sqrt(2) off.
+    SphereLocalizerOptions px_only = o;
+    px_only.edge_noise_rel = 0.0;
+    const double range_var = nominal.measurement.cov_p_in_cam(2, 2);
+    EXPECT_GT(range_var, 4 * localize_box(box, camera, px_only).measurement.cov_p_in_cam(2, 2));
+    if (p.head<2>().isZero()) EXPECT_NEAR(std::sqrt(range_var) / p.norm(), su / box.w, 0.003);
+  }
+  o.edge_noise_rel = -0.1;
+  ASSERT_EQ(o.validate().size(), 1u);
+  EXPECT_NE(o.validate()[0].find("noise.edge_rel = -0.1: must be >= 0"), std::string::npos) << o.validate()[0];
+}
+
 // --- Real calibrations (skipped without ../shared) ---
 
 TEST(SphereLocalizerAccuracy, ExactThroughEveryRealCalibration) {

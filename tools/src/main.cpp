@@ -83,6 +83,8 @@ int main(int argc, char** argv) {
   lo->add_option("--min-range", localize.localizer.min_range_m, "Reject ranges below this, metres (default 0.5)");
   lo->add_option("--max-range", localize.localizer.max_range_m, "Reject ranges above this, metres (default 100)");
   lo->add_option("--edge-noise", localize.localizer.edge_noise_px, "Box edge noise, pixels (default 1)");
+  lo->add_option("--edge-noise-rel", localize.localizer.edge_noise_rel,
+                 "Plus this fraction of the box width/height per edge, in quadrature (default 0)");
   lo->add_option("--centre-noise", localize.localizer.centre_noise_px, "Box centre noise, pixels (default 0.5)");
   lo->add_option("--border-margin", localize.localizer.border_margin_px,
                  "An edge this close to the image edge is cut, pixels (default 1)");

@@ -37,6 +37,11 @@ struct SphereLocalizerOptions {
   double max_range_m = 100.0;
   /// Standard deviation of each box edge, independently, pixels (> 0).
   double edge_noise_px = 1.0;
+  /// Plus this fraction of the box's width (left and right edges) or height (top and bottom), added to edge_noise_px
+  /// in quadrature (>= 0). A CNN's box edges wander with the box's size (the shipped model: about 10-20 % of the
+  /// width frame to frame, config/flights/cnn.localizer.yaml); a covariance that ignores it makes the tracker's gate
+  /// reject the leader's own detections and split it into many tracks (docs/localizer.md).
+  double edge_noise_rel = 0.0;
   /// Standard deviation of the box centre (a shift of the whole box, common to its edges), pixels (>= 0).
   double centre_noise_px = 0.5;
   /// A box edge within this many pixels of the image edge is cut by the border, pixels (>= 0).
@@ -49,6 +54,8 @@ struct SphereLocalizerOptions {
     v("range.min_m", min_range_m, "reject distances below this, metres (> target.radius_m)");
     v("range.max_m", max_range_m, "reject distances above this, metres");
     v("noise.edge_px", edge_noise_px, "standard deviation of each box edge, pixels");
+    v("noise.edge_rel", edge_noise_rel,
+      "plus this fraction of the box width (left/right edges) or height (top/bottom), in quadrature (CNN boxes)");
     v("noise.centre_px", centre_noise_px, "standard deviation of the box centre (common shift), pixels");
     v("border.margin_px", border_margin_px, "an edge this close to the image edge is cut by the border, pixels");
   }
