@@ -46,19 +46,21 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   // model.backend = opencl: no usable OpenCL device, or a kernel that fails to build, throws here (exit 1, one line).
   // The first network is built at start-up (the cfg's size, or model.input_size's WxH); with input_size auto,
   // frames of another aspect build another one when the first of them arrives.
+  bool built_once = false;  // a fallback warns at start-up only; a later network for another frame size says it as info
   auto make_backend = [&](const detector::DarknetModel& sized) {
     std::string why;
     const auto t_backend = std::chrono::steady_clock::now();
     auto backend = detector::make_backend(o.backend, sized, o.opencl, o.opencl.max_batch, &why);
     const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
     const std::string net = fmt::format("network input {}x{}", sized.net.width, sized.net.height);
-    if (why.find("no usable OpenCL device") != std::string::npos) {
-      spdlog::warn("{}; running on the CPU (chosen in {:.2f} s; {})", why, backend_s, net);  // auto fell back
+    if (why.find("no usable OpenCL device") != std::string::npos && !built_once) {
+      spdlog::warn("{}; running on the CPU (chosen in {:.2f} s; {})", why, backend_s, net);  // auto fell back: once
     } else {
       spdlog::info("{} (chosen in {:.2f} s; {})", why, backend_s, net);
     }
     // The heartbeat says which backend runs, and why, for as long as nothing else needs saying.
     rt.status().set_state(status_t::STATE_OK, why);
+    built_once = true;
     return backend;
   };
   auto on_build = [&](cv::Size net, cv::Size image) {
