@@ -76,11 +76,12 @@ TEST(DarknetNet, ThesisNetworkMatchesOpenCvDnnOnRandomWeights) {
 
 TEST(DarknetNet, ProposedSmallNetworkMatchesOpenCvDnnOnRandomWeights) {
   const DarknetModel m = detector::parse_darknet_cfg(testing::source_path("models/wingman-small.cfg"));
-  // 640x352 input (0.68 GFLOP at 416x416 x 640*352 / 416^2): heads 40x22 (stride 16) and 80x44 (stride 8).
-  EXPECT_NEAR(m.flops() / 1e9, 0.885, 0.005);
-  ASSERT_EQ(m.heads().size(), 2u);
+  // 640x352 input: heads 40x22 (stride 16), 80x44 (stride 8) and, grown on them, 20x11 (stride 32, large drones).
+  EXPECT_NEAR(m.flops() / 1e9, 1.083, 0.005);
+  ASSERT_EQ(m.heads().size(), 3u);
   EXPECT_EQ(m.layers[9].input, (detector::Shape{18, 22, 40}));
   EXPECT_EQ(m.layers[16].input, (detector::Shape{18, 44, 80}));
+  EXPECT_EQ(m.layers[23].input, (detector::Shape{18, 11, 20}));
   expect_torch_matches_opencv(m, 31, 1);
 }
 
