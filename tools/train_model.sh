@@ -5,13 +5,16 @@
 # the simulator, and trains models/wingman-small.cfg at 416x416 on Halmstad + synth with the card's schedule
 # (stage 1), then fine-tunes stage 1's iteration-1000 weights for 400 iterations with the follower's-view set
 # (drones on the horizon) added (stage 2), then flies eight training flights through the pipeline, takes their
-# frames with the renderer's boxes, and fine-tunes stage 2 at the cfg's 640x352 with them added (stage 3). The
-# shipped weights are stage 3's final ones (OUT/stage3/wingman-small_final.weights).
+# frames with the renderer's boxes, and fine-tunes stage 2 at the cfg's 640x352 with them added (stage 3), then grows
+# the cfg's third head (stride 32, for large, close drones) on stage 3 with --partial-weights and trains the whole
+# network on the same data (stage 4). Stages 1-3 train the cfg without its third head (the section from "# Third
+# head" on cut, the first six anchors). The shipped weights are stage 4's final ones
+# (OUT/stage4/wingman-small_final.weights).
 # Resumable: run it again after an interruption and it continues from the last checkpoint (datasets are kept once
 # complete; a finished stage is not trained again).
 #
 # Usage: tools/train_model.sh [--data DIR] [--out DIR] [--threads N] [--max-batches N] [--stage2-batches N]
-#                             [--stage3-batches N]
+#                             [--stage3-batches N] [--stage4-batches N]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
 #   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 and 3 in OUT/stage2, OUT/stage3
 #                     (default build/train-wingman-small)
@@ -20,6 +23,7 @@
 #   --stage2-batches  stage 2 iterations (default 400, the shipped model's; 0 = stage 1 only). Stage 2 starts from
 #                     stage 1's iteration-1000 weights (or its final ones when it is shorter)
 #   --stage3-batches  stage 3 iterations (default 400, the shipped model's; 0 = stop after stage 2)
+#   --stage4-batches  stage 4 iterations (default 600, the shipped model's; 0 = stop after stage 3)
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
 set -euo pipefail
@@ -27,7 +31,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
-stage3_batches=400
+stage3_batches=400 stage4_batches=600
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -36,6 +40,7 @@ while [ $# -gt 0 ]; do
     --max-batches) max_batches="$2"; shift 2 ;;
     --stage2-batches) stage2_batches="$2"; shift 2 ;;
     --stage3-batches) stage3_batches="$2"; shift 2 ;;
+    --stage4-batches) stage4_batches="$2"; shift 2 ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -43,6 +48,7 @@ done
 case "$max_batches" in ''|*[!0-9]*) echo "train_model: --max-batches '$max_batches': expected a positive integer" >&2; exit 2 ;; esac
 case "$stage2_batches" in ''|*[!0-9]*) echo "train_model: --stage2-batches '$stage2_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage3_batches" in ''|*[!0-9]*) echo "train_model: --stage3-batches '$stage3_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+case "$stage4_batches" in ''|*[!0-9]*) echo "train_model: --stage4-batches '$stage4_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 halmstad_src="$src/../shared/datasets/halmstad"
 [ -d "$halmstad_src" ] || { echo "train_model: $halmstad_src is missing (the Halmstad videos)" >&2; exit 2; }
 "$bin/wingman" train --help > /dev/null 2>&1 ||
@@ -117,12 +123,16 @@ EOF
 # Stages 1 and 2 train the network at 416x416 (the .cfg with that input size); stage 3 at the .cfg's own 640x352.
 # The copy keeps the name wingman-small.cfg (the trainer names its files after the cfg: wingman-small_*.weights) in
 # a folder of its own (the trainer copies its cfg into OUT).
-mkdir -p "$out/cfg-416"
-sed 's/^width=.*/width=416/; s/^height=.*/height=416/' "$src/models/wingman-small.cfg" > "$out/cfg-416/wingman-small.cfg"
+# Stages 1-3: the two-head network (the shipped cfg without its third head, and with the first six anchors, so that
+# every box trains one of the two heads). Each copy keeps the name wingman-small.cfg in a folder of its own.
+mkdir -p "$out/cfg-416" "$out/cfg-2head"
+two_head=(-e '/^# Third head/,$d' -e 's/^anchors=.*/anchors=4,3, 6,5, 9,8, 13,13, 21,16, 34,27/' -e 's/^num=9$/num=6/')
+sed "${two_head[@]}" "$src/models/wingman-small.cfg" > "$out/cfg-2head/wingman-small.cfg"
+sed 's/^width=.*/width=416/; s/^height=.*/height=416/' "$out/cfg-2head/wingman-small.cfg" > "$out/cfg-416/wingman-small.cfg"
 augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 --blur 0.1 --noise 0.1
   --checkpoint-interval 25 --log-interval 10 --val-max-images 400)
 common=(--cfg "$out/cfg-416/wingman-small.cfg" "${augment[@]}")
-common640=(--cfg "$src/models/wingman-small.cfg" "${augment[@]}")
+common640=(--cfg "$out/cfg-2head/wingman-small.cfg" "${augment[@]}")
 # 3. Stage 1: Table 2's rate steps, scaled to the run's length; warm-up 100 iterations.
 if [ ! -f "$out/wingman-small_final.weights" ]; then
   s1=$((max_batches * 53 / 100)) s2=$((max_batches * 77 / 100)) s3=$((max_batches * 90 / 100))
@@ -182,10 +192,23 @@ EOF
 # 6. Stage 3 (the shipped weights): stage 2's final weights fine-tuned at the shipped input size, 640x352 (the .cfg
 # as it is: a 16:9 frame keeps 0.49 of its rows instead of the 416x416 stretch's 0.58 and 0.50 of its columns
 # instead of 0.33), at Table 2's 1e-3, 5e-4, 1e-4, 5e-5.
-[ -f "$out/stage3/wingman-small_final.weights" ] && exit 0
-u1=$((stage3_batches / 2)) u2=$((stage3_batches * 8 / 10)) u3=$((stage3_batches * 9 / 10))
+if [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
+  u1=$((stage3_batches / 2)) u2=$((stage3_batches * 8 / 10)) u3=$((stage3_batches * 9 / 10))
+  resume=()
+  [ -f "$out/stage3/checkpoint.pt" ] && resume=(--resume)
+  "$bin/wingman" train "${common640[@]}" --data "$data/combined-flights.yaml" --out "$out/stage3" \
+    --weights "$out/stage2/wingman-small_final.weights" --max-batches "$stage3_batches" --burn-in 30 \
+    --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 40 "${resume[@]}"
+fi
+# 7. Stage 4 (the shipped weights): the shipped cfg, whose third head (stride 32; the stride-16 head sees 99 input
+# pixels, too few for a close drone) starts random on stage 3's layers (--partial-weights), the whole network trained
+# on stage 3's data at the same rate steps.
+[ "$stage4_batches" -gt 0 ] || exit 0
+[ -f "$out/stage4/wingman-small_final.weights" ] && exit 0
+u1=$((stage4_batches / 2)) u2=$((stage4_batches * 8 / 10)) u3=$((stage4_batches * 9 / 10))
 resume=()
-[ -f "$out/stage3/checkpoint.pt" ] && resume=(--resume)
-exec "$bin/wingman" train "${common640[@]}" --data "$data/combined-flights.yaml" --out "$out/stage3" \
-  --weights "$out/stage2/wingman-small_final.weights" --max-batches "$stage3_batches" --burn-in 30 \
-  --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 40 "${resume[@]}"
+[ -f "$out/stage4/checkpoint.pt" ] && resume=(--resume)
+exec "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-flights.yaml" \
+  --out "$out/stage4" --weights "$out/stage3/wingman-small_final.weights" --partial-weights \
+  --max-batches "$stage4_batches" --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 \
+  "${resume[@]}"
