@@ -326,11 +326,35 @@ TEST(SphereLocalizerInput, RejectsRangesOutsideTheConfiguredLimits) {
 
 // --- Covariance against Monte-Carlo ---
 
+/// Sample covariance of localize_box's camera-frame position over `n` noisy copies of `box`: a common shift of
+/// o.centre_noise_px per axis plus independent edge noise of `sigma_u` (left, right) and `sigma_v` (top, bottom).
+Eigen::Matrix3d monte_carlo_cov(const CameraModel& camera, const PixelBox& box, const SphereLocalizerOptions& o,
+                                double sigma_u, double sigma_v, std::mt19937& rng, int n) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<Eigen::Vector3d> samples;
+  samples.reserve(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const double shift_u = o.centre_noise_px * normal(rng), shift_v = o.centre_noise_px * normal(rng);
+    const double l = box.cx - box.w / 2 + shift_u + sigma_u * normal(rng);
+    const double r = box.cx + box.w / 2 + shift_u + sigma_u * normal(rng);
+    const double t = box.cy - box.h / 2 + shift_v + sigma_v * normal(rng);
+    const double b = box.cy + box.h / 2 + shift_v + sigma_v * normal(rng);
+    const LocalizeResult s = localize_box({0.5 * (l + r), 0.5 * (t + b), r - l, b - t}, camera, o);
+    EXPECT_TRUE(s.ok) << s.reason;
+    if (s.ok) samples.push_back(s.measurement.p_target_in_cam);
+  }
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& s : samples) mean += s;
+  mean /= static_cast<double>(samples.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& s : samples) cov += (s - mean) * (s - mean).transpose();
+  return cov / static_cast<double>(samples.size() - 1);
+}
+
 TEST(SphereLocalizerCovariance, MatchesMonteCarloWithin10PercentInEveryEigenvalue) {
   // 4000 samples per case (fixed seed): the standard error of a sample variance is sqrt(2/4000) = 2.2%, so 10%
   // is more than 4 standard errors; the boxes are >= 20 px so the first-order propagation holds.
   std::mt19937 rng(12345);
-  std::normal_distribution<double> normal(0.0, 1.0);
   struct Case {
     int camera;
     Eigen::Vector3d p;
@@ -349,25 +373,7 @@ TEST(SphereLocalizerCovariance, MatchesMonteCarloWithin10PercentInEveryEigenvalu
     ASSERT_TRUE(nominal.ok) << nominal.reason;
     const Eigen::Matrix3d predicted = nominal.measurement.cov_p_in_cam;
 
-    const int n = 4000;
-    std::vector<Eigen::Vector3d> samples;
-    samples.reserve(n);
-    for (int k = 0; k < n; ++k) {
-      const double shift_u = o.centre_noise_px * normal(rng), shift_v = o.centre_noise_px * normal(rng);
-      const double l = box.cx - box.w / 2 + shift_u + o.edge_noise_px * normal(rng);
-      const double r = box.cx + box.w / 2 + shift_u + o.edge_noise_px * normal(rng);
-      const double t = box.cy - box.h / 2 + shift_v + o.edge_noise_px * normal(rng);
-      const double b = box.cy + box.h / 2 + shift_v + o.edge_noise_px * normal(rng);
-      const LocalizeResult s = localize_box({0.5 * (l + r), 0.5 * (t + b), r - l, b - t}, camera, o);
-      ASSERT_TRUE(s.ok) << s.reason;
-      samples.push_back(s.measurement.p_target_in_cam);
-    }
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto& s : samples) mean += s;
-    mean /= n;
-    Eigen::Matrix3d sample_cov = Eigen::Matrix3d::Zero();
-    for (const auto& s : samples) sample_cov += (s - mean) * (s - mean).transpose();
-    sample_cov /= n - 1;
+    const Eigen::Matrix3d sample_cov = monte_carlo_cov(camera, box, o, o.edge_noise_px, o.edge_noise_px, rng, 4000);
 
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(predicted);
     for (int k = 0; k < 3; ++k) {
@@ -390,7 +396,6 @@ TEST(SphereLocalizerCovariance, RelativeEdgeNoiseMatchesMonteCarlo) {
   // noise.edge_rel: each edge's standard deviation grows with the box's size, sqrt(edge_px^2 + (rel w)^2) for the
   // left and right edges (h for top and bottom). 4000 samples, fixed seed, 10 % as above.
   std::mt19937 rng(777);
-  std::normal_distribution<double> normal(0.0, 1.0);
   const auto cameras = test_cameras();
   const CameraModel& camera = cameras[0].camera;
   SphereLocalizerOptions o = options_for("exact");
@@ -403,24 +408,7 @@ TEST(SphereLocalizerCovariance, RelativeEdgeNoiseMatchesMonteCarlo) {
     const Eigen::Matrix3d predicted = nominal.measurement.cov_p_in_cam;
     const double su = std::hypot(o.edge_noise_px, o.edge_noise_rel * box.w);
     const double sv = std::hypot(o.edge_noise_px, o.edge_noise_rel * box.h);
-    const int n = 4000;
-    std::vector<Eigen::Vector3d> samples;
-    for (int k = 0; k < n; ++k) {
-      const double shift_u = o.centre_noise_px * normal(rng), shift_v = o.centre_noise_px * normal(rng);
-      const double l = box.cx - box.w / 2 + shift_u + su * normal(rng);
-      const double r = box.cx + box.w / 2 + shift_u + su * normal(rng);
-      const double t = box.cy - box.h / 2 + shift_v + sv * normal(rng);
-      const double b = box.cy + box.h / 2 + shift_v + sv * normal(rng);
-      const LocalizeResult s = localize_box({0.5 * (l + r), 0.5 * (t + b), r - l, b - t}, camera, o);
-      ASSERT_TRUE(s.ok) << s.reason;
-      samples.push_back(s.measurement.p_target_in_cam);
-    }
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto& s : samples) mean += s;
-    mean /= n;
-    Eigen::Matrix3d sample_cov = Eigen::Matrix3d::Zero();
-    for (const auto& s : samples) sample_cov += (s - mean) * (s - mean).transpose();
-    sample_cov /= n - 1;
+    const Eigen::Matrix3d sample_cov = monte_carlo_cov(camera, box, o, su, sv, rng, 4000);
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(predicted);
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d v = eig.eigenvectors().col(k);
@@ -433,7 +421,9 @@ TEST(SphereLocalizerCovariance, RelativeEdgeNoiseMatchesMonteCarlo) {
     px_only.edge_noise_rel = 0.0;
     const double range_var = nominal.measurement.cov_p_in_cam(2, 2);
     EXPECT_GT(range_var, 4 * localize_box(box, camera, px_only).measurement.cov_p_in_cam(2, 2));
-    if (p.head<2>().isZero()) EXPECT_NEAR(std::sqrt(range_var) / p.norm(), su / box.w, 0.003);
+    if (p.head<2>().isZero()) {
+      EXPECT_NEAR(std::sqrt(range_var) / p.norm(), su / box.w, 0.003);
+    }
   }
   o.edge_noise_rel = -0.1;
   ASSERT_EQ(o.validate().size(), 1u);
