@@ -7,7 +7,8 @@
 # build/experiments/NAME/ (docs/results.md collects them).
 #
 # Usage: tools/experiment.sh NAME [--quick] [--out DIR] [--detections cnn|truth]
-#   NAME           static_sweep  box width error over distance, single pass vs zoom-in (thesis Fig. 13)
+#   NAME           static_sweep  box width error over distance, single pass vs zoom-in (thesis Fig. 13), and the
+#                                boxes' range scale side-on and from behind (the radius calibration)
 #                  distance      distance error on a fast-moving leader: single, zoom-in, zoom-in filtered (Table 3)
 #                  follow_1d     the 1-D PID follow (thesis section 5.3)
 #                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
@@ -18,7 +19,7 @@
 #   --detections   cnn (default): the shipped model on rendered images; truth: boxes from the simulator's ground truth
 #                  (the bounding sphere's box, 1 px noise; no rendering): what the rest of the pipeline does with
 #                  perfect boxes (distance, follow_1d and formation_2d only)
-# Lengths (a rendered closed-loop frame takes 0.2-0.5 s here): static_sweep 2 x 952 frames, distance 4 x 10 s,
+# Lengths (a rendered closed-loop frame takes 0.2-0.5 s here): static_sweep 3 x 952 frames, distance 4 x 10 s,
 # follow_1d 20 s, formation_2d 3 x 10 s, max_range 200 frames; about 30 min in all on the 2-core development VM.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -78,7 +79,13 @@ static_sweep() {
   printf 'target: {radius_m: 0.348}\n' > "$out/sphere.localizer.yaml"
   fly "$out/single" --scenario "$scn" --localizer-config "$out/sphere.localizer.yaml"
   fly "$out/zoom" --scenario "$scn" --zoom-in --localizer-config "$out/sphere.localizer.yaml"
-  py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json"
+  # The same sweep with the drone turned 90 degrees, seen from behind as a follower sees its leader (single pass): the
+  # boxes' width, and so the range scale, depends on the view; config/flights/cnn.localizer.yaml takes this one.
+  local behind; behind=$(scenario_variant "$out/scenario-behind" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/" \
+    "s/yaw_deg: 0 *# seen from the side/yaw_deg: 90               # seen from behind/")
+  grep -q "seen from behind" "$behind" || { echo "experiment: could not turn the drone in $behind" >&2; exit 1; }
+  fly "$out/behind" --scenario "$behind" --localizer-config "$out/sphere.localizer.yaml"
+  py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json" "$out/behind/eval.json"
 }
 
 distance() {

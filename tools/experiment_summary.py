@@ -65,17 +65,19 @@ def range_scale(csv_path, lo=2.0, hi=20.0):
     return (ratios[len(ratios) // 2] if ratios else None), len(ratios)
 
 
-def static_sweep(out, single, zoom):
+def static_sweep(out, single, zoom, behind=None):
     s, z = load(single), load(zoom)
     k, k_n = range_scale(os.path.join(os.path.dirname(single), "targets.csv"))
     kz, kz_n = range_scale(os.path.join(os.path.dirname(zoom), "targets.csv"))
+    kb, kb_n = range_scale(os.path.join(os.path.dirname(behind), "targets.csv")) if behind else (None, 0)
     bins = []
     for bs, bz in zip(s["box_width_single_by_range"], z["box_width_zoom_by_range"]):
         bins.append({"lo_m": bs["lo_m"], "hi_m": bs["hi_m"], "single": bs["error"], "zoom": bz["error"]})
     data = {"single": {"box_width_error": s["box_width_single"], **common_row(s)},
             "zoom": {"box_width_error": z["box_width_zoom"], **common_row(z)}, "by_range": bins,
             "thesis": {"single_mean": 0.026, "zoom_mean": 0.007},
-            "range_scale": {"single": k, "single_n": k_n, "zoom": kz, "zoom_n": kz_n, "true_range_m": [2.0, 20.0]}}
+            "range_scale": {"single": k, "single_n": k_n, "zoom": kz, "zoom_n": kz_n, "behind": kb, "behind_n": kb_n,
+                            "true_range_m": [2.0, 20.0]}}
     f = lambda e: f"{e['mean']:.4f} (n = {e['n']})" if e["n"] else "no detections"
     lines = ["| box width error, mean abs., fraction of image width | thesis (Fig. 13) | ours |", "|---|---|---|",
              f"| single detection | 0.026 | {f(s['box_width_single'])} |",
@@ -93,6 +95,11 @@ def static_sweep(out, single, zoom):
                   f"{k:.3f} single (n = {k_n})" + (f", {kz:.3f} zoom-in (n = {kz_n})" if kz else "") +
                   ": the detector's boxes are this fraction of the bounding sphere's width when the flight used the "
                   "sphere's radius (multiply target.radius_m by it to calibrate)."]
+    if kb:
+        lines += ["", f"Seen from behind (the same sweep, the drone turned 90°, single pass: the view a follower has "
+                  f"of its leader): range scale {kb:.3f} (n = {kb_n}), {100 * rate(load(behind)):.1f} % of the frames "
+                  f"detected. `config/flights/cnn.localizer.yaml` takes this one (0.348 m × {kb:.3f} = "
+                  f"{0.348 * kb:.3f} m)."]
     write(out, "static_sweep", data, lines)
 
 
@@ -188,7 +195,7 @@ def max_range(out, run):
     write(out, "max_range", data, lines)
 
 
-KINDS = {"static_sweep": (static_sweep, 2), "distance": (distance, 4), "follow_1d": (follow_1d, 1),
+KINDS = {"static_sweep": (static_sweep, 3), "distance": (distance, 4), "follow_1d": (follow_1d, 1),
          "formation_2d": (formation_2d, 3), "max_range": (max_range, 1)}
 
 if __name__ == "__main__":
