@@ -195,10 +195,12 @@ def max_range(out, run):
     write(out, "max_range", data, lines)
 
 
-KINDS = {"static_sweep": (static_sweep, 3), "distance": (distance, 4), "follow_1d": (follow_1d, 1),
-         "formation_2d": (formation_2d, 3), "max_range": (max_range, 1)}
+# Each kind: its function and how many EVAL_JSON arguments it takes (static_sweep: the third, from behind, optional).
+KINDS = {"static_sweep": (static_sweep, (2, 3)), "distance": (distance, (4, 4)), "follow_1d": (follow_1d, (1, 1)),
+         "formation_2d": (formation_2d, (3, 3)), "max_range": (max_range, (1, 1))}
 
 if __name__ == "__main__":
-    if len(sys.argv) < 3 or sys.argv[1] not in KINDS or len(sys.argv) - 3 != KINDS[sys.argv[1]][1]:
+    if (len(sys.argv) < 3 or sys.argv[1] not in KINDS or
+            not KINDS[sys.argv[1]][1][0] <= len(sys.argv) - 3 <= KINDS[sys.argv[1]][1][1]):
         sys.exit(__doc__)
     KINDS[sys.argv[1]][0](*sys.argv[2:])

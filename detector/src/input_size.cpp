@@ -58,8 +58,8 @@ cv::Size fit_input_size(cv::Size cfg_net, cv::Size region) {
                                             cfg_net.width, cfg_net.height, region.width, region.height));
   const int long_side = std::max(cfg_net.width, cfg_net.height);
   const bool landscape = region.width >= region.height;
-  const double ratio = landscape ? static_cast<double>(region.height) / region.width
-                                 : static_cast<double>(region.width) / region.height;
+  const double ratio =
+      landscape ? static_cast<double>(region.height) / region.width : static_cast<double>(region.width) / region.height;
   const int short_side = std::max(kStep, static_cast<int>(std::lround(long_side * ratio / kStep)) * kStep);
   return landscape ? cv::Size(long_side, short_side) : cv::Size(short_side, long_side);
 }

@@ -22,8 +22,8 @@ SizedDetector::SizedDetector(DetectorPipelineOptions options, DarknetModel model
       on_build_(std::move(on_build)) {
   if (!make_backend_) throw std::invalid_argument("SizedDetector: make_backend is empty");
   if (input_size_.mode == InputSize::Mode::kFixed && (input_size_.fixed.width <= 0 || input_size_.fixed.height <= 0))
-    throw std::invalid_argument(fmt::format("SizedDetector: input size {}x{} must be positive",
-                                            input_size_.fixed.width, input_size_.fixed.height));
+    throw std::invalid_argument(fmt::format("SizedDetector: input size {}x{} must be positive", input_size_.fixed.width,
+                                            input_size_.fixed.height));
   const cv::Size first = input_size_.mode == InputSize::Mode::kFixed ? input_size_.fixed : cfg_net_;
   build(first, cv::Size());
 }
@@ -44,8 +44,9 @@ DetectionPipeline& SizedDetector::pipeline_for(cv::Size image) {
   const cv::Size net = net_size_for(image);
   for (size_t i = 0; i < pipelines_.size(); ++i) {
     if (pipelines_[i].net != net) continue;
-    if (i != 0) std::rotate(pipelines_.begin(), pipelines_.begin() + static_cast<std::ptrdiff_t>(i),
-                            pipelines_.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    if (i != 0)
+      std::rotate(pipelines_.begin(), pipelines_.begin() + static_cast<std::ptrdiff_t>(i),
+                  pipelines_.begin() + static_cast<std::ptrdiff_t>(i) + 1);
     return *pipelines_.front().pipeline;
   }
   return build(net, image);

@@ -318,8 +318,8 @@ LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, cons
   const double rel_u = options.edge_noise_rel * (edges.e[kRight] - edges.e[kLeft]);
   const double rel_v = options.edge_noise_rel * (edges.e[kBottom] - edges.e[kTop]);
   const double sc2 = options.centre_noise_px * options.centre_noise_px;
-  Eigen::Matrix4d S = Eigen::Vector4d(se2 + rel_u * rel_u, se2 + rel_u * rel_u, se2 + rel_v * rel_v, se2 + rel_v * rel_v)
-                          .asDiagonal();
+  Eigen::Matrix4d S =
+      Eigen::Vector4d(se2 + rel_u * rel_u, se2 + rel_u * rel_u, se2 + rel_v * rel_v, se2 + rel_v * rel_v).asDiagonal();
   S.block<2, 2>(0, 0).array() += sc2;
   S.block<2, 2>(2, 2).array() += sc2;
   out.cov_p_in_cam = J * S * J.transpose();

@@ -274,8 +274,9 @@ TEST(DarknetWeights, WrongLengthNamesExpectedAndActualSize) {
 }
 
 /// A two-layer network and the same with two layers appended (a [maxpool] and a second [convolutional]).
-const char* kBase = "[net]\nwidth=16\nheight=16\n[convolutional]\nbatch_normalize=1\nfilters=4\nsize=3\n"
-                    "[convolutional]\nfilters=6\nsize=1\n";
+const char* kBase =
+    "[net]\nwidth=16\nheight=16\n[convolutional]\nbatch_normalize=1\nfilters=4\nsize=3\n"
+    "[convolutional]\nfilters=6\nsize=1\n";
 const char* kExtension = "[maxpool]\nsize=2\nstride=2\n[convolutional]\nbatch_normalize=1\nfilters=5\nsize=3\n";
 
 void write_bytes(const std::string& path, const std::vector<char>& bytes) {
@@ -337,8 +338,9 @@ TEST(DarknetWeights, PrefixRefusesPartLayersLongerFilesAndHeadersAlone) {
   msg = message_of([&] { load_darknet_weights_prefix(grown, dir.file("long.weights")); });
   EXPECT_NE(msg.find("long.weights"), std::string::npos) << msg;
   EXPECT_NE(msg.find("the first 3 fit in"), std::string::npos) << msg;
-  EXPECT_NE(message_of([&] { load_darknet_weights_prefix(grown, dir.file("missing.weights")); })
-                .find("missing.weights: cannot open"),
+  EXPECT_NE(message_of([&] {
+              load_darknet_weights_prefix(grown, dir.file("missing.weights"));
+            }).find("missing.weights: cannot open"),
             std::string::npos);
 }
 

@@ -32,8 +32,8 @@ TEST(InputSize, ParsesAutoCfgAndSizes) {
 }
 
 TEST(InputSize, RejectsOtherTextSayingWhatWasExpected) {
-  for (const std::string bad : {"", "Auto", "640", "641x512", "640x500", "0x32", "-32x32", "640x512x3", "x512",
-                                "640x", "4128x32", "640 x 512", "+64x64", "1e3x32"}) {
+  for (const std::string bad : {"", "Auto", "640", "641x512", "640x500", "0x32", "-32x32", "640x512x3", "x512", "640x",
+                                "4128x32", "640 x 512", "+64x64", "1e3x32"}) {
     std::string error;
     EXPECT_FALSE(InputSize::parse(bad, &error)) << bad;
     EXPECT_NE(error.find("'" + bad + "': expected auto, cfg or WxH"), std::string::npos) << error;
@@ -48,7 +48,7 @@ TEST(InputSize, FitKeepsTheLongerSideAndFollowsTheAspect) {
   EXPECT_EQ(fit_input_size(cfg, {720, 720}), cv::Size(640, 640));   // a subsquare region
   EXPECT_EQ(fit_input_size(cfg, {720, 1280}), cv::Size(352, 640));  // portrait
   EXPECT_EQ(fit_input_size(cfg, {1920, 1080}), cv::Size(640, 352));
-  EXPECT_EQ(fit_input_size(cfg, {10000, 10}), cv::Size(640, 32));  // never below 32
+  EXPECT_EQ(fit_input_size(cfg, {10000, 10}), cv::Size(640, 32));          // never below 32
   EXPECT_EQ(fit_input_size({416, 416}, {1280, 720}), cv::Size(416, 224));  // 234 rounds to 224
   EXPECT_EQ(fit_input_size({352, 640}, {1280, 720}), cv::Size(640, 352));  // the longer side, whichever it is
   EXPECT_THROW(fit_input_size(cfg, {0, 720}), std::invalid_argument);
@@ -75,12 +75,13 @@ DarknetModel small_two_head_model() {
     s.replace(s.find("{}"), 2, mask);
     return s;
   };
-  const std::string conv = "[convolutional]\nbatch_normalize=1\nfilters=8\nsize=3\nstride=1\npad=1\nactivation=leaky\n\n";
+  const std::string conv =
+      "[convolutional]\nbatch_normalize=1\nfilters=8\nsize=3\nstride=1\npad=1\nactivation=leaky\n\n";
   const std::string out = "[convolutional]\nfilters=18\nsize=1\nstride=1\npad=1\nactivation=linear\n\n";
   const std::string pool = "[maxpool]\nsize=2\nstride=2\n\n";
   const std::string cfg = "[net]\nwidth=128\nheight=64\nchannels=3\n\n" + conv + pool + pool + pool + pool +  // 0-4
-                          conv + pool + out + head("3,4,5") +                                             // 5-8
-                          "[route]\nlayers=-4\n\n[route]\nlayers=-1\n\n" + out + head("0,1,2");           // 9-12
+                          conv + pool + out + head("3,4,5") +                                                 // 5-8
+                          "[route]\nlayers=-4\n\n[route]\nlayers=-1\n\n" + out + head("0,1,2");               // 9-12
   DarknetModel m = parse_darknet_cfg_string(cfg, "small-two-head.cfg");
   randomize_weights(m, 21);
   return m;
@@ -123,8 +124,8 @@ TEST(SizedDetector, AutoBuildsOnePipelinePerAspectAndMatchesAHandBuiltOne) {
   EXPECT_EQ(built[0].first, cv::Size(128, 64));
   EXPECT_TRUE(built[0].second.empty());
 
-  const cv::Mat wide = noise(1280, 720, 1);   // 128 x 72 -> the cfg's 128 x 64: no new build
-  const cv::Mat tall4 = noise(640, 512, 2);   // 128 x 102 -> 128 x 96
+  const cv::Mat wide = noise(1280, 720, 1);  // 128 x 72 -> the cfg's 128 x 64: no new build
+  const cv::Mat tall4 = noise(640, 512, 2);  // 128 x 102 -> 128 x 96
   EXPECT_EQ(d.net_size_for(wide.size()), cv::Size(128, 64));
   EXPECT_EQ(d.net_size_for(tall4.size()), cv::Size(128, 96));
 

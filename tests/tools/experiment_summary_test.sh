@@ -13,12 +13,12 @@ summary="$src/tools/experiment_summary.py"
 
 mkdir -p "$work/run"
 "$write_flight" "$work/run/flight.lcmlog"
-"$wingman" eval "$work/run/flight.lcmlog" --json "$work/run/eval.json" --quiet > /dev/null
+"$wingman" eval "$work/run/flight.lcmlog" --json "$work/run/eval.json" --csv "$work/run/targets.csv" --quiet > /dev/null
 run="$work/run/eval.json"
 val() { python3 -c "import json,sys; r=json.load(open('$1')); print(eval(sys.argv[1]))" "$2"; }
 
 for kind in static_sweep distance follow_1d formation_2d max_range; do mkdir -p "$work/$kind"; done
-python3 "$summary" static_sweep "$work/static_sweep" "$run" "$run" > /dev/null
+python3 "$summary" static_sweep "$work/static_sweep" "$run" "$run" "$run" > /dev/null
 python3 "$summary" distance "$work/distance" "$run" "$run" "$run" "$run" > /dev/null
 python3 "$summary" follow_1d "$work/follow_1d" "$run" > /dev/null
 python3 "$summary" formation_2d "$work/formation_2d" "$run" "$run" "$run" > /dev/null
@@ -32,6 +32,15 @@ grep -q "^| average | 2.86 | $(printf '%.3f' "$rms") |" "$work/formation_2d/resu
 # Static sweep: the single-pass mean box-width error of the eval, as a fraction of the width.
 single=$(val "$run" "'%.4f' % r['box_width_single']['mean']")
 grep -q "^| single detection | 0.026 | $single (n = " "$work/static_sweep/results.md" || fail "sweep table: $(cat "$work/static_sweep/results.md")"
+# The range scale side-on and, from the optional third flight, from behind (here the same flight: the same scale).
+k=$(val "$work/static_sweep/results.json" "'%.3f' % r['range_scale']['single']")
+kb=$(val "$work/static_sweep/results.json" "'%.3f' % r['range_scale']['behind']")
+[ "$k" = "$kb" ] || fail "range scale side-on $k, from behind $kb: the same flight"
+grep -q "^Seen from behind .*range scale $kb (n = " "$work/static_sweep/results.md" || fail "no from-behind line: $(cat "$work/static_sweep/results.md")"
+# Without the third flight the summary still works and says nothing about the view from behind.
+mkdir -p "$work/static_sweep2"
+python3 "$summary" static_sweep "$work/static_sweep2" "$run" "$run" > /dev/null
+! grep -q "Seen from behind" "$work/static_sweep2/results.md" || fail "a from-behind line without that flight"
 # Distance: the along-the-line-of-sight mean and max.
 along=$(val "$run" "'%.2f / %.2f' % (r['along_line_of_sight']['mean_m'], r['along_line_of_sight']['max_m'])")
 grep -q "^| single detection, unfiltered | 1.59 / 19.77 | $along |" "$work/distance/results.md" || fail "distance table: $(cat "$work/distance/results.md")"

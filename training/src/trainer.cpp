@@ -277,9 +277,8 @@ Trainer::Trainer(TrainOptions options) : impl_(std::make_unique<Impl>()) {
     } else {
       detector::load_darknet_weights(m, s.o.init_weights);
       s.net->load_weights(m);
-      s.init_layers = static_cast<int>(std::count_if(m.layers.begin(), m.layers.end(), [](const auto& l) {
-        return l.type == LayerType::kConvolutional;
-      }));
+      s.init_layers = static_cast<int>(std::count_if(
+          m.layers.begin(), m.layers.end(), [](const auto& l) { return l.type == LayerType::kConvolutional; }));
     }
   }
   std::vector<torch::optim::OptimizerParamGroup> groups;

@@ -30,8 +30,8 @@ class SizedDetector {
 
   /// @param model  with weights loaded; its [net] size is the cfg's. Throws std::invalid_argument for a kFixed size
   ///               of 0 and what DetectionPipeline and `make_backend` throw.
-  SizedDetector(DetectorPipelineOptions options, DarknetModel model, InputSize input_size,
-                BackendFactory make_backend, BuildObserver on_build = {});
+  SizedDetector(DetectorPipelineOptions options, DarknetModel model, InputSize input_size, BackendFactory make_backend,
+                BuildObserver on_build = {});
 
   /// Detects in `bgr_image` (CV_8UC3, non-empty; std::invalid_argument otherwise) with the pipeline for its size.
   std::vector<Box> detect(const cv::Mat& bgr_image);

@@ -25,7 +25,7 @@ struct TrainOptions {
   /// init_weights may hold the first [convolutional] layers only (detector::load_darknet_weights_prefix: a trained
   /// network that the .cfg extends with appended layers); the others keep their seeded random weights.
   bool init_partial = false;
-  bool resume = false;                ///< continue from out_dir/checkpoint.pt (an error if there is none)
+  bool resume = false;  ///< continue from out_dir/checkpoint.pt (an error if there is none)
 
   int batch = 64;        ///< [net] batch: images per iteration (per weight update), >= 1
   int subdivisions = 8;  ///< [net] subdivisions: the batch runs in this many forward/backward passes, divides batch

@@ -23,8 +23,8 @@ struct ValOptions {
   /// Network input size, as the detector's model.input_size (detector::InputSize::parse): auto fits the cfg's size
   /// to each image's aspect (640x512 for Halmstad's 640x512 frames), cfg keeps the cfg's, WxH is that size.
   std::string input_size = "auto";
-  int class_id = 0;             ///< the class evaluated (truths of other classes are ignored), >= 0
-  int max_images = 0;           ///< evaluate at most this many images, spread evenly over the split (0 = all), >= 0
+  int class_id = 0;    ///< the class evaluated (truths of other classes are ignored), >= 0
+  int max_images = 0;  ///< evaluate at most this many images, spread evenly over the split (0 = all), >= 0
   /// The detector's Algorithm 2 settings. p_thresh is low (0.005) so that the PR curve and AP see nearly every
   /// box; the operating point of the counts is metrics.conf_thresh (the detector's default p_thresh, 0.2).
   detector::DetectorPipelineOptions detection = low_threshold_detection();
@@ -39,9 +39,9 @@ struct ValOptions {
 /// Evaluates one split: for each image (sorted by path), its truths (class class_id, in pixels) and the
 /// detector's boxes (or the prediction file's, scaled to pixels), then evaluate_detections().
 /// `progress(done, total)` (may be empty) is called after each image; `log` (may be empty) gets one line per
-/// network built (which backend, at which input size). Throws std::invalid_argument listing invalid options; DatasetError naming the file
-/// for bad labels, a missing or bad prediction file, an unreadable image, or two images with the same stem in
-/// predictions mode; std::runtime_error from loading the model.
+/// network built (which backend, at which input size). Throws std::invalid_argument listing invalid options;
+/// DatasetError naming the file for bad labels, a missing or bad prediction file, an unreadable image, or two images
+/// with the same stem in predictions mode; std::runtime_error from loading the model.
 DetectionMetrics run_val(const ValOptions& options, const std::function<void(size_t, size_t)>& progress = {},
                          const std::function<void(const std::string&)>& log = {});
 
