@@ -8,6 +8,7 @@
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
 #include <wingman/detector/detection_pipeline.hpp>
+#include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
 #include <wingman/detector/opencl_backend.hpp>
 #include <wingman/detector/opencl_device.hpp>
@@ -25,6 +26,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -67,18 +69,12 @@ std::string cpu_model_name() {
   return "(unknown)";
 }
 
-/// A size option other than "cfg" ("416" or "640x352") as width x height; {-1, -1} when malformed.
+/// A size option other than "cfg" ("416" for 416x416, or "640x352") as width x height, read as model.input_size's
+/// WxH (detector::InputSize: each side a multiple of 32, 32..4096); {-1, -1} when malformed.
 cv::Size parse_size(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  std::istringstream in(text);
-  if (!(in >> w)) return {-1, -1};
-  if (in >> x) {
-    if (x != 'x' || !(in >> h) || (in >> extra)) return {-1, -1};
-  } else {
-    h = w;
-  }
-  return {w, h};
+  const bool square = !text.empty() && text.find('x') == std::string::npos;
+  const std::optional<detector::InputSize> size = detector::InputSize::parse(square ? text + "x" + text : text);
+  return size && size->mode == detector::InputSize::Mode::kFixed ? size->fixed : cv::Size(-1, -1);
 }
 
 /// "416" for a square input, else "640x352".
@@ -207,9 +203,8 @@ std::vector<std::string> BenchDetectorOptions::validate() const {
   if (sizes.empty()) p.push_back("sizes = (empty): give at least one size");
   for (const std::string& s : sizes) {
     if (s == "cfg") continue;
-    const cv::Size net = parse_size(s);
-    if (net.width < 32 || net.width % 32 != 0 || net.height < 32 || net.height % 32 != 0)
-      p.push_back(fmt::format("sizes = {}: expected N or WxH (each a multiple of 32, >= 32) or cfg", s));
+    if (parse_size(s).width < 0)
+      p.push_back(fmt::format("sizes = {}: expected N or WxH (each a multiple of 32, 32..4096) or cfg", s));
   }
   if (threads.empty()) p.push_back("threads = (empty): give at least one thread count");
   for (const int t : threads)
