@@ -12,6 +12,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 namespace wingman::training {
 namespace {
@@ -120,6 +123,51 @@ TEST(WingmanTrain, TrainsWithOverridesThenResumes) {
   const auto refused = wingman(args);
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find("made with seed 1"), std::string::npos) << refused.err;
+}
+TEST(WingmanTrain, GrowsANetworkOnPartialWeights) {
+  testing::TempDir dir;
+  write_tiny_training_set(dir);
+  const std::vector<std::string> common = {
+      "--data", dir.file("data"), "--batch", "4", "--subdivisions", "2", "--threads", "1", "--max-batches", "2"};
+  auto args = std::vector<std::string>{"train", "--cfg", dir.file("tiny.cfg"), "--out", dir.file("out")};
+  args.insert(args.end(), common.begin(), common.end());
+  const auto first = wingman(args, 120);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  // tiny.cfg's three convolutions, then a new 1x1 one before its [region] head.
+  std::ifstream in(dir.file("tiny.cfg"));
+  std::string cfg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string head = "[region]";
+  ASSERT_NE(cfg.find(head), std::string::npos);
+  cfg.insert(cfg.find(head), "[convolutional]\nsize=1\nstride=1\npad=1\nfilters=6\nactivation=linear\n");
+  std::ofstream(dir.file("grown.cfg")) << cfg;
+
+  args = {"train",
+          "--cfg",
+          dir.file("grown.cfg"),
+          "--out",
+          dir.file("grown"),
+          "--weights",
+          dir.file("out/tiny_final.weights")};
+  args.insert(args.end(), common.begin(), common.end());
+  const auto whole = wingman(args, 120);  // without --partial-weights the file is too short for grown.cfg
+  EXPECT_EQ(whole.exit_code, 1) << whole.err;
+  EXPECT_NE(whole.err.find("tiny_final.weights"), std::string::npos) << whole.err;
+
+  args.push_back("--partial-weights");
+  const auto grown = wingman(args, 120);
+  ASSERT_EQ(grown.exit_code, 0) << grown.err;
+  EXPECT_NE(grown.err.find("the first 3 convolutional layers from " + dir.file("out/tiny_final.weights") +
+                           "; the others start random"),
+            std::string::npos)
+      << grown.err;
+  detector::DarknetModel m = detector::parse_darknet_cfg(dir.file("grown.cfg"));
+  detector::load_darknet_weights(m, dir.file("grown/grown_final.weights"));
+  EXPECT_EQ(m.seen, 8u);  // 2 iterations x 4 images: the count restarts for the grown network
+
+  args = {"train", "--cfg", dir.file("tiny.cfg"), "--data", dir.file("data"), "--partial-weights"};
+  const auto alone = wingman(args);  // --partial-weights needs --weights
+  EXPECT_EQ(alone.exit_code, 2) << alone.err;
+  EXPECT_NE(alone.err.find("init_partial"), std::string::npos) << alone.err;
 }
 #else
 TEST(WingmanTrain, SaysHowToGetTheTrainer) {
