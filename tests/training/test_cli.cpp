@@ -124,6 +124,7 @@ TEST(WingmanTrain, TrainsWithOverridesThenResumes) {
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find("made with seed 1"), std::string::npos) << refused.err;
 }
+
 TEST(WingmanTrain, GrowsANetworkOnPartialWeights) {
   testing::TempDir dir;
   write_tiny_training_set(dir);
@@ -169,6 +170,7 @@ TEST(WingmanTrain, GrowsANetworkOnPartialWeights) {
   EXPECT_EQ(alone.exit_code, 2) << alone.err;
   EXPECT_NE(alone.err.find("init_partial"), std::string::npos) << alone.err;
 }
+
 #else
 TEST(WingmanTrain, SaysHowToGetTheTrainer) {
   testing::TempDir dir;
