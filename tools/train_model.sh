@@ -7,23 +7,25 @@
 # (drones on the horizon) added (stage 2), then flies eight training flights through the pipeline, takes their
 # frames with the renderer's boxes, and fine-tunes stage 2 at the cfg's 640x352 with them added (stage 3), then grows
 # the cfg's third head (stride 32, for large, close drones) on stage 3 with --partial-weights and trains the whole
-# network on the same data (stage 4). Stages 1-3 train the cfg without its third head (the section from "# Third
-# head" on cut, the first six anchors). The shipped weights are stage 4's final ones
-# (OUT/stage4/wingman-small_final.weights).
+# network on the same data (stage 4), then trains stage 4 longer with 2400 more synthetic 1280x720 images up to 30 m
+# added (stage 5). Stages 1-3 train the cfg without its third head (the section from "# Third head" on cut, the
+# first six anchors). The shipped weights are stage 5's final ones (OUT/stage5/wingman-small_final.weights).
 # Resumable: run it again after an interruption and it continues from the last checkpoint (datasets are kept once
 # complete; a finished stage is not trained again).
 #
 # Usage: tools/train_model.sh [--data DIR] [--out DIR] [--threads N] [--max-batches N] [--stage2-batches N]
 #                             [--stage3-batches N] [--stage4-batches N]
+#                             [--stage5-batches N]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
-#   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 and 3 in OUT/stage2, OUT/stage3
+#   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 to 5 in OUT/stage2 .. OUT/stage5
 #                     (default build/train-wingman-small)
 #   --threads         libtorch threads (default 2)
 #   --max-batches     stage 1 iterations (default 1500; the schedule scales with it)
 #   --stage2-batches  stage 2 iterations (default 400, the shipped model's; 0 = stage 1 only). Stage 2 starts from
 #                     stage 1's iteration-1000 weights (or its final ones when it is shorter)
 #   --stage3-batches  stage 3 iterations (default 400, the shipped model's; 0 = stop after stage 2)
-#   --stage4-batches  stage 4 iterations (default 600, the shipped model's; 0 = stop after stage 3)
+#   --stage4-batches  stage 4 iterations (default 600; 0 = stop after stage 3)
+#   --stage5-batches  stage 5 iterations (default 1000, the shipped model's; 0 = stop after stage 4)
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
 set -euo pipefail
@@ -31,7 +33,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
-stage3_batches=400 stage4_batches=600
+stage3_batches=400 stage4_batches=600 stage5_batches=1000
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -41,6 +43,7 @@ while [ $# -gt 0 ]; do
     --stage2-batches) stage2_batches="$2"; shift 2 ;;
     --stage3-batches) stage3_batches="$2"; shift 2 ;;
     --stage4-batches) stage4_batches="$2"; shift 2 ;;
+    --stage5-batches) stage5_batches="$2"; shift 2 ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -49,6 +52,7 @@ case "$max_batches" in ''|*[!0-9]*) echo "train_model: --max-batches '$max_batch
 case "$stage2_batches" in ''|*[!0-9]*) echo "train_model: --stage2-batches '$stage2_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage3_batches" in ''|*[!0-9]*) echo "train_model: --stage3-batches '$stage3_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage4_batches" in ''|*[!0-9]*) echo "train_model: --stage4-batches '$stage4_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+case "$stage5_batches" in ''|*[!0-9]*) echo "train_model: --stage5-batches '$stage5_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 halmstad_src="$src/../shared/datasets/halmstad"
 [ -d "$halmstad_src" ] || { echo "train_model: $halmstad_src is missing (the Halmstad videos)" >&2; exit 2; }
 "$bin/wingman" train --help > /dev/null 2>&1 ||
@@ -200,15 +204,41 @@ if [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
     --weights "$out/stage2/wingman-small_final.weights" --max-batches "$stage3_batches" --burn-in 30 \
     --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 40 "${resume[@]}"
 fi
-# 7. Stage 4 (the shipped weights): the shipped cfg, whose third head (stride 32; the stride-16 head sees 99 input
-# pixels, too few for a close drone) starts random on stage 3's layers (--partial-weights), the whole network trained
-# on stage 3's data at the same rate steps.
+# 7. Stage 4: the shipped cfg, whose third head (stride 32; the stride-16 head sees 99 input pixels, too few for a
+# close drone) starts random on stage 3's layers (--partial-weights), the whole network trained on stage 3's data at
+# the same rate steps.
 [ "$stage4_batches" -gt 0 ] || exit 0
-[ -f "$out/stage4/wingman-small_final.weights" ] && exit 0
-u1=$((stage4_batches / 2)) u2=$((stage4_batches * 8 / 10)) u3=$((stage4_batches * 9 / 10))
+if [ ! -f "$out/stage4/wingman-small_final.weights" ]; then
+  u1=$((stage4_batches / 2)) u2=$((stage4_batches * 8 / 10)) u3=$((stage4_batches * 9 / 10))
+  resume=()
+  [ -f "$out/stage4/checkpoint.pt" ] && resume=(--resume)
+  "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-flights.yaml" \
+    --out "$out/stage4" --weights "$out/stage3/wingman-small_final.weights" --partial-weights \
+    --max-batches "$stage4_batches" --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 \
+    "${resume[@]}"
+fi
+[ "$stage5_batches" -gt 0 ] || exit 0
+# 8. Stage 5 (the shipped weights): stage 4 trained longer, with 2400 more synthetic images added, rendered as the
+# synthetic 1280x720 test set is (the simulator's camera size, up to 30 m, antialiased) but from another seed.
+if [ ! -f "$data/synth720train/data.yaml" ]; then
+  rm -rf "$data/synth720train"
+  printf 'synth:\n  width: 1280\n  height: 720\n  range_max_m: 30.0\n  val_fraction: 0.0\n  image_format: "jpg"\n  jpeg_quality: 92\n' \
+    > "$data/synth720train.yaml"
+  "$bin/wingman" dataset synth --out "$data/synth720train" --count 2400 --seed 23 --config "$data/synth720train.yaml" \
+    --meshes "$src/../shared/meshes"
+fi
+cat > "$data/combined-s5.yaml" <<EOF
+# Stage 5 mix: stage 3's plus 2400 synthetic 1280x720 images up to 30 m; validation: the Halmstad val clips.
+path: $data
+train: [halmstad/images/train, synth/images/train, horizon/images/train, flights/images/train, synth720train/images/train]
+val: halmstad/images/val
+nc: 1
+names: [drone]
+EOF
+[ -f "$out/stage5/wingman-small_final.weights" ] && exit 0
+u1=$((stage5_batches / 2)) u2=$((stage5_batches * 8 / 10)) u3=$((stage5_batches * 9 / 10))
 resume=()
-[ -f "$out/stage4/checkpoint.pt" ] && resume=(--resume)
-exec "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-flights.yaml" \
-  --out "$out/stage4" --weights "$out/stage3/wingman-small_final.weights" --partial-weights \
-  --max-batches "$stage4_batches" --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 \
-  "${resume[@]}"
+[ -f "$out/stage5/checkpoint.pt" ] && resume=(--resume)
+exec "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-s5.yaml" \
+  --out "$out/stage5" --weights "$out/stage4/wingman-small_final.weights" --max-batches "$stage5_batches" \
+  --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${resume[@]}"
