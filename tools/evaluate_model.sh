@@ -49,9 +49,7 @@ val synth_val "$data/synth/data.yaml"
 # A synthetic 1280x720 set (the simulator's camera) up to 30 m, seed 99: never trained on.
 if [ ! -f "$data/synth720/data.yaml" ]; then
   rm -rf "$data/synth720"
-  printf 'synth:\n  width: 1280\n  height: 720\n  range_max_m: 30.0\n  val_fraction: 1.0\n  image_format: "jpg"\n  jpeg_quality: 92\n' \
-    > "$data/synth720.yaml"
-  "$bin/wingman" dataset synth --out "$data/synth720" --count 300 --seed 99 --config "$data/synth720.yaml" \
+  "$bin/wingman" dataset synth --out "$data/synth720" --count 300 --seed 99 --config "$src/config/datasets/synth720.yaml" \
     --meshes "$src/../shared/meshes"
 fi
 val synth720_val "$data/synth720/data.yaml"

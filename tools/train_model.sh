@@ -222,8 +222,9 @@ fi
 # synthetic 1280x720 test set is (the simulator's camera size, up to 30 m, antialiased) but from another seed.
 if [ ! -f "$data/synth720train/data.yaml" ]; then
   rm -rf "$data/synth720train"
-  printf 'synth:\n  width: 1280\n  height: 720\n  range_max_m: 30.0\n  val_fraction: 0.0\n  image_format: "jpg"\n  jpeg_quality: 92\n' \
-    > "$data/synth720train.yaml"
+  sed 's/^  val_fraction: .*/  val_fraction: 0.0/' "$src/config/datasets/synth720.yaml" > "$data/synth720train.yaml"
+  grep -q '^  val_fraction: 0.0$' "$data/synth720train.yaml" ||
+    { echo "train_model: config/datasets/synth720.yaml has no synth.val_fraction line to set to 0" >&2; exit 1; }
   "$bin/wingman" dataset synth --out "$data/synth720train" --count 2400 --seed 23 --config "$data/synth720train.yaml" \
     --meshes "$src/../shared/meshes"
 fi
