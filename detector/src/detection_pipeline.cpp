@@ -22,6 +22,8 @@ std::vector<std::string> DetectorPipelineOptions::validate() const {
   if (!(o_thresh >= 0.0 && o_thresh <= 1.0)) p.push_back(problem("detection.o_thresh", o_thresh, "must be in 0..1"));
   if (policy != "all" && policy != "most_confident")
     p.push_back(problem("detection.policy", policy, "must be all or most_confident"));
+  if (!(zoom_max_fraction > 0.0 && zoom_max_fraction <= 1.0))
+    p.push_back(problem("detection.zoom_max_fraction", zoom_max_fraction, "must be in (0, 1]"));
   if (max_detections < 1) p.push_back(problem("detection.max_detections", max_detections, "must be >= 1"));
   return p;
 }
@@ -64,6 +66,7 @@ DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::uniqu
   for (auto& c : candidates_) c.reserve(per_image);
   detections_.reserve(per_image);
   crops_.reserve(options_.max_detections);
+  zoomed_.reserve(options_.max_detections);
   resized_.create(net_size_, CV_8UC3);
 }
 
@@ -102,7 +105,21 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
   // Step 4: zoom-in re-detection, crops in batches.
   if (options_.zoom_in && !detections_.empty()) {
     crops_.clear();
-    for (const Box& b : detections_) crops_.push_back(zoom_crop(bgr_image.size(), net_size_, b.cx, b.cy));
+    zoomed_.clear();
+    const float max_w = static_cast<float>(options_.zoom_max_fraction) * static_cast<float>(net_size_.width);
+    const float max_h = static_cast<float>(options_.zoom_max_fraction) * static_cast<float>(net_size_.height);
+    for (size_t k = 0; k < detections_.size(); ++k) {
+      const Box& b = detections_[k];
+      if (b.w > max_w || b.h > max_h) continue;  // too large for the crop: keep the first pass's box
+      // Overlapping a more confident detection (NMS kept it at IoU <= o_thresh): likely a part of that drone, and a
+      // crop centred on a part re-detects the part with a confident box. Keep the first pass's box.
+      bool overlaps_better = false;
+      for (size_t j = 0; j < k && !overlaps_better; ++j)
+        overlaps_better = detections_[j].confidence >= b.confidence && iou(detections_[j], b) > 0.0f;
+      if (overlaps_better) continue;
+      crops_.push_back(zoom_crop(bgr_image.size(), net_size_, b.cx, b.cy));
+      zoomed_.push_back(k);
+    }
     for (size_t first = 0; first < crops_.size(); first += batch_capacity_) {
       const int count = static_cast<int>(std::min(crops_.size() - first, static_cast<size_t>(batch_capacity_)));
       for (int i = 0; i < count; ++i)
@@ -116,7 +133,7 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
           if (b.confidence > best->confidence) best = &b;
         Box refined = network_to_image(*best, crops_[first + i], net_size_);
         refined.zoom_refined = true;
-        detections_[first + i] = refined;
+        detections_[zoomed_[first + i]] = refined;
       }
     }
     non_max_suppression(detections_, o_thresh);

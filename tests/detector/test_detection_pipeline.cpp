@@ -323,6 +323,7 @@ TEST(Algorithm2, ZoomInKeepsMostConfidentRedetectionInClampedCrop) {
   std::vector<int> batches;
   DetectorPipelineOptions o;
   o.zoom_in = true;
+  o.zoom_max_fraction = 0.5;  // the boxes are 106 px wide, the crop 416: zoomed (the default 0.25 would not)
   auto p = make(o, {{{{0, 6, 12, 0, 0, 0, 0, 0.6f}}}, {{{1, 6, 6, 0, 0, 0, 0, 0.7f}, {0, 2, 3, 0, 0, 0, 0, 0.95f}}}},
                 &batches);
   auto boxes = p.detect(image_1280x720());
@@ -338,6 +339,7 @@ TEST(Algorithm2, ZoomInKeepsMostConfidentRedetectionInClampedCrop) {
 TEST(Algorithm2, ZoomInFallsBackToOriginalBoxWhenRedetectionFindsNothing) {
   DetectorPipelineOptions o;
   o.zoom_in = true;
+  o.zoom_max_fraction = 0.5;  // the boxes are 106 px wide, the crop 416: zoomed (the default 0.25 would not)
   auto p = make(o, {{{{0, 6, 6, 0, 0, 0, 0, 0.6f}}}, {{}}});
   auto boxes = p.detect(image_1280x720());
   ASSERT_EQ(boxes.size(), 1u);
@@ -346,12 +348,82 @@ TEST(Algorithm2, ZoomInFallsBackToOriginalBoxWhenRedetectionFindsNothing) {
   EXPECT_NEAR(boxes[0].confidence, 0.6f, 1e-5);
 }
 
+TEST(Algorithm2, ZoomInOnlyBoxesThatFitTheCropByZoomMaxFraction) {
+  // A small box (anchor 0 at cell (1, 1): 106 x 66 image px) and a large one (anchor 1 at cell (8, 8): 109 x 141
+  // network px = 337 x 244 image px). The crop is 416 x 416 image px: with zoom_max_fraction 0.5 (208 px) only the
+  // small box is zoomed and the large keeps its first-pass box; with 1.0 both are; with the default 0.25 (104 px)
+  // neither (the small box is 106 px wide).
+  const std::vector<Cell> first = {{0, 1, 1, 0, 0, 0, 0, 0.9f}, {1, 8, 8, 0, 0, 0, 0, 0.8f}};
+  const std::vector<Cell> in_crop = {{0, 6, 6, 0, 0, 0, 0, 0.95f}};
+  DetectorPipelineOptions o;
+  o.zoom_in = true;
+  EXPECT_DOUBLE_EQ(o.zoom_max_fraction, 0.25);  // the documented default
+  std::vector<int> batches;
+  auto unzoomed = make(o, {{first}, {in_crop, in_crop}}, &batches).detect(image_1280x720());
+  EXPECT_EQ(batches, (std::vector<int>{1}));
+  ASSERT_EQ(unzoomed.size(), 2u);
+  EXPECT_FALSE(unzoomed[0].zoom_refined);
+  EXPECT_FALSE(unzoomed[1].zoom_refined);
+
+  o.zoom_max_fraction = 0.5;
+  batches.clear();
+  auto boxes = make(o, {{first}, {in_crop}}, &batches).detect(image_1280x720());
+  EXPECT_EQ(batches, (std::vector<int>{1, 1}));
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_TRUE(boxes[0].zoom_refined);
+  EXPECT_NEAR(boxes[0].confidence, 0.95f, 1e-5);
+  EXPECT_FALSE(boxes[1].zoom_refined);
+  EXPECT_NEAR(boxes[1].confidence, 0.8f, 1e-5);
+  EXPECT_NEAR(boxes[1].cx, 8.5f * kCell * 1280 / 416, 1e-2);
+  EXPECT_NEAR(boxes[1].cy, 8.5f * kCell * 720 / 416, 1e-2);
+  EXPECT_NEAR(boxes[1].w, 3.42f * kCell * 1280 / 416, 1e-2);
+  EXPECT_NEAR(boxes[1].h, 4.41f * kCell * 720 / 416, 1e-2);
+
+  o.zoom_max_fraction = 1.0;
+  batches.clear();
+  boxes = make(o, {{first}, {in_crop, in_crop}}, &batches).detect(image_1280x720());
+  EXPECT_EQ(batches, (std::vector<int>{1, 2}));
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_TRUE(boxes[0].zoom_refined);
+  EXPECT_TRUE(boxes[1].zoom_refined);
+
+  for (const double bad : {0.0, -0.1, 1.5}) {
+    o.zoom_max_fraction = bad;
+    const auto problems = o.validate();
+    ASSERT_EQ(problems.size(), 1u) << bad;
+    EXPECT_NE(problems[0].find("detection.zoom_max_fraction"), std::string::npos) << problems[0];
+  }
+}
+
+TEST(Algorithm2, ZoomInSkipsADetectionOverlappingAMoreConfidentOne) {
+  // NMS keeps two boxes at IoU <= o_thresh: a confident one (anchor 1 at cell (6, 6): 337 x 244 image px, too large to
+  // zoom at 0.5) and a weaker small one at cell (6, 7) inside it (a part of the same drone). The weaker one is not
+  // zoomed (a crop centred on a part re-detects the part); a third box elsewhere is. One crop runs.
+  const std::vector<Cell> first = {
+      {1, 6, 6, 0, 0, 0, 0, 0.9f}, {0, 6, 7, 0, 0, 0, 0, 0.5f}, {0, 1, 1, 0, 0, 0, 0, 0.4f}};
+  DetectorPipelineOptions o;
+  o.zoom_in = true;
+  o.zoom_max_fraction = 0.5;
+  std::vector<int> batches;
+  auto boxes = make(o, {{first}, {{{0, 6, 6, 0, 0, 0, 0, 0.95f}}}}, &batches).detect(image_1280x720());
+  EXPECT_EQ(batches, (std::vector<int>{1, 1}));
+  ASSERT_EQ(boxes.size(), 3u);
+  EXPECT_TRUE(boxes[0].zoom_refined);  // the box at cell (1, 1), re-detected at 0.95
+  EXPECT_NEAR(boxes[0].confidence, 0.95f, 1e-5);
+  EXPECT_FALSE(boxes[1].zoom_refined);
+  EXPECT_NEAR(boxes[1].confidence, 0.9f, 1e-5);
+  EXPECT_FALSE(boxes[2].zoom_refined);  // the part: its first-pass box, unchanged
+  EXPECT_NEAR(boxes[2].confidence, 0.5f, 1e-5);
+  EXPECT_NEAR(boxes[2].cx, 7.5f * kCell * 1280 / 416, 1e-2);
+}
+
 TEST(Algorithm2, ZoomInCropsRunAsBatches) {
   // Three separate detections: with max_batch 2 the crops run as a batch of 2 then 1; with 8 as one batch.
   const std::vector<Cell> three = {
       {0, 1, 1, 0, 0, 0, 0, 0.9f}, {0, 6, 6, 0, 0, 0, 0, 0.8f}, {0, 11, 11, 0, 0, 0, 0, 0.7f}};
   DetectorPipelineOptions o;
   o.zoom_in = true;
+  o.zoom_max_fraction = 0.5;  // the boxes are 106 px wide, the crop 416: zoomed (the default 0.25 would not)
   std::vector<int> batches;
   make(o, {{three}}, &batches, 2).detect(image_1280x720());
   EXPECT_EQ(batches, (std::vector<int>{1, 2, 1}));

@@ -181,6 +181,8 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold (default 0.2)");
   v->add_flag("--subsquare", vo.detection.subsquare, "Detect in the centred h x h square of a wide image");
   v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
+  v->add_option("--zoom-max-fraction", vo.detection.zoom_max_fraction,
+                "Zoom in only on boxes at most this fraction of the crop's width and height (default 0.25)");
   v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
   v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
   v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");

@@ -16,10 +16,13 @@ namespace wingman::detector {
 
 /// Options of the detection pipeline (keys under `detection.` in config/detector.yaml).
 struct DetectorPipelineOptions {
-  double p_thresh = 0.2;       ///< confidence threshold: boxes with confidence < p_thresh are dropped, 0..1
-  double o_thresh = 0.2;       ///< NMS overlap threshold (Algorithm 1): IoU > o_thresh suppresses, 0..1
-  bool subsquare = false;      ///< detect in the centred h x h square of a wider image instead of the whole image
-  bool zoom_in = false;        ///< re-detect in a network-sized full-resolution crop around each detection
+  double p_thresh = 0.2;   ///< confidence threshold: boxes with confidence < p_thresh are dropped, 0..1
+  double o_thresh = 0.2;   ///< NMS overlap threshold (Algorithm 1): IoU > o_thresh suppresses, 0..1
+  bool subsquare = false;  ///< detect in the centred h x h square of a wider image instead of the whole image
+  bool zoom_in = false;    ///< re-detect in a network-sized full-resolution crop around each detection
+  /// zoom-in only for boxes at most this fraction of the crop's width and of its height (the crop is the network's
+  /// size in full-image pixels); larger boxes keep the first pass's box. (0..1]; 1 zooms every box.
+  double zoom_max_fraction = 0.25;
   std::string policy = "all";  ///< which detections to return: "all" or "most_confident"
   int max_detections = 10;     ///< at most this many boxes per image (and zoom-in crops), >= 1
 
@@ -29,6 +32,8 @@ struct DetectorPipelineOptions {
     v("detection.o_thresh", o_thresh, "non-max suppression: IoU above this suppresses the less confident box (0..1)");
     v("detection.subsquare", subsquare, "detect in the centred h x h square of a wider image (Algorithm 2)");
     v("detection.zoom_in", zoom_in, "re-detect in a full-resolution network-sized crop around each detection");
+    v("detection.zoom_max_fraction", zoom_max_fraction,
+      "zoom-in only boxes at most this fraction of the crop's width and height; larger keep the first box (0..1]");
     v("detection.policy", policy, "all or most_confident");
     v("detection.max_detections", max_detections, "at most this many boxes per image (>= 1)");
   }
@@ -42,10 +47,14 @@ struct DetectorPipelineOptions {
 ///  2. stretch the region to the network input (bilinear), run the backend, decode every head's output
 ///     (decode_region / decode_yolo) into one candidate list, keep confidence >= p_thresh;
 ///  3. non-max suppression (Algorithm 1, o_thresh); apply `policy` and `max_detections`;
-///  4. with `zoom_in`: for each kept detection, a network-sized crop of the full-resolution image centred
-///     on it and clamped inside the image (zoom_crop()); all crops run as batches of up to
+///  4. with `zoom_in`: for each kept detection whose box is at most `zoom_max_fraction` of the network's
+///     width and height (in full-image pixels: a crop could not hold a larger one with a margin) and overlaps no
+///     more confident detection (NMS keeps a part of a drone at IoU <= o_thresh, and a crop centred on the part
+///     re-detects the part), a network-sized crop of the full-resolution image
+///     centred on it and clamped inside the image (zoom_crop()); all crops run as batches of up to
 ///     backend.max_batch(); in each crop the most confident re-detection (>= p_thresh) replaces the
-///     detection (zoom_refined = true). When a crop finds nothing, the original box is kept unchanged
+///     detection (zoom_refined = true). The other detections, and those whose crop finds nothing, keep
+///     their first-pass box unchanged
 ///     (zoom_refined = false). The refined boxes go through NMS once more (two crops may find the same
 ///     drone);
 ///  5. boxes are returned in full-image pixels, most confident first.
@@ -83,6 +92,7 @@ class DetectionPipeline {
   std::vector<std::vector<Box>> candidates_;  ///< per batch slot: decoded boxes
   std::vector<Box> detections_;               ///< current detections, full-image pixels
   std::vector<cv::Rect> crops_;               ///< zoom-in crops, full-image pixels
+  std::vector<size_t> zoomed_;                ///< per crop: the index in detections_ it re-detects
   cv::Mat resized_;                           ///< resize scratch
 };
 
