@@ -103,7 +103,10 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
   for (const Box& b : candidates_[0]) detections_.push_back(network_to_image(b, roi, net_size_));
 
   // Step 4: zoom-in re-detection, crops in batches.
-  if (options_.zoom_in && !detections_.empty()) {
+  // A crop is network-sized at full resolution: when the first pass did not shrink the region in either direction,
+  // a crop would see the drone at the same scale or coarser, and zoom-in adds nothing.
+  const bool zoom_finer = roi.width > net_size_.width || roi.height > net_size_.height;
+  if (options_.zoom_in && zoom_finer && !detections_.empty()) {
     crops_.clear();
     zoomed_.clear();
     const float max_w = static_cast<float>(options_.zoom_max_fraction) * static_cast<float>(net_size_.width);

@@ -417,6 +417,26 @@ TEST(Algorithm2, ZoomInSkipsADetectionOverlappingAMoreConfidentOne) {
   EXPECT_NEAR(boxes[2].cx, 7.5f * kCell * 1280 / 416, 1e-2);
 }
 
+TEST(Algorithm2, ZoomInSkipsImagesNoLargerThanTheNetworkInput) {
+  // A 416 x 416 image on a 416 x 416 network: a crop would be the image itself, so only the first pass runs; a
+  // 416 x 600 image was shrunk vertically, so its detection is zoomed.
+  DetectorPipelineOptions o;
+  o.zoom_in = true;
+  o.zoom_max_fraction = 1.0;
+  const std::vector<std::vector<std::vector<Cell>>> script = {{{{0, 6, 6, 0, 0, 0, 0, 0.6f}}},
+                                                              {{{0, 6, 6, 0, 0, 0, 0, 0.9f}}}};
+  std::vector<int> batches;
+  auto same = make(o, script, &batches).detect(cv::Mat(416, 416, CV_8UC3, cv::Scalar(0, 0, 0)));
+  EXPECT_EQ(batches, (std::vector<int>{1}));
+  ASSERT_EQ(same.size(), 1u);
+  EXPECT_FALSE(same[0].zoom_refined);
+  batches.clear();
+  auto taller = make(o, script, &batches).detect(cv::Mat(600, 416, CV_8UC3, cv::Scalar(0, 0, 0)));
+  EXPECT_EQ(batches, (std::vector<int>{1, 1}));
+  ASSERT_EQ(taller.size(), 1u);
+  EXPECT_TRUE(taller[0].zoom_refined);
+}
+
 TEST(Algorithm2, ZoomInCropsRunAsBatches) {
   // Three separate detections: with max_batch 2 the crops run as a batch of 2 then 1; with 8 as one batch.
   const std::vector<Cell> three = {

@@ -47,7 +47,9 @@ struct DetectorPipelineOptions {
 ///  2. stretch the region to the network input (bilinear), run the backend, decode every head's output
 ///     (decode_region / decode_yolo) into one candidate list, keep confidence >= p_thresh;
 ///  3. non-max suppression (Algorithm 1, o_thresh); apply `policy` and `max_detections`;
-///  4. with `zoom_in`: for each kept detection whose box is at most `zoom_max_fraction` of the network's
+///  4. with `zoom_in`, when step 1's region is larger than the network input in width or height (otherwise a
+///     crop sees the drone at the first pass's scale or coarser, and nothing is zoomed): for each kept detection
+///     whose box is at most `zoom_max_fraction` of the network's
 ///     width and height (in full-image pixels: a crop could not hold a larger one with a margin) and overlaps no
 ///     more confident detection (NMS keeps a part of a drone at IoU <= o_thresh, and a crop centred on the part
 ///     re-detects the part), a network-sized crop of the full-resolution image
