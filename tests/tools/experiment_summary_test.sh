@@ -32,6 +32,10 @@ grep -q "^| average | 2.86 | $(printf '%.3f' "$rms") |" "$work/formation_2d/resu
 # Static sweep: the single-pass mean box-width error of the eval, as a fraction of the width.
 single=$(val "$run" "'%.4f' % r['box_width_single']['mean']")
 grep -q "^| single detection | 0.026 | $single (n = " "$work/static_sweep/results.md" || fail "sweep table: $(cat "$work/static_sweep/results.md")"
+# The zoom-in flight over every box: its re-detected and its single-pass boxes together (the same run given as both
+# flights: the eval's zoom and single counts added, the mean weighted by them).
+all=$(val "$run" "'%.4f (n = %d)' % ((r['box_width_single']['n'] * r['box_width_single']['mean'] + r['box_width_zoom']['n'] * r['box_width_zoom']['mean']) / (r['box_width_single']['n'] + r['box_width_zoom']['n']), r['box_width_single']['n'] + r['box_width_zoom']['n'])")
+grep -q "^| zoom-in flight, every box (re-detected or kept from the single pass) | — | $all |" "$work/static_sweep/results.md" || fail "sweep every-box row, want $all: $(cat "$work/static_sweep/results.md")"
 # The range scale side-on and, from the optional third flight, from behind (here the same flight: the same scale).
 k=$(val "$work/static_sweep/results.json" "'%.3f' % r['range_scale']['single']")
 kb=$(val "$work/static_sweep/results.json" "'%.3f' % r['range_scale']['behind']")
