@@ -114,11 +114,11 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
     for (size_t k = 0; k < detections_.size(); ++k) {
       const Box& b = detections_[k];
       if (b.w > max_w || b.h > max_h) continue;  // too large for the crop: keep the first pass's box
-      // Overlapping a more confident detection (NMS kept it at IoU <= o_thresh): likely a part of that drone, and a
-      // crop centred on a part re-detects the part with a confident box. Keep the first pass's box.
+      // Overlapping a more confident detection (NMS left detections_ most confident first, and kept this one at
+      // IoU <= o_thresh): likely a part of that drone, and a crop centred on a part re-detects the part with a
+      // confident box. Keep the first pass's box.
       bool overlaps_better = false;
-      for (size_t j = 0; j < k && !overlaps_better; ++j)
-        overlaps_better = detections_[j].confidence >= b.confidence && iou(detections_[j], b) > 0.0f;
+      for (size_t j = 0; j < k && !overlaps_better; ++j) overlaps_better = iou(detections_[j], b) > 0.0f;
       if (overlaps_better) continue;
       crops_.push_back(zoom_crop(bgr_image.size(), net_size_, b.cx, b.cy));
       zoomed_.push_back(k);

@@ -49,16 +49,14 @@ struct DetectorPipelineOptions {
 ///  3. non-max suppression (Algorithm 1, o_thresh); apply `policy` and `max_detections`;
 ///  4. with `zoom_in`, when step 1's region is larger than the network input in width or height (otherwise a
 ///     crop sees the drone at the first pass's scale or coarser, and nothing is zoomed): for each kept detection
-///     whose box is at most `zoom_max_fraction` of the network's
-///     width and height (in full-image pixels: a crop could not hold a larger one with a margin) and overlaps no
-///     more confident detection (NMS keeps a part of a drone at IoU <= o_thresh, and a crop centred on the part
-///     re-detects the part), a network-sized crop of the full-resolution image
-///     centred on it and clamped inside the image (zoom_crop()); all crops run as batches of up to
-///     backend.max_batch(); in each crop the most confident re-detection (>= p_thresh) replaces the
-///     detection (zoom_refined = true). The other detections, and those whose crop finds nothing, keep
-///     their first-pass box unchanged
-///     (zoom_refined = false). The refined boxes go through NMS once more (two crops may find the same
-///     drone);
+///     whose box is at most `zoom_max_fraction` of the network's width and height (in full-image pixels: a crop
+///     could not hold a larger one with a margin) and overlaps no more confident detection (NMS keeps a part of
+///     a drone at IoU <= o_thresh, and a crop centred on the part re-detects the part), a network-sized crop of
+///     the full-resolution image centred on it and clamped inside the image (zoom_crop()); all crops run as
+///     batches of up to backend.max_batch(); in each crop the most confident re-detection (>= p_thresh)
+///     replaces the detection (zoom_refined = true). The other detections, and those whose crop finds nothing,
+///     keep their first-pass box unchanged (zoom_refined = false). The refined boxes go through NMS once more
+///     (two crops may find the same drone);
 ///  5. boxes are returned in full-image pixels, most confident first.
 /// Buffers (network input batch, output tensor, box lists, resize scratch) are allocated at construction;
 /// detect() allocates only the returned vector (and a new image size's resize scratch).
