@@ -14,8 +14,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <thread>
+#include <vector>
 
 namespace {
 
@@ -47,37 +52,52 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   // The first network is built at start-up (the cfg's size, or model.input_size's WxH); with input_size auto,
   // frames of another aspect build another one when the first of them arrives.
   bool built_once = false;  // a fallback warns at start-up only; a later network for another frame size says it as info
+  // What a network build says: logged, and (with `state`) the heartbeat's detail. In real-time mode builds run on
+  // the worker thread, which queues these for the thread that owns the runtime and the log.
+  struct Note {
+    spdlog::level::level_enum level = spdlog::level::info;
+    std::string text;
+    std::string state;  ///< non-empty: the new STATE_OK detail
+  };
+  std::mutex* notes_mutex = nullptr;  // set while the worker thread runs; then notes go to `queued_notes`
+  std::vector<Note> queued_notes;
+  auto say = [&](Note note) {
+    if (notes_mutex != nullptr) {
+      std::lock_guard<std::mutex> lock(*notes_mutex);
+      queued_notes.push_back(std::move(note));
+      return;
+    }
+    spdlog::log(note.level, note.text);
+    if (!note.state.empty()) rt.status().set_state(status_t::STATE_OK, note.state);
+  };
   auto make_backend = [&](const detector::DarknetModel& sized) {
     std::string why;
     const auto t_backend = std::chrono::steady_clock::now();
     auto backend = detector::make_backend(o.backend, sized, o.opencl, o.opencl.max_batch, &why);
     const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
     const std::string net = fmt::format("network input {}x{}", sized.net.width, sized.net.height);
-    if (why.find("no usable OpenCL device") != std::string::npos && !built_once) {
-      spdlog::warn("{}; running on the CPU (chosen in {:.2f} s; {})", why, backend_s, net);  // auto fell back: once
-    } else {
-      spdlog::info("{} (chosen in {:.2f} s; {})", why, backend_s, net);
-    }
     // The heartbeat says which backend runs, and why, for as long as nothing else needs saying.
-    rt.status().set_state(status_t::STATE_OK, why);
+    if (why.find("no usable OpenCL device") != std::string::npos && !built_once) {
+      // auto fell back: warned once
+      say({spdlog::level::warn, fmt::format("{}; running on the CPU (chosen in {:.2f} s; {})", why, backend_s, net),
+           why});
+    } else {
+      say({spdlog::level::info, fmt::format("{} (chosen in {:.2f} s; {})", why, backend_s, net), why});
+    }
     built_once = true;
     return backend;
   };
   auto on_build = [&](cv::Size net, cv::Size image) {
     if (image.empty()) return;  // the start-up build: make_backend said it
-    spdlog::info("model.input_size {}: network input {}x{} for {}x{} images", input_size.to_string(), net.width,
-                 net.height, image.width, image.height);
+    say({spdlog::level::info,
+         fmt::format("model.input_size {}: network input {}x{} for {}x{} images", input_size.to_string(), net.width,
+                     net.height, image.width, image.height),
+         ""});
   };
   detector::SizedDetector pipeline(o.detection, std::move(model), input_size, make_backend, on_build);
 
-  auto detect_and_publish = [&](const image_t& img) {
-    std::string error;
-    const cv::Mat bgr = detector::image_to_bgr(img, &error);
-    if (!error.empty()) throw std::invalid_argument(error);
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<detector::Box> boxes = pipeline.detect(bgr);
-    const auto latency_us =
-        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+  // Publishes the detections of frame `img` (its header is enough) and marks it processed.
+  auto publish_detections = [&](const image_t& img, const std::vector<detector::Box>& boxes, int64_t latency_us) {
     detections_t out{};
     out.utime = img.utime;
     out.seq = img.seq;
@@ -90,6 +110,16 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     out.num_detections = static_cast<int32_t>(out.detections.size());
     rt.publish(o.output_channel, out);
     rt.status().set_last_processed_seq(img.seq);
+  };
+  auto detect_and_publish = [&](const image_t& img) {
+    std::string error;
+    const cv::Mat bgr = detector::image_to_bgr(img, &error);
+    if (!error.empty()) throw std::invalid_argument(error);
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<detector::Box> boxes = pipeline.detect(bgr);
+    publish_detections(
+        img, boxes,
+        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count());
   };
   auto validate = [limits](const image_t& img) { return common::validate_message(img, limits); };
   // Frames that never reached this process (lost at the camera, or on the bus when a receive buffer overflows)
@@ -128,29 +158,130 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
         validate);
     return rt.spin();
   }
-  // Real time: keep the newest frame; a frame superseded before it was processed is a counted drop.
-  std::optional<image_t> pending;
+  // Real time: a worker thread detects while this thread keeps reading the bus, so no frame waits in a socket
+  // buffer while a detection (or the build of a network for a new frame size) runs: every frame is received,
+  // and a frame superseded by a newer one before the worker took it is a counted drop. Only this thread touches
+  // the runtime and the log; the worker hands back what it did and wakes it.
+  struct Done {
+    image_t meta;  ///< the frame's header (no pixels)
+    std::vector<detector::Box> boxes;
+    int64_t latency_us = 0;
+    std::string error;  ///< non-empty: the frame was dropped for this reason
+  };
+  struct Shared {
+    std::mutex mutex;
+    std::condition_variable wanted;
+    std::optional<image_t> pending;  ///< the newest frame, not yet taken by the worker
+    bool stop = false;
+    std::vector<Done> done;
+    std::exception_ptr fatal;        ///< a failure that ends the process (e.g. an OpenCL error), rethrown here
+  } shared;
+  // Builds for a new frame size run on the worker: what they say is queued under the shared mutex.
+  notes_mutex = &shared.mutex;
+  rt.set_record_handler_latency(false);  // the handler only queues; the detection's time is the latency
   rt.subscribe<image_t>(
       o.input_channel,
       [&](const image_t& img) {
         count_gap(img);
-        if (pending) rt.status().item_dropped(o.input_channel, "frame superseded by a newer one while busy");
+        image_t copy = img;  // outside the lock: the worker may be taking the previous frame
+        {
+          std::lock_guard<std::mutex> lock(shared.mutex);
+          if (shared.pending) rt.status().item_dropped(o.input_channel, "frame superseded by a newer one while busy");
+          shared.pending = std::move(copy);
+        }
+        shared.wanted.notify_one();
         accounted();
-        pending = img;
       },
       validate);
-  while (rt.spin_once(100)) {
-    rt.drain();
-    if (!pending) continue;
-    const image_t img = std::move(*pending);
-    pending.reset();
-    try {
-      detect_and_publish(img);
-    } catch (const std::invalid_argument& e) {
-      rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + e.what());
-      accounted();
+  std::thread worker([&] {
+    for (;;) {
+      image_t img;
+      {
+        std::unique_lock<std::mutex> lock(shared.mutex);
+        shared.wanted.wait(lock, [&] { return shared.stop || shared.pending.has_value(); });
+        if (shared.stop) return;
+        img = std::move(*shared.pending);
+        shared.pending.reset();
+      }
+      Done d;
+      try {
+        std::string error;
+        const cv::Mat bgr = detector::image_to_bgr(img, &error);
+        if (!error.empty()) throw std::invalid_argument(error);
+        const auto t0 = std::chrono::steady_clock::now();
+        d.boxes = pipeline.detect(bgr);
+        d.latency_us =
+            std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+      } catch (const std::invalid_argument& e) {
+        d.error = e.what();
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(shared.mutex);
+        shared.fatal = std::current_exception();
+        rt.wake();
+        return;
+      }
+      std::vector<uint8_t>().swap(img.data);  // the header is all the publisher needs
+      d.meta = std::move(img);
+      {
+        std::lock_guard<std::mutex> lock(shared.mutex);
+        shared.done.push_back(std::move(d));
+      }
+      rt.wake();
     }
+  });
+  auto stop_worker = [&] {
+    {
+      std::lock_guard<std::mutex> lock(shared.mutex);
+      shared.stop = true;
+    }
+    shared.wanted.notify_one();
+    if (worker.joinable()) worker.join();
+  };
+  // Publishes what the worker finished, in order; rethrows its fatal error (after stopping it).
+  auto collect = [&] {
+    std::vector<Done> done;
+    std::vector<Note> notes;
+    std::exception_ptr fatal;
+    {
+      std::lock_guard<std::mutex> lock(shared.mutex);
+      done.swap(shared.done);
+      notes.swap(queued_notes);
+      fatal = shared.fatal;
+    }
+    for (const Note& note : notes) {
+      spdlog::log(note.level, note.text);
+      if (!note.state.empty()) rt.status().set_state(status_t::STATE_OK, note.state);
+    }
+    for (const Done& d : done) {
+      if (!d.error.empty()) {
+        rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + d.error);
+        ++drops_accounted;  // this drop is not a message the runtime rejected: keep it out of the next gap
+        continue;
+      }
+      publish_detections(d.meta, d.boxes, d.latency_us);
+      rt.status().record_latency_ms(static_cast<double>(d.latency_us) / 1000.0);
+    }
+    if (fatal) {
+      stop_worker();
+      std::rethrow_exception(fatal);
+    }
+  };
+  try {
+    while (rt.spin_once(100)) collect();
+  } catch (...) {
+    stop_worker();
+    throw;
   }
+  // Stopping: a frame still waiting is dropped and counted; the one being detected is finished and published.
+  {
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    if (shared.pending)
+      rt.status().item_dropped(o.input_channel, fmt::format("channel {}: frame seq {} not processed: stopping",
+                                                            o.input_channel, shared.pending->seq));
+    shared.pending.reset();
+  }
+  stop_worker();
+  collect();
   return rt.shutdown();
 }
 

@@ -31,7 +31,19 @@ file: {path: "$video", mode: realtime, loop: false}
 YAML
 echo "demo: playing $video through wingman-camera-driver"
 "$bin/wingman-camera-driver" --config "$out/camera_driver.yaml" --lcm-url "$url" --status-period 0.5
-sleep 1.2   # one more heartbeat from every process
+# The detector may still be working on the last frames (or building a network for the clip's frame size): wait, at
+# most 60 s, until its heartbeat has every frame accounted for (detected or counted as dropped), then one more
+# heartbeat from every process.
+for _ in $(seq 120); do
+  info=$("$bin/wingman" loginfo "$log" 2>/dev/null || true)
+  images=$(sed -nE 's/^IMAGE_CAM0 +image_t +([0-9]+) .*/\1/p' <<<"$info")
+  dets=$(sed -nE 's/^DETECTIONS_CAM0 +detections_t +([0-9]+) .*/\1/p' <<<"$info")
+  handled=$(sed -nE 's/^  detector +[A-Z]+ .*handled ([0-9]+), drops ([0-9]+).*/\1/p' <<<"$info")
+  drops=$(sed -nE 's/^  detector +[A-Z]+ .*handled ([0-9]+), drops ([0-9]+).*/\2/p' <<<"$info")
+  [ -n "$images" ] && [ "${handled:-0}" -ge "$images" ] && [ $((${dets:-0} + ${drops:-0})) -ge "$images" ] && break
+  sleep 0.5
+done
+sleep 1.2
 cleanup
 pids=()
 trap - EXIT

@@ -7,12 +7,16 @@
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <poll.h>
+#include <sys/eventfd.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <cstdlib>
 #include <iostream>
 
@@ -87,6 +91,8 @@ Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
       status_channel_(status_channel(instance_)),
       status_(instance_, static_cast<int32_t>(getpid())) {
   install_signal_handlers();
+  wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd_ < 0) throw std::runtime_error(fmt::format("cannot create the wake-up eventfd: {}", std::strerror(errno)));
   const std::string in_url = options_.lcm_in.empty() ? options_.lcm_url : options_.lcm_in;
   const std::string out_url = options_.lcm_out.empty() ? options_.lcm_url : options_.lcm_out;
   input_is_file_ = is_file_url(in_url);
@@ -106,7 +112,15 @@ Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
   spdlog::debug("lcm in '{}', out '{}', status on {}", in_url, out_url, status_channel_);
 }
 
-Runtime::~Runtime() = default;
+Runtime::~Runtime() {
+  if (wake_fd_ >= 0) close(wake_fd_);
+}
+
+void Runtime::wake() {
+  const uint64_t one = 1;
+  // EAGAIN means the counter is already non-zero: a wake-up is pending either way.
+  [[maybe_unused]] const ssize_t n = write(wake_fd_, &one, sizeof one);
+}
 
 bool Runtime::stop_requested() const {
   // A process that asks has a loop that honours the answer: start-up is over (see on_signal).
@@ -164,9 +178,18 @@ bool Runtime::spin_once(int timeout_ms) {
       stop_reason_ = "end of input log";
     }
   } else {
-    const int rc = in.handleTimeout(timeout_ms);
-    if (rc < 0 && !stop_requested()) {
-      throw std::runtime_error("LCM input failed while waiting for messages");
+    // Wait for LCM's descriptor or a wake(); then handle what is there without blocking again.
+    pollfd fds[2] = {{in.getFileno(), POLLIN, 0}, {wake_fd_, POLLIN, 0}};
+    const int ready = poll(fds, 2, std::max(0, timeout_ms));
+    if (ready < 0 && errno != EINTR) throw std::runtime_error(fmt::format("poll on the LCM input failed: {}",
+                                                                          std::strerror(errno)));
+    if (ready > 0 && (fds[1].revents & POLLIN) != 0) {
+      uint64_t count = 0;
+      [[maybe_unused]] const ssize_t n = read(wake_fd_, &count, sizeof count);
+    }
+    if (ready > 0 && fds[0].revents != 0 && !stop_requested()) {
+      if (in.handleTimeout(0) < 0 && !stop_requested())
+        throw std::runtime_error("LCM input failed while waiting for messages");
     }
   }
   heartbeat_if_due();

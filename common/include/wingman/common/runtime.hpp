@@ -48,7 +48,9 @@ struct RuntimeOptions {
 /// Channel on which process instance `instance` publishes its status_t: "STATUS_" + upper case.
 std::string status_channel(const std::string& instance);
 
-/// LCM I/O and bookkeeping for one process. Single-threaded: handlers run inside spin_once().
+/// LCM I/O and bookkeeping for one process. Single-threaded: handlers run inside spin_once(), and every member
+/// but wake() is for the thread that spins. A process that works on another thread (the real-time detector)
+/// hands its results back to that thread and calls wake() so they are published without waiting for a message.
 class Runtime {
  public:
   /// Opens the LCM URLs and installs SIGINT/SIGTERM handlers. Throws std::runtime_error naming the
@@ -83,6 +85,12 @@ class Runtime {
   /// that keeps only the newest input calls it before working, so stale inputs are superseded.
   /// Returns the number handled. Not for file inputs (there every message is handled in turn).
   int drain(int max_messages = 1000);
+  /// Makes the spin_once() in progress, or the next one, return before its timeout (its messages handled first).
+  /// The one member that may be called from any thread.
+  void wake();
+  /// Whether subscriptions record their handler's run time as the status latency (default true). A process whose
+  /// handler only queues work (and records the work's time itself with status().record_latency_ms) turns it off.
+  void set_record_handler_latency(bool record) { record_handler_latency_ = record; }
   /// spin_once() until it returns false, then shutdown(). Returns 0.
   int spin();
   /// Sets the state to STOPPING with `reason` (default: the signal or end of input) and publishes a
@@ -136,6 +144,8 @@ class Runtime {
   std::chrono::steady_clock::time_point last_heartbeat_;
   std::string stop_reason_;
   bool stop_requested_locally_ = false;
+  bool record_handler_latency_ = true;
+  int wake_fd_ = -1;  ///< eventfd that wake() writes and spin_once() waits on beside LCM's descriptor
 };
 
 template <class Msg>
@@ -163,7 +173,8 @@ class Runtime::Subscription : public Runtime::SubscriptionBase {
       rt_->status_.input_dropped(channel_, "channel " + channel_ + ": " + e.what());
     }
     const auto t1 = std::chrono::steady_clock::now();
-    rt_->status_.record_latency_ms(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    if (rt_->record_handler_latency_)
+      rt_->status_.record_latency_ms(std::chrono::duration<double, std::milli>(t1 - t0).count());
     rt_->after_message();
   }
 
