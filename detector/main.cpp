@@ -70,10 +70,21 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     spdlog::log(note.level, note.text);
     if (!note.state.empty()) rt.status().set_state(status_t::STATE_OK, note.state);
   };
+  std::string auto_kind;  // what model.backend auto chose at start-up ("opencl" or "cpu"), for later builds
+  std::string auto_net;   // the network size it chose for, WxH
   auto make_backend = [&](const detector::DarknetModel& sized) {
     std::string why;
     const auto t_backend = std::chrono::steady_clock::now();
-    auto backend = detector::make_backend(o.backend, sized, o.opencl, o.opencl.max_batch, &why);
+    // model.backend auto chooses (and, without an OpenCL GPU, measures both) at start-up; a network for another
+    // frame size later takes the same kind without measuring again (seconds in which no frame would be detected).
+    const bool reuse = o.backend == "auto" && !auto_kind.empty();
+    auto backend = detector::make_backend(reuse ? auto_kind : o.backend, sized, o.opencl, o.opencl.max_batch, &why);
+    if (reuse) {
+      why = fmt::format("backend {} (auto: as chosen at start-up for the {} network)", backend->name(), auto_net);
+    } else if (o.backend == "auto") {
+      auto_kind = backend->name().rfind("opencl", 0) == 0 ? "opencl" : "cpu";
+      auto_net = fmt::format("{}x{}", sized.net.width, sized.net.height);
+    }
     const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
     const std::string net = fmt::format("network input {}x{}", sized.net.width, sized.net.height);
     // The heartbeat says which backend runs, and why, for as long as nothing else needs saying.

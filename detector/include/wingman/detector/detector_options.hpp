@@ -28,7 +28,8 @@ struct DetectorOptions {
   /// auto: an OpenCL GPU if there is one, else the faster of opencl and cpu here; without a usable OpenCL device
   /// (no platform, no device, kernels that fail to build) the CPU backend, with one warning saying why.
   /// opencl: OpenCL or nothing (no usable device: exit 1 with one line). cpu: OpenCV DNN.
-  /// The backend that runs, and why, is the heartbeat's detail.
+  /// The backend that runs, and why, is the heartbeat's detail. auto chooses once, at start-up: a network built
+  /// later for another frame size (model.input_size auto) takes the same kind.
   std::string backend = "auto";
   /// Network input size (InputSize::parse): auto (default) keeps the cfg's longer side and fits the other to the
   /// camera's aspect, rounded to a multiple of 32 (640x352 for 1280x720 frames, 640x512 for 640x512 ones; the
