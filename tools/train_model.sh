@@ -26,6 +26,7 @@
 #   --stage3-batches  stage 3 iterations (default 400, the shipped model's; 0 = stop after stage 2)
 #   --stage4-batches  stage 4 iterations (default 600; 0 = stop after stage 3)
 #   --stage5-batches  stage 5 iterations (default 1000, the shipped model's; 0 = stop after stage 4)
+#   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
 set -euo pipefail
@@ -33,7 +34,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
-stage3_batches=400 stage4_batches=600 stage5_batches=1000
+stage3_batches=400 stage4_batches=600 stage5_batches=1000 data_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -44,6 +45,7 @@ while [ $# -gt 0 ]; do
     --stage3-batches) stage3_batches="$2"; shift 2 ;;
     --stage4-batches) stage4_batches="$2"; shift 2 ;;
     --stage5-batches) stage5_batches="$2"; shift 2 ;;
+    --data-only) data_only=1; shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -138,7 +140,7 @@ augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 
 common=(--cfg "$out/cfg-416/wingman-small.cfg" "${augment[@]}")
 common640=(--cfg "$out/cfg-2head/wingman-small.cfg" "${augment[@]}")
 # 3. Stage 1: Table 2's rate steps, scaled to the run's length; warm-up 100 iterations.
-if [ ! -f "$out/wingman-small_final.weights" ]; then
+if [ "$data_only" = 0 ] && [ ! -f "$out/wingman-small_final.weights" ]; then
   s1=$((max_batches * 53 / 100)) s2=$((max_batches * 77 / 100)) s3=$((max_batches * 90 / 100))
   resume=()
   [ -f "$out/checkpoint.pt" ] && resume=(--resume)
@@ -147,7 +149,7 @@ if [ ! -f "$out/wingman-small_final.weights" ]; then
 fi
 [ "$stage2_batches" -gt 0 ] || exit 0
 # 4. Stage 2: fine-tune iteration 1000's weights at the rate stage 1 had there (1e-3), then Table 2's later steps.
-if [ ! -f "$out/stage2/wingman-small_final.weights" ]; then
+if [ "$data_only" = 0 ] && [ ! -f "$out/stage2/wingman-small_final.weights" ]; then
   init="$out/wingman-small_1000.weights"
   [ -f "$init" ] || init="$out/wingman-small_final.weights"
   t1=$((stage2_batches / 2)) t2=$((stage2_batches * 8 / 10)) t3=$((stage2_batches * 9 / 10))
@@ -196,7 +198,7 @@ EOF
 # 6. Stage 3 (the shipped weights): stage 2's final weights fine-tuned at the shipped input size, 640x352 (the .cfg
 # as it is: a 16:9 frame keeps 0.49 of its rows instead of the 416x416 stretch's 0.58 and 0.50 of its columns
 # instead of 0.33), at Table 2's 1e-3, 5e-4, 1e-4, 5e-5.
-if [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
+if [ "$data_only" = 0 ] && [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
   u1=$((stage3_batches / 2)) u2=$((stage3_batches * 8 / 10)) u3=$((stage3_batches * 9 / 10))
   resume=()
   [ -f "$out/stage3/checkpoint.pt" ] && resume=(--resume)
@@ -208,7 +210,7 @@ fi
 # close drone) starts random on stage 3's layers (--partial-weights), the whole network trained on stage 3's data at
 # the same rate steps.
 [ "$stage4_batches" -gt 0 ] || exit 0
-if [ ! -f "$out/stage4/wingman-small_final.weights" ]; then
+if [ "$data_only" = 0 ] && [ ! -f "$out/stage4/wingman-small_final.weights" ]; then
   u1=$((stage4_batches / 2)) u2=$((stage4_batches * 8 / 10)) u3=$((stage4_batches * 9 / 10))
   resume=()
   [ -f "$out/stage4/checkpoint.pt" ] && resume=(--resume)
@@ -236,6 +238,7 @@ val: halmstad/images/val
 nc: 1
 names: [drone]
 EOF
+[ "$data_only" = 0 ] || { echo "train_model: the datasets are ready in $data"; exit 0; }
 [ -f "$out/stage5/wingman-small_final.weights" ] && exit 0
 u1=$((stage5_batches / 2)) u2=$((stage5_batches * 8 / 10)) u3=$((stage5_batches * 9 / 10))
 resume=()
