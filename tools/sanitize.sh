@@ -79,11 +79,12 @@ build=build-tsan
 # The multi-process tests (processes talk over LCM in private network namespaces) and the tests whose code uses
 # threads: only `wingman bench` starts threads of its own (tools/src/bench.cpp); LCM's receive thread, OpenCV's
 # and PoCL's workers run inside every process.
-# The recorder runs a writer thread of its own (recorder/): its tests run here too.
-TSAN_TESTS='^(ProcessConfig|ProcessFileIo|ProcessSignals|Replay|LocalizerProcess|FollowerProcess|DetectorProcess|DetectorRealtime|RecorderTest|RecorderProcess)\.|^recorder\.|^demo\.|^sim_flight\.'
+# The recorder runs a writer thread of its own (recorder/), and the real-time detector a worker thread (Runtime::wake()
+# hands its results back): their tests run here too.
+TSAN_TESTS='^(Runtime|ProcessConfig|ProcessFileIo|ProcessSignals|Replay|LocalizerProcess|FollowerProcess|DetectorProcess|DetectorRealtime|RecorderTest|RecorderProcess)\.|^recorder\.|^demo\.|^sim_flight\.'
 tsan_targets=(wingman-camera-driver wingman-detector wingman-localizer wingman-follower-ctrl wingman-recorder wingman
   test_process_runtime test_replay test_localizer_process test_detector_process test_detector_realtime
-  test_follower_process test_recorder test_recorder_process test_recorder_disk_full)
+  test_follower_process test_recorder test_recorder_process test_recorder_disk_full test_common)
 stage "tsan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=thread -DWINGMAN_WITH_SIM=OFF \
   --log-level=WARNING
 if [[ -n ${SANITIZE_TARGETS:-} ]]; then
