@@ -26,6 +26,10 @@
 #   --stage3-batches  stage 3 iterations (default 400, the shipped model's; 0 = stop after stage 2)
 #   --stage4-batches  stage 4 iterations (default 600; 0 = stop after stage 3)
 #   --stage5-batches  stage 5 iterations (default 1000, the shipped model's; 0 = stop after stage 4)
+#   --stage6-batches  stage 6 iterations (default 0: the shipped model has no stage 6). Stage 6 trains stage 5's
+#                     final weights longer with a second set of 2400 synthetic 1280x720 images (seed 41) added
+#   --stage6-init     FILE: stage 6 starts from FILE (e.g. the shipped models/wingman-small.weights) and stages 1-5
+#                     are not trained (their datasets are still prepared: stage 6 trains on them)
 #   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
@@ -34,7 +38,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
-stage3_batches=400 stage4_batches=600 stage5_batches=1000 data_only=0
+stage3_batches=400 stage4_batches=600 stage5_batches=1000 stage6_batches=0 stage6_init="" data_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -45,6 +49,8 @@ while [ $# -gt 0 ]; do
     --stage3-batches) stage3_batches="$2"; shift 2 ;;
     --stage4-batches) stage4_batches="$2"; shift 2 ;;
     --stage5-batches) stage5_batches="$2"; shift 2 ;;
+    --stage6-batches) stage6_batches="$2"; shift 2 ;;
+    --stage6-init) stage6_init="$2"; shift 2 ;;
     --data-only) data_only=1; shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -55,6 +61,15 @@ case "$stage2_batches" in ''|*[!0-9]*) echo "train_model: --stage2-batches '$sta
 case "$stage3_batches" in ''|*[!0-9]*) echo "train_model: --stage3-batches '$stage3_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage4_batches" in ''|*[!0-9]*) echo "train_model: --stage4-batches '$stage4_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage5_batches" in ''|*[!0-9]*) echo "train_model: --stage5-batches '$stage5_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+case "$stage6_batches" in ''|*[!0-9]*) echo "train_model: --stage6-batches '$stage6_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+if [ -n "$stage6_init" ]; then
+  [ -f "$stage6_init" ] || { echo "train_model: --stage6-init '$stage6_init': no such file" >&2; exit 2; }
+  [ "$stage6_batches" -gt 0 ] || { echo "train_model: --stage6-init needs --stage6-batches > 0" >&2; exit 2; }
+  stage6_init=$(cd "$(dirname "$stage6_init")" && pwd)/$(basename "$stage6_init")
+fi
+# Stages 1-5 train unless only the data is wanted or stage 6 starts from a given file.
+train_early=1
+{ [ "$data_only" = 1 ] || [ -n "$stage6_init" ]; } && train_early=0
 halmstad_src="$src/../shared/datasets/halmstad"
 [ -d "$halmstad_src" ] || { echo "train_model: $halmstad_src is missing (the Halmstad videos)" >&2; exit 2; }
 "$bin/wingman" train --help > /dev/null 2>&1 ||
@@ -140,7 +155,7 @@ augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 
 common=(--cfg "$out/cfg-416/wingman-small.cfg" "${augment[@]}")
 common640=(--cfg "$out/cfg-2head/wingman-small.cfg" "${augment[@]}")
 # 3. Stage 1: Table 2's rate steps, scaled to the run's length; warm-up 100 iterations.
-if [ "$data_only" = 0 ] && [ ! -f "$out/wingman-small_final.weights" ]; then
+if [ "$train_early" = 1 ] && [ ! -f "$out/wingman-small_final.weights" ]; then
   s1=$((max_batches * 53 / 100)) s2=$((max_batches * 77 / 100)) s3=$((max_batches * 90 / 100))
   resume=()
   [ -f "$out/checkpoint.pt" ] && resume=(--resume)
@@ -149,7 +164,7 @@ if [ "$data_only" = 0 ] && [ ! -f "$out/wingman-small_final.weights" ]; then
 fi
 [ "$stage2_batches" -gt 0 ] || exit 0
 # 4. Stage 2: fine-tune iteration 1000's weights at the rate stage 1 had there (1e-3), then Table 2's later steps.
-if [ "$data_only" = 0 ] && [ ! -f "$out/stage2/wingman-small_final.weights" ]; then
+if [ "$train_early" = 1 ] && [ ! -f "$out/stage2/wingman-small_final.weights" ]; then
   init="$out/wingman-small_1000.weights"
   [ -f "$init" ] || init="$out/wingman-small_final.weights"
   t1=$((stage2_batches / 2)) t2=$((stage2_batches * 8 / 10)) t3=$((stage2_batches * 9 / 10))
@@ -198,7 +213,7 @@ EOF
 # 6. Stage 3 (the shipped weights): stage 2's final weights fine-tuned at the shipped input size, 640x352 (the .cfg
 # as it is: a 16:9 frame keeps 0.49 of its rows instead of the 416x416 stretch's 0.58 and 0.50 of its columns
 # instead of 0.33), at Table 2's 1e-3, 5e-4, 1e-4, 5e-5.
-if [ "$data_only" = 0 ] && [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
+if [ "$train_early" = 1 ] && [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
   u1=$((stage3_batches / 2)) u2=$((stage3_batches * 8 / 10)) u3=$((stage3_batches * 9 / 10))
   resume=()
   [ -f "$out/stage3/checkpoint.pt" ] && resume=(--resume)
@@ -210,7 +225,7 @@ fi
 # close drone) starts random on stage 3's layers (--partial-weights), the whole network trained on stage 3's data at
 # the same rate steps.
 [ "$stage4_batches" -gt 0 ] || exit 0
-if [ "$data_only" = 0 ] && [ ! -f "$out/stage4/wingman-small_final.weights" ]; then
+if [ "$train_early" = 1 ] && [ ! -f "$out/stage4/wingman-small_final.weights" ]; then
   u1=$((stage4_batches / 2)) u2=$((stage4_batches * 8 / 10)) u3=$((stage4_batches * 9 / 10))
   resume=()
   [ -f "$out/stage4/checkpoint.pt" ] && resume=(--resume)
@@ -238,11 +253,42 @@ val: halmstad/images/val
 nc: 1
 names: [drone]
 EOF
-[ "$data_only" = 0 ] || { echo "train_model: the datasets are ready in $data"; exit 0; }
-[ -f "$out/stage5/wingman-small_final.weights" ] && exit 0
-u1=$((stage5_batches / 2)) u2=$((stage5_batches * 8 / 10)) u3=$((stage5_batches * 9 / 10))
+if [ "$train_early" = 1 ] && [ ! -f "$out/stage5/wingman-small_final.weights" ]; then
+  u1=$((stage5_batches / 2)) u2=$((stage5_batches * 8 / 10)) u3=$((stage5_batches * 9 / 10))
+  resume=()
+  [ -f "$out/stage5/checkpoint.pt" ] && resume=(--resume)
+  "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-s5.yaml" \
+    --out "$out/stage5" --weights "$out/stage4/wingman-small_final.weights" --max-batches "$stage5_batches" \
+    --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${resume[@]}"
+fi
+if [ "$stage6_batches" -eq 0 ]; then
+  [ "$data_only" = 0 ] || echo "train_model: the datasets are ready in $data"
+  exit 0
+fi
+# 9. Stage 6 (not in the shipped model): stage 5 trained longer with a second set of 2400 synthetic 1280x720 images
+# (seed 41) added: the synthetic 1280x720 target is the one the model misses (models/wingman-small.md).
+if [ ! -f "$data/synth720train2/data.yaml" ]; then
+  rm -rf "$data/synth720train2"
+  "$bin/wingman" dataset synth --out "$data/synth720train2" --count 2400 --seed 41 \
+    --config "$data/synth720train.yaml" --meshes "$src/../shared/meshes"
+fi
+cat > "$data/combined-s6.yaml" <<EOF
+# Stage 6 mix: stage 5's plus 2400 more synthetic 1280x720 images up to 30 m; validation: the Halmstad val clips.
+path: $data
+train: [halmstad/images/train, synth/images/train, horizon/images/train, flights/images/train, synth720train/images/train, synth720train2/images/train]
+val: halmstad/images/val
+nc: 1
+names: [drone]
+EOF
+if [ "$data_only" = 1 ]; then
+  echo "train_model: the datasets are ready in $data"
+  exit 0
+fi
+[ -f "$out/stage6/wingman-small_final.weights" ] && exit 0
+init6="${stage6_init:-$out/stage5/wingman-small_final.weights}"
+u1=$((stage6_batches / 2)) u2=$((stage6_batches * 8 / 10)) u3=$((stage6_batches * 9 / 10))
 resume=()
-[ -f "$out/stage5/checkpoint.pt" ] && resume=(--resume)
-exec "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-s5.yaml" \
-  --out "$out/stage5" --weights "$out/stage4/wingman-small_final.weights" --max-batches "$stage5_batches" \
+[ -f "$out/stage6/checkpoint.pt" ] && resume=(--resume)
+exec "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-s6.yaml" \
+  --out "$out/stage6" --weights "$init6" --max-batches "$stage6_batches" \
   --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${resume[@]}"
