@@ -71,7 +71,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     if (!note.state.empty()) rt.status().set_state(status_t::STATE_OK, note.state);
   };
   std::string auto_kind;  // what model.backend auto chose at start-up ("opencl" or "cpu"), for later builds
-  std::string auto_net;   // the network size it chose for, WxH
+  std::string auto_why;   // why it chose so (said again for a later network)
   auto make_backend = [&](const detector::DarknetModel& sized) {
     std::string why;
     const auto t_backend = std::chrono::steady_clock::now();
@@ -80,10 +80,10 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     const bool reuse = o.backend == "auto" && !auto_kind.empty();
     auto backend = detector::make_backend(reuse ? auto_kind : o.backend, sized, o.opencl, o.opencl.max_batch, &why);
     if (reuse) {
-      why = fmt::format("backend {} (auto: as chosen at start-up for the {} network)", backend->name(), auto_net);
+      why = fmt::format("{}; kept for the {}x{} network", auto_why, sized.net.width, sized.net.height);
     } else if (o.backend == "auto") {
       auto_kind = backend->name().rfind("opencl", 0) == 0 ? "opencl" : "cpu";
-      auto_net = fmt::format("{}x{}", sized.net.width, sized.net.height);
+      auto_why = why;
     }
     const double backend_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_backend).count();
     const std::string net = fmt::format("network input {}x{}", sized.net.width, sized.net.height);
@@ -185,7 +185,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     std::optional<image_t> pending;  ///< the newest frame, not yet taken by the worker
     bool stop = false;
     std::vector<Done> done;
-    std::exception_ptr fatal;        ///< a failure that ends the process (e.g. an OpenCL error), rethrown here
+    std::exception_ptr fatal;  ///< a failure that ends the process (e.g. an OpenCL error), rethrown here
   } shared;
   // Builds for a new frame size run on the worker: what they say is queued under the shared mutex.
   notes_mutex = &shared.mutex;

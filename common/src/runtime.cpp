@@ -5,9 +5,9 @@
 #include "wingman/common/time.hpp"
 
 #include <fmt/format.h>
+#include <poll.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <poll.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -16,8 +16,8 @@
 #include <cctype>
 #include <cerrno>
 #include <csignal>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 
 namespace wingman::common {
@@ -92,7 +92,8 @@ Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
       status_(instance_, static_cast<int32_t>(getpid())) {
   install_signal_handlers();
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (wake_fd_ < 0) throw std::runtime_error(fmt::format("cannot create the wake-up eventfd: {}", std::strerror(errno)));
+  if (wake_fd_ < 0)
+    throw std::runtime_error(fmt::format("cannot create the wake-up eventfd: {}", std::strerror(errno)));
   const std::string in_url = options_.lcm_in.empty() ? options_.lcm_url : options_.lcm_in;
   const std::string out_url = options_.lcm_out.empty() ? options_.lcm_url : options_.lcm_out;
   input_is_file_ = is_file_url(in_url);
@@ -181,8 +182,8 @@ bool Runtime::spin_once(int timeout_ms) {
     // Wait for LCM's descriptor or a wake(); then handle what is there without blocking again.
     pollfd fds[2] = {{in.getFileno(), POLLIN, 0}, {wake_fd_, POLLIN, 0}};
     const int ready = poll(fds, 2, std::max(0, timeout_ms));
-    if (ready < 0 && errno != EINTR) throw std::runtime_error(fmt::format("poll on the LCM input failed: {}",
-                                                                          std::strerror(errno)));
+    if (ready < 0 && errno != EINTR)
+      throw std::runtime_error(fmt::format("poll on the LCM input failed: {}", std::strerror(errno)));
     if (ready > 0 && (fds[1].revents & POLLIN) != 0) {
       uint64_t count = 0;
       [[maybe_unused]] const ssize_t n = read(wake_fd_, &count, sizeof count);

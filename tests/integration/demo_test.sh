@@ -15,11 +15,13 @@ for p in camera_driver detector localizer follower_ctrl; do
   echo "$log" | grep -Eq "^  $p " || fail "no status from $p"
 done
 # Every frame reached the detector; in real-time mode it keeps the newest when busy (drops are counted), and the
-# shipped model's detections were published for the frames it ran on. Its last status is its periodic OK or, when
-# the logger also caught the heartbeat it sends on SIGTERM at the demo's end, STOPPING: both carry the counts.
-echo "$log" | grep -Eq "^  detector +(OK|STOPPING) .*handled 30, drops ([0-9]+)" ||
+# shipped model's detections were published for the frames it ran on. Its last status is its periodic OK; DEGRADED
+# when 3 s have passed since the clip's last frame (stale input: the demo waits for the detector to settle, and more
+# on a loaded machine); or STOPPING, when the logger also caught the heartbeat it sends on SIGTERM at the demo's end.
+# Each carries the counts. A detector that failed (ERROR) fails the test.
+echo "$log" | grep -Eq "^  detector +(OK|DEGRADED|STOPPING) .*handled 30, drops ([0-9]+)" ||
   fail "detector did not receive all 30 frames"
-drops=$(echo "$log" | sed -nE 's/^  detector +(OK|STOPPING) .*handled 30, drops ([0-9]+).*/\2/p')
+drops=$(echo "$log" | sed -nE 's/^  detector +(OK|DEGRADED|STOPPING) .*handled 30, drops ([0-9]+).*/\2/p')
 echo "$log" | grep -Eq "^DETECTIONS_CAM0 +detections_t +$((30 - drops)) " ||
   fail "expected one detections_t per frame the detector kept (30 - $drops)"
 [ -s "$out/last_frame.png" ] || fail "no snapshot written"
