@@ -258,7 +258,7 @@ def realtime(a):
         last = ok[-1] if ok else st[p][-1]
         result["processes"][p] = {"p50_ms": last["p50"], "p99_ms": last["p99"], "cpu_pct": cpu.get(p)}
         c = f"{cpu[p]:.0f}" if p in cpu else "-"
-        note = "  (real time: taking the frame off the bus; inference above)" if p.startswith("detector") else ""
+        note = "  (the detection's time, on its worker thread)" if p.startswith("detector") else ""
         print(f"  {p:16s} p50 {last['p50']:8.2f} ms  p99 {last['p99']:8.2f} ms  CPU {c:>4} %{note}")
     return finish(a, result, failures)
 
