@@ -107,8 +107,8 @@ TEST(DetectorRealtime, KeepsReadingTheBusAndBeatingWhileADetectionRuns) {
   wingman::detector::randomize_weights(model, 7);
   wingman::detector::save_darknet_weights(model, dir.file("random.weights"));
   const std::string cfg = dir.file("detector.yaml");
-  // The thesis network at 2048x1152 on the CPU: about a second per frame here (95 GFLOP), against the few
-  // milliseconds the burst below takes to publish and the heartbeat's 0.1 s.
+  // The thesis network at 2048x1152 on the CPU: 95 GFLOP per frame, far longer than the few milliseconds the burst
+  // below takes to publish and the heartbeat's 0.1 s.
   std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << dir.file("random.weights")
                      << ", backend: cpu, input_size: 2048x1152}\ninput: {mode: realtime}\n";
 
