@@ -308,6 +308,13 @@ DarknetModel parse_darknet_cfg_string(const std::string& cfg_text, const std::st
       l.truth_thresh = r.get_float("truth_thresh", l.truth_thresh);
       l.jitter = r.get_float("jitter", l.jitter);
       l.random = r.get_float("random", l.random);
+      l.iou_loss = r.get_string("iou_loss", l.iou_loss);
+      l.iou_normalizer = r.get_float("iou_normalizer", l.iou_normalizer);
+      if (l.iou_loss != "mse" && l.iou_loss != "giou" && l.iou_loss != "diou" && l.iou_loss != "ciou")
+        r.fail(r.line_of("iou_loss"),
+               fmt::format("key 'iou_loss' = '{}': expected mse, giou, diou or ciou", l.iou_loss));
+      if (!(l.iou_normalizer > 0.0f))
+        r.fail(r.line_of("iou_normalizer"), fmt::format("key 'iou_normalizer' = {}: must be > 0", l.iou_normalizer));
       if (!(l.scale_x_y >= 1.0f))
         r.fail(r.line_of("scale_x_y"), fmt::format("key 'scale_x_y' = {}: must be >= 1", l.scale_x_y));
       if (l.anchors.size() != static_cast<size_t>(2 * total))
@@ -472,6 +479,7 @@ std::string write_darknet_cfg(const DarknetModel& model) {
         if (l.scale_x_y != 1.0f) s += fmt::format("scale_x_y={}\n", l.scale_x_y);  // not a key of every Darknet
         s += fmt::format("ignore_thresh={}\ntruth_thresh={}\njitter={}\nrandom={}\n", l.ignore_thresh, l.truth_thresh,
                          l.jitter, l.random);
+        if (l.iou_loss != "mse") s += fmt::format("iou_loss={}\niou_normalizer={}\n", l.iou_loss, l.iou_normalizer);
         break;
       case LayerType::kRoute:
         s += fmt::format("layers={}\n", join_ints(l.route_layers));

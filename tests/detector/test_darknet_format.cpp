@@ -151,7 +151,7 @@ TEST(DarknetCfg, HeadTrainingKeysRoundTrip) {
       "classes=13\nobject_scale=4.5\nnoobject_scale=0.25\nclass_scale=2\ncoord_scale=3\nrescore=1\n"
       "bias_match=1\nabsolute=1\nthresh=.7\njitter=.3\nrandom=1\n"
       "[convolutional]\nfilters=18\nsize=1\n[yolo]\nmask=1,2,3\nanchors=1,2,3,4,5,6,7,8\nclasses=1\n"
-      "scale_x_y=1.05\nignore_thresh=.7\ntruth_thresh=.9\njitter=.1\nrandom=1.5\n";
+      "scale_x_y=1.05\nignore_thresh=.7\ntruth_thresh=.9\njitter=.1\nrandom=1.5\niou_loss=ciou\niou_normalizer=0.5\n";
   const DarknetModel m = parse_darknet_cfg_string(cfg, "keys.cfg");
   const DarknetModel n = parse_darknet_cfg_string(write_darknet_cfg(m), "written.cfg");
   for (const DarknetModel* x : {&m, &n}) {
@@ -174,7 +174,27 @@ TEST(DarknetCfg, HeadTrainingKeysRoundTrip) {
     EXPECT_FLOAT_EQ(yolo.truth_thresh, 0.9f);
     EXPECT_FLOAT_EQ(yolo.jitter, 0.1f);
     EXPECT_FLOAT_EQ(yolo.random, 1.5f);
+    EXPECT_EQ(yolo.iou_loss, "ciou");
+    EXPECT_FLOAT_EQ(yolo.iou_normalizer, 0.5f);
   }
+  // Without the keys: YOLOv3's squared error (and AlexeyAB Darknet's normalizer default), and none written.
+  const DarknetModel plain = parse_darknet_cfg_string(
+      "[net]\n[convolutional]\nfilters=6\nsize=1\n[yolo]\nanchors=1,1\nmask=0\nclasses=1\n", "plain.cfg");
+  EXPECT_EQ(plain.layers[1].iou_loss, "mse");
+  EXPECT_FLOAT_EQ(plain.layers[1].iou_normalizer, 0.75f);
+  EXPECT_EQ(write_darknet_cfg(plain).find("iou_"), std::string::npos);
+  // An unknown box loss, or a normalizer that is not positive, names the key and what is expected.
+  const std::string loss = message_of([] {
+    parse_darknet_cfg_string("[net]\n[convolutional]\nfilters=6\n[yolo]\nanchors=1,1\nmask=0\niou_loss=eiou\n",
+                             "l.cfg");
+  });
+  EXPECT_NE(loss.find("l.cfg:7"), std::string::npos) << loss;
+  EXPECT_NE(loss.find("'iou_loss' = 'eiou': expected mse, giou, diou or ciou"), std::string::npos) << loss;
+  const std::string norm = message_of([] {
+    parse_darknet_cfg_string(
+        "[net]\n[convolutional]\nfilters=6\n[yolo]\nanchors=1,1\nmask=0\niou_loss=giou\niou_normalizer=0\n", "n.cfg");
+  });
+  EXPECT_NE(norm.find("iou_normalizer"), std::string::npos) << norm;
   // A bad number names the key, and scale_x_y below 1 is refused.
   const std::string bad = message_of([] {
     parse_darknet_cfg_string("[net]\n[convolutional]\nfilters=6\n[region]\nanchors=1,1\nnum=1\nobject_scale=x\n",

@@ -8,6 +8,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <string>
 
 namespace wingman::training {
 namespace {
@@ -151,6 +152,87 @@ TEST(YoloLoss, HandComputedTinyCase) {
   // With ignore_thresh 0.25 the cell at (col 0, row 0) (IoU 0.30 with truth 2) leaves the no-object term.
   const LossTerms ignored = yolo_loss(raw, yolo_layer(".25"), 8, 8, truths);
   EXPECT_NEAR(ignored.noobject, 2 * std::log(2.0), 1e-6);
+}
+
+/// The same head with iou_loss = `kind` and iou_normalizer 0.5.
+detector::Layer yolo_iou_layer(const std::string& kind) {
+  const detector::DarknetModel m = detector::parse_darknet_cfg_string(
+      "[net]\nwidth=8\nheight=8\nchannels=3\n[convolutional]\nfilters=6\nsize=1\nstride=4\n"
+      "activation=linear\n[yolo]\nmask=1\nanchors=2,2, 6,3\nclasses=1\nnum=2\nignore_thresh=.5\niou_loss=" +
+          kind + "\niou_normalizer=0.5\n",
+      "yolo-iou.cfg");
+  return m.layers[1];
+}
+
+/// GIoU, DIoU and CIoU of two (cx, cy, w, h) boxes, written out plainly.
+double plain_iou_family(const std::string& kind, double ax, double ay, double aw, double ah, double bx, double by,
+                        double bw, double bh) {
+  const double iou = plain_iou(ax, ay, aw, ah, bx, by, bw, bh);
+  const double left = std::min(ax - aw / 2, bx - bw / 2), right = std::max(ax + aw / 2, bx + bw / 2);
+  const double top = std::min(ay - ah / 2, by - bh / 2), bottom = std::max(ay + ah / 2, by + bh / 2);
+  const double cw = right - left, ch = bottom - top;
+  const double inter = iou * (aw * ah + bw * bh) / (1 + iou);  // from iou = I / (A + B - I)
+  const double uni = aw * ah + bw * bh - inter;
+  if (kind == "giou") return iou - (cw * ch - uni) / (cw * ch);
+  const double diou = iou - ((ax - bx) * (ax - bx) + (ay - by) * (ay - by)) / (cw * cw + ch * ch);
+  if (kind == "diou") return diou;
+  const double v = 4 / (M_PI * M_PI) * std::pow(std::atan(bw / bh) - std::atan(aw / ah), 2);
+  return diou - v / (1 - iou + v) * v;
+}
+
+TEST(YoloLoss, IouLossesComputedByHandAndTheirGradients) {
+  // The tiny case above: the responsible prediction at col 1, row 0 of the 2 x 2 grid; anchor 1 is 6 x 3 px of the
+  // 8 x 8 input (0.75 x 0.375); truth 2 is (0.6, 0.2, 0.75, 0.375).
+  const float resp[5] = {0.2f, -0.1f, 0.3f, -0.2f, 0.5f};
+  const std::vector<std::vector<LabeledBox>> truths = {{{0, 0.3f, 0.7f, 0.25f, 0.25f}, {0, 0.6f, 0.2f, 0.75f, 0.375f}}};
+  auto make_raw = [&](int channel, float delta) {
+    torch::Tensor raw = torch::zeros({1, 6, 2, 2});
+    for (int k = 0; k < 5; ++k) raw[0][k][0][1] = resp[k] + (k == channel ? delta : 0.0f);
+    return raw.requires_grad_(true);
+  };
+  const double bx = (1 + sig(0.2)) / 2, by = (0 + sig(-0.1)) / 2, bw = 0.75 * std::exp(0.3),
+               bh = 0.375 * std::exp(-0.2);
+  const LossTerms mse = yolo_loss(make_raw(-1, 0), yolo_layer(".5"), 8, 8, truths);
+  for (const std::string kind : {"giou", "diou", "ciou"}) {
+    SCOPED_TRACE(kind);
+    const detector::Layer yolo = yolo_iou_layer(kind);
+    torch::Tensor raw = make_raw(-1, 0);
+    const LossTerms t = yolo_loss(raw, yolo, 8, 8, truths);
+    const double by_hand = 0.5 * (1 - plain_iou_family(kind, bx, by, bw, bh, 0.6, 0.2, 0.75, 0.375));
+    EXPECT_EQ(t.responsible, 1);
+    EXPECT_NEAR(t.coord, by_hand, 1e-6);
+    // The other terms are the squared-error loss's.
+    EXPECT_NEAR(t.object, mse.object, 1e-9);
+    EXPECT_NEAR(t.noobject, mse.noobject, 1e-9);
+    EXPECT_NEAR(t.cls, mse.cls, 1e-9);
+    EXPECT_NEAR(t.iou_sum, mse.iou_sum, 1e-9);
+    t.total.backward();
+    const torch::Tensor g = raw.grad();
+    // Central differences of the box term in t_x .. t_h (CIoU's alpha is held constant by the gradient, so
+    // there the difference only bounds it).
+    for (int c = 0; c < 4; ++c) {
+      const double eps = 1e-3;
+      const double up = yolo_loss(make_raw(c, eps), yolo, 8, 8, truths).coord;
+      const double down = yolo_loss(make_raw(c, -eps), yolo, 8, 8, truths).coord;
+      const double numeric = (up - down) / (2 * eps), analytic = g[0][c][0][1].item<double>();
+      if (kind == "ciou")
+        EXPECT_NEAR(analytic, numeric, 0.05 * std::abs(numeric) + 1e-3) << "channel " << c;
+      else
+        EXPECT_NEAR(analytic, numeric, 1e-3) << "channel " << c;
+    }
+    // A gradient step on the box moves the prediction towards the truth: the term falls.
+    torch::Tensor stepped = make_raw(-1, 0).detach();
+    for (int c = 0; c < 4; ++c) stepped[0][c][0][1] -= 0.5 * g[0][c][0][1];
+    stepped.requires_grad_(true);
+    EXPECT_LT(yolo_loss(stepped, yolo, 8, 8, truths).coord, t.coord);
+  }
+  // A perfect box: every variant's box term is 0.
+  torch::Tensor perfect = torch::zeros({1, 6, 2, 2});
+  // x offset 0.2 in the cell = sigma(t_x) -> t_x = logit(0.2); y offset 0.4; t_w = t_h = 0 (the anchor's shape).
+  perfect[0][0][0][1] = std::log(0.2 / 0.8);
+  perfect[0][1][0][1] = std::log(0.4 / 0.6);
+  for (const std::string kind : {"giou", "diou", "ciou"})
+    EXPECT_NEAR(yolo_loss(perfect, yolo_iou_layer(kind), 8, 8, truths).coord, 0.0, 1e-6) << kind;
 }
 
 }  // namespace

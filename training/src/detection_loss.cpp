@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <string>
 #include <tuple>
 
 namespace wingman::training {
@@ -198,6 +199,35 @@ LossTerms region_loss(const at::Tensor& raw, const detector::Layer& region,
   return out;
 }
 
+namespace {
+
+/// GIoU, DIoU or CIoU (`kind`) of boxes (x, y, w, h: centre and size) against truths (tx, ty, tw, th), elementwise;
+/// differentiable through the boxes (CIoU's alpha held constant, as in its paper and Darknet).
+at::Tensor iou_family(const at::Tensor& x, const at::Tensor& y, const at::Tensor& w, const at::Tensor& h,
+                      const at::Tensor& tx, const at::Tensor& ty, const at::Tensor& tw, const at::Tensor& th,
+                      const std::string& kind) {
+  constexpr double kEps = 1e-9;
+  const at::Tensor ax0 = x - w / 2, ax1 = x + w / 2, ay0 = y - h / 2, ay1 = y + h / 2;
+  const at::Tensor bx0 = tx - tw / 2, bx1 = tx + tw / 2, by0 = ty - th / 2, by1 = ty + th / 2;
+  const at::Tensor iw = (at::minimum(ax1, bx1) - at::maximum(ax0, bx0)).clamp_min(0.0);
+  const at::Tensor ih = (at::minimum(ay1, by1) - at::maximum(ay0, by0)).clamp_min(0.0);
+  const at::Tensor inter = iw * ih;
+  const at::Tensor uni = w * h + tw * th - inter;
+  const at::Tensor iou = inter / (uni + kEps);
+  const at::Tensor cw = at::maximum(ax1, bx1) - at::minimum(ax0, bx0);
+  const at::Tensor ch = at::maximum(ay1, by1) - at::minimum(ay0, by0);
+  if (kind == "giou") return iou - (cw * ch - uni) / (cw * ch + kEps);
+  const at::Tensor diou = iou - ((x - tx).pow(2) + (y - ty).pow(2)) / (cw.pow(2) + ch.pow(2) + kEps);
+  if (kind == "diou") return diou;
+  if (kind != "ciou") throw std::invalid_argument("iou_family: kind '" + kind + "': expected giou, diou or ciou");
+  const double k = 4.0 / (M_PI * M_PI);
+  const at::Tensor v = k * (at::atan(tw / (th + kEps)) - at::atan(w / (h + kEps))).pow(2);
+  const at::Tensor alpha = (v / (1.0 - iou + v + kEps)).detach();
+  return diou - alpha * v;
+}
+
+}  // namespace
+
 LossTerms yolo_loss(const at::Tensor& raw, const detector::Layer& yolo, int net_w, int net_h,
                     const std::vector<std::vector<LabeledBox>>& truths) {
   const HeadView v = split_head(raw, yolo, truths.size());
@@ -254,9 +284,25 @@ LossTerms yolo_loss(const at::Tensor& raw, const detector::Layer& yolo, int net_
     auto at_resp = [&](const at::Tensor& t) { return t.index({N, A, R, C}); };
     const at::Tensor x = s * at::sigmoid(at_resp(v.tx)) - 0.5 * (s - 1.0);
     const at::Tensor y = s * at::sigmoid(at_resp(v.ty)) - 0.5 * (s - 1.0);
-    coord = (at::tensor(scale) * ((x - at::tensor(xt)).pow(2) + (y - at::tensor(yt)).pow(2) +
-                                  (at_resp(v.tw) - at::tensor(twt)).pow(2) + (at_resp(v.th) - at::tensor(tht)).pow(2)))
-                .sum();
+    if (yolo.iou_loss == "mse") {
+      coord =
+          (at::tensor(scale) * ((x - at::tensor(xt)).pow(2) + (y - at::tensor(yt)).pow(2) +
+                                (at_resp(v.tw) - at::tensor(twt)).pow(2) + (at_resp(v.th) - at::tensor(tht)).pow(2)))
+              .sum();
+    } else {
+      std::vector<float> colv, rowv, tcx, tcy, tw, th;
+      for (const Assignment& r : resp) {
+        colv.push_back(static_cast<float>(r.col)), rowv.push_back(static_cast<float>(r.row));
+        tcx.push_back(r.truth.cx), tcy.push_back(r.truth.cy), tw.push_back(r.truth.w), th.push_back(r.truth.h);
+      }
+      const at::Tensor bx = (x + at::tensor(colv)) / static_cast<double>(v.w);
+      const at::Tensor by = (y + at::tensor(rowv)) / static_cast<double>(v.h);
+      const at::Tensor bw = anchor_w.index({A}) * at::exp(at_resp(v.tw).clamp(-10.0, 10.0));
+      const at::Tensor bh = anchor_h.index({A}) * at::exp(at_resp(v.th).clamp(-10.0, 10.0));
+      const at::Tensor l =
+          iou_family(bx, by, bw, bh, at::tensor(tcx), at::tensor(tcy), at::tensor(tw), at::tensor(th), yolo.iou_loss);
+      coord = static_cast<double>(yolo.iou_normalizer) * (1.0 - l).sum();
+    }
     object = at::softplus(-at_resp(v.to)).sum();
     if (v.k > 0) {
       const at::Tensor logits = v.cls.permute({0, 1, 3, 4, 2}).index({N, A, R, C});

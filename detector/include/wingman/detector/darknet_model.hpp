@@ -80,6 +80,10 @@ struct Layer {
   float truth_thresh = 1.0f;    ///< [yolo] IoU above which a prediction also learns that truth
   float jitter = 0.2f;          ///< [region]/[yolo] random crop augmentation, fraction of the image
   float random = 0.0f;          ///< [region]/[yolo] != 0: multi-scale training (Darknet resizes the network)
+  /// [yolo] box term of the loss (AlexeyAB Darknet's key): "mse" (YOLOv3's squared error on the offsets, the
+  /// default), "giou", "diou" or "ciou" (iou_normalizer * (1 - that IoU) of the predicted box with the truth).
+  std::string iou_loss = "mse";
+  float iou_normalizer = 0.75f;  ///< [yolo] weight of the giou/diou/ciou box term (AlexeyAB Darknet's default)
 };
 
 /// The [net] section: input size and the training settings (kept for the trainer).

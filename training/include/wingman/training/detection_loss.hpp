@@ -60,6 +60,12 @@ LossTerms region_loss(const at::Tensor& raw, const detector::Layer& region,
 ///   coord    = sum_resp s [(x - x_t)^2 + (y - y_t)^2 + (t_w - log(w_t net_w / p_w))^2 + (t_h - log(h_t net_h /
 ///   p_h))^2] object   = sum_resp BCE(t_o, 1) noobject = sum_other BCE(t_o, 0), leaving out predictions whose IoU with
 ///   some truth exceeds ignore_thresh cls      = sum_resp sum_c BCE(t_class_c, [c = class_t])
+/// With the layer's iou_loss giou, diou or ciou (AlexeyAB Darknet's keys) the box term is instead
+///   coord = iou_normalizer * sum_resp (1 - L(b, b_t)),  b = ((x + c_x) / W, (y + c_y) / H, w, h) the predicted box,
+/// L the generalized IoU (IoU - (|C| - |A u B|) / |C|, C the smallest box holding both), the distance IoU
+/// (IoU - d^2 / c^2: d the distance of the centres, c the diagonal of C) or the complete IoU (DIoU - alpha v,
+/// v = 4 / pi^2 (atan(w_t / h_t) - atan(w / h))^2, alpha = v / (1 - IoU + v) held constant), all in image fractions,
+/// differentiable through b (t_w and t_h clamped to +-10 inside the exponential).
 LossTerms yolo_loss(const at::Tensor& raw, const detector::Layer& yolo, int net_w, int net_h,
                     const std::vector<std::vector<LabeledBox>>& truths);
 
