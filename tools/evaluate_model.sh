@@ -14,6 +14,7 @@
 #   --cfg      default builtin:wingman-small; --weights default builtin:wingman-small (the shipped model)
 #   --out      default build/model-eval
 set -euo pipefail
+caller=$(pwd)
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
@@ -30,6 +31,9 @@ while [ $# -gt 0 ]; do
     *) echo "evaluate_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+# Relative paths are the caller's; the lists and YAML files written below need absolute ones.
+absolute() { case "$1" in /*|builtin:*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
+data=$(absolute "$data") out=$(absolute "$out") cfg=$(absolute "$cfg") weights=$(absolute "$weights")
 [ -f "$data/halmstad/data.yaml" ] || { echo "evaluate_model: $data/halmstad is missing: run tools/train_model.sh" >&2; exit 2; }
 mkdir -p "$out"
 
