@@ -122,15 +122,20 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     rt.publish(o.output_channel, out);
     rt.status().set_last_processed_seq(img.seq);
   };
-  auto detect_and_publish = [&](const image_t& img) {
+  // Runs the detector on one frame; a frame whose pixels cannot be read throws std::invalid_argument (a counted drop).
+  struct Detected {
+    std::vector<detector::Box> boxes;
+    int64_t latency_us = 0;  ///< the time detect() took (the one wall-clock field of detections_t)
+  };
+  auto detect = [&](const image_t& img) {
     std::string error;
     const cv::Mat bgr = detector::image_to_bgr(img, &error);
     if (!error.empty()) throw std::invalid_argument(error);
     const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<detector::Box> boxes = pipeline.detect(bgr);
-    publish_detections(
-        img, boxes,
-        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count());
+    Detected d;
+    d.boxes = pipeline.detect(bgr);
+    d.latency_us = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+    return d;
   };
   auto validate = [limits](const image_t& img) { return common::validate_message(img, limits); };
   // Frames that never reached this process (lost at the camera, or on the bus when a receive buffer overflows)
@@ -160,7 +165,8 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
           count_gap(img);
           accounted();
           try {
-            detect_and_publish(img);
+            const Detected d = detect(img);
+            publish_detections(img, d.boxes, d.latency_us);
           } catch (...) {
             handler_threw = true;  // the runtime drops and counts it
             throw;
@@ -175,8 +181,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   // the runtime and the log; the worker hands back what it did and wakes it.
   struct Done {
     image_t meta;  ///< the frame's header (no pixels)
-    std::vector<detector::Box> boxes;
-    int64_t latency_us = 0;
+    Detected result;
     std::string error;  ///< non-empty: the frame was dropped for this reason
   };
   struct Shared {
@@ -216,13 +221,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       }
       Done d;
       try {
-        std::string error;
-        const cv::Mat bgr = detector::image_to_bgr(img, &error);
-        if (!error.empty()) throw std::invalid_argument(error);
-        const auto t0 = std::chrono::steady_clock::now();
-        d.boxes = pipeline.detect(bgr);
-        d.latency_us =
-            std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+        d.result = detect(img);
       } catch (const std::invalid_argument& e) {
         d.error = e.what();
       } catch (...) {
@@ -269,8 +268,8 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
         ++drops_accounted;  // this drop is not a message the runtime rejected: keep it out of the next gap
         continue;
       }
-      publish_detections(d.meta, d.boxes, d.latency_us);
-      rt.status().record_latency_ms(static_cast<double>(d.latency_us) / 1000.0);
+      publish_detections(d.meta, d.result.boxes, d.result.latency_us);
+      rt.status().record_latency_ms(static_cast<double>(d.result.latency_us) / 1000.0);
     }
     if (fatal) {
       stop_worker();

@@ -15,6 +15,8 @@
 
 #include <csignal>
 #include <fstream>
+#include <memory>
+#include <vector>
 
 namespace {
 
@@ -41,26 +43,44 @@ bool spin_until(lcm::LCM& lcm, Pred done, std::chrono::seconds limit) {
   return done();
 }
 
-TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
-  wingman::testing::TempDir dir;
+/// Writes a detector config for the thesis network with random weights (seed 7) on the CPU backend in real-time
+/// mode; `model_keys` adds keys to its model section (", key: value"). Returns the config's path.
+std::string write_realtime_config(wingman::testing::TempDir& dir, const std::string& model_keys) {
   auto model = wingman::detector::parse_darknet_cfg_string(wingman::detector::builtin_thesis_cfg(), "thesis");
   wingman::detector::randomize_weights(model, 7);
   wingman::detector::save_darknet_weights(model, dir.file("random.weights"));
   const std::string cfg = dir.file("detector.yaml");
   std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << dir.file("random.weights")
-                     << ", backend: cpu}\ninput: {mode: realtime}\n";
+                     << ", backend: cpu" << model_keys << "}\ninput: {mode: realtime}\n";
+  return cfg;
+}
 
+/// Subscribes `bus` to the detector's outputs on `lcm`, starts wingman-detector with `cfg` and `status_period`
+/// on `url`, and waits up to `limit` for its first heartbeat (nullptr when none came; the test then fails).
+std::unique_ptr<wingman::testing::Child> start_detector(lcm::LCM& lcm, Bus& bus, const std::string& url,
+                                                        const std::string& cfg, const char* status_period,
+                                                        std::chrono::seconds limit) {
+  lcm.subscribe("DETECTIONS_CAM0", &Bus::on_detections, &bus);
+  lcm.subscribe("STATUS_DETECTOR", &Bus::on_status, &bus);
+  auto detector = std::make_unique<wingman::testing::Child>(
+      std::vector<std::string>{wingman::testing::bin_path("wingman-detector"), "--lcm-url", url, "--config", cfg,
+                               "--status-period", status_period});
+  EXPECT_TRUE(spin_until(
+      lcm, [&] { return bus.have_status; }, limit))
+      << detector->err();
+  if (!bus.have_status) return nullptr;
+  return detector;
+}
+
+TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
+  wingman::testing::TempDir dir;
+  const std::string cfg = write_realtime_config(dir, "");
   const std::string url = wingman::testing::netns_lcm_url();
   lcm::LCM lcm(url);
   ASSERT_TRUE(lcm.good());
   Bus bus;
-  lcm.subscribe("DETECTIONS_CAM0", &Bus::on_detections, &bus);
-  lcm.subscribe("STATUS_DETECTOR", &Bus::on_status, &bus);
-  wingman::testing::Child detector(
-      {wingman::testing::bin_path("wingman-detector"), "--lcm-url", url, "--config", cfg, "--status-period", "0.2"});
-  ASSERT_TRUE(spin_until(
-      lcm, [&] { return bus.have_status; }, 30s))
-      << detector.err();
+  const auto detector = start_detector(lcm, bus, url, cfg, "0.2", 30s);
+  ASSERT_TRUE(detector);
 
   // 20 frames at once: far faster than ~100 ms per frame on the CPU backend.
   constexpr int kFrames = 20;
@@ -85,7 +105,7 @@ TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
       },
       60s);
   ASSERT_TRUE(settled) << "handled " << bus.status.messages_handled << ", detections " << bus.detections.size()
-                       << ", drops " << bus.status.drops_total << "; " << detector.err();
+                       << ", drops " << bus.status.drops_total << "; " << detector->err();
   EXPECT_GT(bus.status.drops_total, 0) << "the detector kept up with a burst; the test proves nothing";
   EXPECT_LT(bus.detections.size(), static_cast<size_t>(kFrames));
   // The newest frame is always processed, and detections come out in order.
@@ -94,8 +114,8 @@ TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
   for (size_t i = 1; i < bus.detections.size(); ++i) EXPECT_GT(bus.detections[i].seq, bus.detections[i - 1].seq);
   EXPECT_NE(bus.status.last_error.find("superseded"), std::string::npos) << bus.status.last_error;
 
-  detector.signal(SIGTERM);
-  EXPECT_EQ(detector.wait(5s), 0) << detector.err();
+  detector->signal(SIGTERM);
+  EXPECT_EQ(detector->wait(5s), 0) << detector->err();
 }
 
 // A detection far slower than the frames come: the detector keeps reading the bus while it detects (a worker
@@ -103,26 +123,15 @@ TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
 // the frames superseded meanwhile are counted drops, and the newest is detected.
 TEST(DetectorRealtime, KeepsReadingTheBusAndBeatingWhileADetectionRuns) {
   wingman::testing::TempDir dir;
-  auto model = wingman::detector::parse_darknet_cfg_string(wingman::detector::builtin_thesis_cfg(), "thesis");
-  wingman::detector::randomize_weights(model, 7);
-  wingman::detector::save_darknet_weights(model, dir.file("random.weights"));
-  const std::string cfg = dir.file("detector.yaml");
   // The thesis network at 2048x1152 on the CPU: 95 GFLOP per frame, far longer than the few milliseconds the burst
   // below takes to publish and the heartbeat's 0.1 s.
-  std::ofstream(cfg) << "model: {cfg: builtin:tiny-yolo-thesis, weights: " << dir.file("random.weights")
-                     << ", backend: cpu, input_size: 2048x1152}\ninput: {mode: realtime}\n";
-
+  const std::string cfg = write_realtime_config(dir, ", input_size: 2048x1152");
   const std::string url = wingman::testing::netns_lcm_url();
   lcm::LCM lcm(url);
   ASSERT_TRUE(lcm.good());
   Bus bus;
-  lcm.subscribe("DETECTIONS_CAM0", &Bus::on_detections, &bus);
-  lcm.subscribe("STATUS_DETECTOR", &Bus::on_status, &bus);
-  wingman::testing::Child detector(
-      {wingman::testing::bin_path("wingman-detector"), "--lcm-url", url, "--config", cfg, "--status-period", "0.1"});
-  ASSERT_TRUE(spin_until(
-      lcm, [&] { return bus.have_status; }, 60s))
-      << detector.err();
+  const auto detector = start_detector(lcm, bus, url, cfg, "0.1", 60s);
+  ASSERT_TRUE(detector);
 
   constexpr int kFrames = 30;
   wingman::image_t img{};
@@ -141,13 +150,13 @@ TEST(DetectorRealtime, KeepsReadingTheBusAndBeatingWhileADetectionRuns) {
   // detections cannot report this: it has handled one frame until that detection is out).
   const bool all_read = spin_until(
       lcm, [&] { return bus.status.messages_handled >= kFrames || !bus.detections.empty(); }, 120s);
-  ASSERT_TRUE(all_read) << detector.err();
+  ASSERT_TRUE(all_read) << detector->err();
   EXPECT_EQ(bus.status.messages_handled, kFrames);
   EXPECT_TRUE(bus.detections.empty()) << "the heartbeat came only after a detection: the bus was not read meanwhile";
   const bool settled = spin_until(
       lcm, [&] { return static_cast<int64_t>(bus.detections.size()) + bus.status.drops_total >= kFrames; }, 120s);
   ASSERT_TRUE(settled) << "handled " << bus.status.messages_handled << " of " << kFrames << ", detections "
-                       << bus.detections.size() << ", drops " << bus.status.drops_total << "; " << detector.err();
+                       << bus.detections.size() << ", drops " << bus.status.drops_total << "; " << detector->err();
   EXPECT_EQ(bus.status.messages_handled, kFrames);
   EXPECT_EQ(static_cast<int64_t>(bus.detections.size()) + bus.status.drops_total, kFrames);
   // The worker took the first frame (0, unless a newer one came before it woke); the rest but the newest were
@@ -161,8 +170,8 @@ TEST(DetectorRealtime, KeepsReadingTheBusAndBeatingWhileADetectionRuns) {
   EXPECT_GT(bus.status.latency_p50_ms, 1.0);
   EXPECT_NE(bus.status.last_error.find("superseded"), std::string::npos) << bus.status.last_error;
 
-  detector.signal(SIGTERM);
-  EXPECT_EQ(detector.wait(30s), 0) << detector.err();
+  detector->signal(SIGTERM);
+  EXPECT_EQ(detector->wait(30s), 0) << detector->err();
 }
 
 }  // namespace
