@@ -15,7 +15,8 @@
 #
 # Usage: tools/train_model.sh [--data DIR] [--out DIR] [--threads N] [--max-batches N] [--stage2-batches N]
 #                             [--stage3-batches N] [--stage4-batches N]
-#                             [--stage5-batches N]
+#                             [--stage5-batches N] [--stage6-batches N] [--stage6-init FILE]
+#                             [--stage6-iou-loss KIND] [--stage6-iou-normalizer X] [--data-only]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
 #   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 to 5 in OUT/stage2 .. OUT/stage5
 #                     (default build/train-wingman-small)
@@ -30,6 +31,9 @@
 #                     final weights longer with a second set of 2400 synthetic 1280x720 images (seed 41) added
 #   --stage6-init     FILE: stage 6 starts from FILE (e.g. the shipped models/wingman-small.weights) and stages 1-5
 #                     are not trained (their datasets are still prepared: stage 6 trains on them)
+#   --stage6-iou-loss KIND: stage 6's [yolo] box loss, mse (default, the cfg's), giou, diou or ciou: stage 6 then
+#                     trains a copy of the cfg with iou_loss=KIND in every [yolo] section, into OUT/stage6-KIND
+#   --stage6-iou-normalizer X: that copy's iou_normalizer (default 0.75, the trainer's)
 #   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
@@ -39,6 +43,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
 stage3_batches=400 stage4_batches=600 stage5_batches=1000 stage6_batches=0 stage6_init="" data_only=0
+stage6_iou_loss=mse stage6_iou_normalizer=0.75
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -51,6 +56,8 @@ while [ $# -gt 0 ]; do
     --stage5-batches) stage5_batches="$2"; shift 2 ;;
     --stage6-batches) stage6_batches="$2"; shift 2 ;;
     --stage6-init) stage6_init="$2"; shift 2 ;;
+    --stage6-iou-loss) stage6_iou_loss="$2"; shift 2 ;;
+    --stage6-iou-normalizer) stage6_iou_normalizer="$2"; shift 2 ;;
     --data-only) data_only=1; shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -62,6 +69,8 @@ case "$stage3_batches" in ''|*[!0-9]*) echo "train_model: --stage3-batches '$sta
 case "$stage4_batches" in ''|*[!0-9]*) echo "train_model: --stage4-batches '$stage4_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage5_batches" in ''|*[!0-9]*) echo "train_model: --stage5-batches '$stage5_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage6_batches" in ''|*[!0-9]*) echo "train_model: --stage6-batches '$stage6_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+case "$stage6_iou_loss" in mse|giou|diou|ciou) ;; *) echo "train_model: --stage6-iou-loss '$stage6_iou_loss': expected mse, giou, diou or ciou" >&2; exit 2 ;; esac
+case "$stage6_iou_normalizer" in ''|*[!0-9.]*|*.*.*|.) echo "train_model: --stage6-iou-normalizer '$stage6_iou_normalizer': expected a positive number" >&2; exit 2 ;; esac
 if [ -n "$stage6_init" ]; then
   [ -f "$stage6_init" ] || { echo "train_model: --stage6-init '$stage6_init': no such file" >&2; exit 2; }
   [ "$stage6_batches" -gt 0 ] || { echo "train_model: --stage6-init needs --stage6-batches > 0" >&2; exit 2; }
@@ -284,11 +293,23 @@ if [ "$data_only" = 1 ]; then
   echo "train_model: the datasets are ready in $data"
   exit 0
 fi
-[ -f "$out/stage6/wingman-small_final.weights" ] && exit 0
+# The box loss: the cfg itself (mse) or a copy with iou_loss/iou_normalizer in every [yolo] section.
+cfg6="$src/models/wingman-small.cfg" out6="$out/stage6"
+if [ "$stage6_iou_loss" != mse ]; then
+  out6="$out/stage6-$stage6_iou_loss"
+  [ "$stage6_iou_normalizer" = 0.75 ] || out6="$out6-$stage6_iou_normalizer"
+  mkdir -p "$out6"
+  cfg6="$out6/wingman-small-$stage6_iou_loss.cfg"
+  sed "s/^\[yolo\]\$/[yolo]\niou_loss=$stage6_iou_loss\niou_normalizer=$stage6_iou_normalizer/" \
+    "$src/models/wingman-small.cfg" > "$cfg6"
+  [ "$(grep -c "^iou_loss=$stage6_iou_loss\$" "$cfg6")" = "$(grep -c '^\[yolo\]$' "$src/models/wingman-small.cfg")" ] ||
+    { echo "train_model: could not write iou_loss into every [yolo] section of $cfg6" >&2; exit 1; }
+fi
+[ -f "$out6/wingman-small_final.weights" ] && exit 0
 init6="${stage6_init:-$out/stage5/wingman-small_final.weights}"
 u1=$((stage6_batches / 2)) u2=$((stage6_batches * 8 / 10)) u3=$((stage6_batches * 9 / 10))
 resume=()
-[ -f "$out/stage6/checkpoint.pt" ] && resume=(--resume)
-exec "$bin/wingman" train --cfg "$src/models/wingman-small.cfg" "${augment[@]}" --data "$data/combined-s6.yaml" \
-  --out "$out/stage6" --weights "$init6" --max-batches "$stage6_batches" \
+[ -f "$out6/checkpoint.pt" ] && resume=(--resume)
+exec "$bin/wingman" train --cfg "$cfg6" "${augment[@]}" --data "$data/combined-s6.yaml" \
+  --out "$out6" --weights "$init6" --max-batches "$stage6_batches" \
   --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${resume[@]}"
