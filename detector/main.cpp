@@ -5,6 +5,7 @@
 #include "wingman/detector/preprocess.hpp"
 #include "wingman/detector/sized_detector.hpp"
 
+#include <wingman/common/latest_worker.hpp>
 #include <wingman/common/runtime.hpp>
 #include <wingman/common/sequence_gaps.hpp>
 
@@ -14,12 +15,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
-#include <exception>
 #include <mutex>
-#include <optional>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 namespace {
@@ -59,11 +56,12 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     std::string text;
     std::string state;  ///< non-empty: the new STATE_OK detail
   };
-  std::mutex* notes_mutex = nullptr;  // set while the worker thread runs; then notes go to `queued_notes`
+  bool queue_notes = false;  // set before the worker thread starts; then notes go to `queued_notes`
+  std::mutex notes_mutex;
   std::vector<Note> queued_notes;
   auto say = [&](Note note) {
-    if (notes_mutex != nullptr) {
-      std::lock_guard<std::mutex> lock(*notes_mutex);
+    if (queue_notes) {
+      std::lock_guard<std::mutex> lock(notes_mutex);
       queued_notes.push_back(std::move(note));
       return;
     }
@@ -184,85 +182,48 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     Detected result;
     std::string error;  ///< non-empty: the frame was dropped for this reason
   };
-  struct Shared {
-    std::mutex mutex;
-    std::condition_variable wanted;
-    std::optional<image_t> pending;  ///< the newest frame, not yet taken by the worker
-    bool stop = false;
-    std::vector<Done> done;
-    std::exception_ptr fatal;  ///< a failure that ends the process (e.g. an OpenCL error), rethrown here
-  } shared;
-  // Builds for a new frame size run on the worker: what they say is queued under the shared mutex.
-  notes_mutex = &shared.mutex;
+  // Builds for a new frame size run on the worker: what they say is queued for this thread.
+  queue_notes = true;
   rt.set_record_handler_latency(false);  // the handler only queues; the detection's time is the latency
+  // An exception other than a bad frame's (e.g. an OpenCL error) ends the worker; collect() rethrows it here.
+  common::LatestWorker<image_t, Done> worker(
+      [&](image_t& img) {
+        Done d;
+        try {
+          d.result = detect(img);
+        } catch (const std::invalid_argument& e) {
+          d.error = e.what();
+        }
+        std::vector<uint8_t>().swap(img.data);  // the header is all the publisher needs
+        d.meta = std::move(img);
+        return d;
+      },
+      [&rt] { rt.wake(); });
   rt.subscribe<image_t>(
       o.input_channel,
       [&](const image_t& img) {
         count_gap(img);
-        image_t copy = img;  // outside the lock: the worker may be taking the previous frame
-        {
-          std::lock_guard<std::mutex> lock(shared.mutex);
-          if (shared.pending) rt.status().item_dropped(o.input_channel, "frame superseded by a newer one while busy");
-          shared.pending = std::move(copy);
+        if (const auto superseded = worker.offer(img)) {  // the copy is made here, outside the worker's lock
+          rt.status().item_dropped(
+              o.input_channel, fmt::format("channel {}: frame seq {} superseded by seq {} while busy", o.input_channel,
+                                           superseded->seq, img.seq));
         }
-        shared.wanted.notify_one();
         accounted();
       },
       validate);
-  std::thread worker([&] {
-    for (;;) {
-      image_t img;
-      {
-        std::unique_lock<std::mutex> lock(shared.mutex);
-        shared.wanted.wait(lock, [&] { return shared.stop || shared.pending.has_value(); });
-        if (shared.stop) return;
-        img = std::move(*shared.pending);
-        shared.pending.reset();
-      }
-      Done d;
-      try {
-        d.result = detect(img);
-      } catch (const std::invalid_argument& e) {
-        d.error = e.what();
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(shared.mutex);
-        shared.fatal = std::current_exception();
-        rt.wake();
-        return;
-      }
-      std::vector<uint8_t>().swap(img.data);  // the header is all the publisher needs
-      d.meta = std::move(img);
-      {
-        std::lock_guard<std::mutex> lock(shared.mutex);
-        shared.done.push_back(std::move(d));
-      }
-      rt.wake();
-    }
-  });
-  auto stop_worker = [&] {
-    {
-      std::lock_guard<std::mutex> lock(shared.mutex);
-      shared.stop = true;
-    }
-    shared.wanted.notify_one();
-    if (worker.joinable()) worker.join();
-  };
-  // Publishes what the worker finished, in order; rethrows its fatal error (after stopping it).
+  // Publishes what the worker finished, in order; rethrows its failure.
   auto collect = [&] {
-    std::vector<Done> done;
     std::vector<Note> notes;
-    std::exception_ptr fatal;
     {
-      std::lock_guard<std::mutex> lock(shared.mutex);
-      done.swap(shared.done);
+      std::lock_guard<std::mutex> lock(notes_mutex);
       notes.swap(queued_notes);
-      fatal = shared.fatal;
     }
     for (const Note& note : notes) {
       spdlog::log(note.level, note.text);
       if (!note.state.empty()) rt.status().set_state(status_t::STATE_OK, note.state);
     }
-    for (const Done& d : done) {
+    auto taken = worker.take();
+    for (const Done& d : taken.results) {
       if (!d.error.empty()) {
         rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + d.error);
         ++drops_accounted;  // this drop is not a message the runtime rejected: keep it out of the next gap
@@ -271,26 +232,14 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       publish_detections(d.meta, d.result.boxes, d.result.latency_us);
       rt.status().record_latency_ms(static_cast<double>(d.result.latency_us) / 1000.0);
     }
-    if (fatal) {
-      stop_worker();
-      std::rethrow_exception(fatal);
-    }
+    if (taken.failure) std::rethrow_exception(taken.failure);
   };
-  try {
-    while (rt.spin_once(100)) collect();
-  } catch (...) {
-    stop_worker();
-    throw;
-  }
+  while (rt.spin_once(100)) collect();  // on an exception the worker's destructor stops it
   // Stopping: a frame still waiting is dropped and counted; the one being detected is finished and published.
-  {
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    if (shared.pending)
-      rt.status().item_dropped(o.input_channel, fmt::format("channel {}: frame seq {} not processed: stopping",
-                                                            o.input_channel, shared.pending->seq));
-    shared.pending.reset();
+  if (const auto waiting = worker.stop()) {
+    rt.status().item_dropped(o.input_channel, fmt::format("channel {}: frame seq {} not processed: stopping",
+                                                          o.input_channel, waiting->seq));
   }
-  stop_worker();
   collect();
   return rt.shutdown();
 }

@@ -1,13 +1,17 @@
 // SPDX-License-Identifier: MIT
 // Cost of one camera frame on the message path, per stage: frame -> image_t, encode (publish side),
-// decode + validate (subscriber side), and MJPEG decoding, at the resolutions the pipeline uses.
+// decode + validate (subscriber side), MJPEG decoding, and the real-time detector's handoff of a frame to its worker
+// thread and back (common::LatestWorker), at the resolutions the pipeline uses.
 // Run: build/tests/bench_message_path --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 #include <wingman/camera_driver/camera_driver.hpp>
+#include <wingman/common/latest_worker.hpp>
 #include <wingman/common/message_validation.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <condition_variable>
+#include <mutex>
 #include <random>
 
 namespace {
@@ -86,6 +90,51 @@ void BM_DecodeMjpeg(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_DecodeMjpeg)->Apply(Args);
+
+// What the real-time detector's worker does with a frame, besides detecting: keeps its header, frees its pixels.
+int64_t keep_header(wingman::image_t& img) {
+  std::vector<uint8_t>().swap(img.data);
+  return img.seq;
+}
+
+// The same frame handled inline (the replay path): the copy the handler makes, and the work above.
+void BM_HandleInline(benchmark::State& state) {
+  const wingman::image_t msg = cd::to_image_message(
+      make_frame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), cd::PixelFormat::kBgr8), 0);
+  for (auto _ : state) {
+    wingman::image_t copy = msg;
+    benchmark::DoNotOptimize(keep_header(copy));
+  }
+}
+BENCHMARK(BM_HandleInline)->Apply(Args);
+
+// One frame through the worker thread and back: the copy, offer(), the worker's wake-up, the work above, the wake
+// of the owner and take(). Against BM_HandleInline: the cost of the two thread switches.
+void BM_HandleOnWorker(benchmark::State& state) {
+  const wingman::image_t msg = cd::to_image_message(
+      make_frame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), cd::PixelFormat::kBgr8), 0);
+  std::mutex mutex;
+  std::condition_variable woken;
+  int wakes = 0;
+  wingman::common::LatestWorker<wingman::image_t, int64_t> worker(keep_header, [&] {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      ++wakes;
+    }
+    woken.notify_one();
+  });
+  int expected = 0;
+  for (auto _ : state) {
+    worker.offer(msg);
+    ++expected;
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      woken.wait(lock, [&] { return wakes >= expected; });
+    }
+    benchmark::DoNotOptimize(worker.take().results);
+  }
+}
+BENCHMARK(BM_HandleOnWorker)->Apply(Args)->UseRealTime();
 
 }  // namespace
 
