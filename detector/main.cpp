@@ -213,6 +213,9 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       validate);
   // Publishes what the worker finished, in order; rethrows its failure.
   auto collect = [&] {
+    // Results first, then the notes: a build's notes are queued before the frame's result, so each result is
+    // published after what its build said.
+    auto taken = worker.take();
     std::vector<Note> notes;
     {
       std::lock_guard<std::mutex> lock(notes_mutex);
@@ -222,7 +225,6 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       spdlog::log(note.level, note.text);
       if (!note.state.empty()) rt.status().set_state(status_t::STATE_OK, note.state);
     }
-    auto taken = worker.take();
     for (const Done& d : taken.results) {
       if (!d.error.empty()) {
         rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + d.error);
