@@ -32,7 +32,8 @@
 #   --stage6-init     FILE: stage 6 starts from FILE (e.g. the shipped models/wingman-small.weights) and stages 1-5
 #                     are not trained (their datasets are still prepared: stage 6 trains on them)
 #   --stage6-iou-loss KIND: stage 6's [yolo] box loss, mse (default, the cfg's), giou, diou or ciou: stage 6 then
-#                     trains a copy of the cfg with iou_loss=KIND in every [yolo] section, into OUT/stage6-KIND
+#                     trains a copy of the cfg with iou_loss=KIND in every [yolo] section (OUT/cfg-KIND), into
+#                     OUT/stage6-KIND (OUT/stage6-KIND-X with a normalizer X other than 0.75)
 #   --stage6-iou-normalizer X: that copy's iou_normalizer (default 0.75, the trainer's)
 #   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
@@ -294,12 +295,14 @@ if [ "$data_only" = 1 ]; then
   exit 0
 fi
 # The box loss: the cfg itself (mse) or a copy with iou_loss/iou_normalizer in every [yolo] section.
+# The copy keeps the cfg's name (as cfg-2head/ and cfg-416/ do): the trainer names its outputs after it.
 cfg6="$src/models/wingman-small.cfg" out6="$out/stage6"
 if [ "$stage6_iou_loss" != mse ]; then
-  out6="$out/stage6-$stage6_iou_loss"
-  [ "$stage6_iou_normalizer" = 0.75 ] || out6="$out6-$stage6_iou_normalizer"
-  mkdir -p "$out6"
-  cfg6="$out6/wingman-small-$stage6_iou_loss.cfg"
+  variant="$stage6_iou_loss"
+  [ "$stage6_iou_normalizer" = 0.75 ] || variant="$variant-$stage6_iou_normalizer"
+  out6="$out/stage6-$variant"
+  mkdir -p "$out/cfg-$variant"
+  cfg6="$out/cfg-$variant/wingman-small.cfg"
   sed "s/^\[yolo\]\$/[yolo]\niou_loss=$stage6_iou_loss\niou_normalizer=$stage6_iou_normalizer/" \
     "$src/models/wingman-small.cfg" > "$cfg6"
   [ "$(grep -c "^iou_loss=$stage6_iou_loss\$" "$cfg6")" = "$(grep -c '^\[yolo\]$' "$src/models/wingman-small.cfg")" ] ||

@@ -97,7 +97,8 @@ int64_t keep_header(wingman::image_t& img) {
   return img.seq;
 }
 
-// The same frame handled inline (the replay path): the copy the handler makes, and the work above.
+// The same work on the calling thread: the copy the real-time handler makes, and the work above (the replay path
+// makes no copy).
 void BM_HandleInline(benchmark::State& state) {
   const wingman::image_t msg = cd::to_image_message(
       make_frame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), cd::PixelFormat::kBgr8), 0);
