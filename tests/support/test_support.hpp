@@ -57,6 +57,18 @@ class Child {
   TempDir dir_;
 };
 
+/// The stated stop latency (docs/runtime.md: exit 0 within 1 s of SIGINT/SIGTERM), scaled for
+/// sanitizer builds: TSan/ASan slow every instruction and the process teardown several-fold, so
+/// there the bound is 3 s (CI measured 1.004 s for the recorder under TSan on a loaded machine).
+/// The promise itself is for release builds and is checked there at 1 s.
+constexpr std::chrono::milliseconds stop_latency_bound() {
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+  return std::chrono::milliseconds(3000);
+#else
+  return std::chrono::milliseconds(1000);
+#endif
+}
+
 /// Runs a command to completion (bounded); returns {exit code, stdout, stderr}. Exit code -1 = timed out (killed).
 struct RunResult {
   int exit_code;
