@@ -39,7 +39,8 @@ mkdir -p "$out"
 
 # Halmstad val, per kind of clip (lists of the val split's images, named V_<KIND>_NNN_<frame>.jpg).
 for kind in DRONE AIRPLANE BIRD HELICOPTER; do
-  ls "$data/halmstad/images/val" | grep "^V_${kind}_" | sed "s|^|$data/halmstad/images/val/|" > "$out/val_$kind.txt"
+  (shopt -s nullglob; files=("$data/halmstad/images/val/V_${kind}_"*); [ ${#files[@]} -eq 0 ] || printf '%s\n' "${files[@]}") \
+    > "$out/val_$kind.txt"
   printf 'path: %s\nval: val_%s.txt\nnc: 1\nnames: [drone]\n' "$out" "$kind" > "$out/val_$kind.yaml"
 done
 val() {  # name data.yaml [args]

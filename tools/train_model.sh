@@ -70,6 +70,16 @@ case "$stage3_batches" in ''|*[!0-9]*) echo "train_model: --stage3-batches '$sta
 case "$stage4_batches" in ''|*[!0-9]*) echo "train_model: --stage4-batches '$stage4_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage5_batches" in ''|*[!0-9]*) echo "train_model: --stage5-batches '$stage5_batches': expected an integer >= 0" >&2; exit 2 ;; esac
 case "$stage6_batches" in ''|*[!0-9]*) echo "train_model: --stage6-batches '$stage6_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+# Stages 2-6 step their rate at N/2, 8N/10 and 9N/10 iterations: those must increase, so N is 0 or at least 6.
+for pair in "stage2 $stage2_batches" "stage3 $stage3_batches" "stage4 $stage4_batches" "stage5 $stage5_batches" \
+            "stage6 $stage6_batches"; do
+  read -r stage n <<<"$pair"
+  if [ "$n" -gt 0 ] && [ "$n" -lt 6 ]; then
+    echo "train_model: --$stage-batches $n: expected 0 (skip the stage) or at least 6 (its rate steps at N/2, 8N/10 and 9N/10 must increase)" >&2
+    exit 2
+  fi
+done
+[ "$max_batches" -ge 5 ] || { echo "train_model: --max-batches $max_batches: expected at least 5 (its rate steps at 53, 77 and 90 % must increase)" >&2; exit 2; }
 case "$stage6_iou_loss" in mse|giou|diou|ciou) ;; *) echo "train_model: --stage6-iou-loss '$stage6_iou_loss': expected mse, giou, diou or ciou" >&2; exit 2 ;; esac
 case "$stage6_iou_normalizer" in ''|*[!0-9.]*|*.*.*|.) echo "train_model: --stage6-iou-normalizer '$stage6_iou_normalizer': expected a positive number" >&2; exit 2 ;; esac
 if [ -n "$stage6_init" ]; then
@@ -157,9 +167,11 @@ EOF
 # Stages 1-3: the two-head network (the shipped cfg without its third head, and with the first six anchors, so that
 # every box trains one of the two heads). Each copy keeps the name wingman-small.cfg in a folder of its own.
 mkdir -p "$out/cfg-416" "$out/cfg-2head"
+# shellcheck disable=SC2016  # sed's $ (the last line), not a shell expansion
 two_head=(-e '/^# Third head/,$d' -e 's/^anchors=.*/anchors=4,3, 6,5, 9,8, 13,13, 21,16, 34,27/' -e 's/^num=9$/num=6/')
 sed "${two_head[@]}" "$src/models/wingman-small.cfg" > "$out/cfg-2head/wingman-small.cfg"
 sed 's/^width=.*/width=416/; s/^height=.*/height=416/' "$out/cfg-2head/wingman-small.cfg" > "$out/cfg-416/wingman-small.cfg"
+# shellcheck disable=SC2054  # --scales takes one comma-separated value
 augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 --blur 0.1 --noise 0.1
   --checkpoint-interval 25 --log-interval 10 --val-max-images 400)
 common=(--cfg "$out/cfg-416/wingman-small.cfg" "${augment[@]}")
@@ -203,8 +215,8 @@ if [ ! -f "$data/flights/.complete" ]; then
       > "$data/flight-logs/$name.log" 2>&1 ||
       { echo "train_model: the training flight $name failed (log: $data/flight-logs/$name.log)" >&2; exit 1; }
     mv "$data/flight-logs/$name/flight.lcmlog" "$data/flight-logs/$name/$name.lcmlog"
-    split=train
-    [ "$k" = 7 ] && split=val
+    split="train"
+    [ "$k" = 7 ] && split="val"
     "$bin/wingman" dataset from-log "$data/flight-logs/$name/$name.lcmlog" --out "$data/flights" --split "$split" \
       --every 5
     rm -f "$data/flight-logs/$name/$name.lcmlog"
