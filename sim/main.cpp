@@ -131,9 +131,12 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
       break;
     }
     const int64_t t_k = simulator.clock().utime(simulator.next_index());
-    if (realtime) {  // pace by the wall clock, taking setpoints as they come
+    // realtime: pace by the wall clock; lockstep with a max_speed: no faster than that. Setpoints are taken as
+    // they come. Only when frames are published depends on the wall clock, never what they hold.
+    const double pace = realtime ? o.sync.speed : (lockstep ? o.sync.max_speed : 0.0);
+    if (pace > 0) {
       const auto due = wall_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                                        simulator.clock().seconds_since_start(t_k) / o.sync.speed));
+                                        simulator.clock().seconds_since_start(t_k) / pace));
       while (Clock::now() < due && !rt.stop_requested()) {
         if (input_ended || rt.input_is_file()) {
           std::this_thread::sleep_for(std::chrono::milliseconds(remaining_ms(due, 100)));

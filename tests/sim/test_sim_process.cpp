@@ -269,6 +269,66 @@ TEST(SimProcess, LockstepWithAFakeFollowerOnTheBusEqualsTheLibrary) {
   EXPECT_EQ(fake.poses, library_own_poses(f.scenario));
 }
 
+TEST(SimProcess, LockstepWithAMaxSpeedPublishesNoFasterAndStaysEqualToTheLibrary) {
+  // sync.max_speed 5: frame k (t_k - t_0 = k / 30 s) is published no earlier than k / 150 s of wall clock after the
+  // start, so the 30 frames span at least 29 / 150 s = 0.193 s, less the first frame's delivery latency (20 ms
+  // allowed: measured 26 us short once); load can only make it slower. Unpaced, the CI flight ran 600 frames in
+  // 0.23 s (~12 ms per 30).
+  // The poses do not depend on the pace.
+  Files f(
+      "sync:\n  mode: lockstep\n  timeout_s: 10\n  max_speed: 5\n  wait_for: [fake_follower]\n"
+      "  startup_timeout_s: 20\nrender:\n  enabled: false\n");
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM bus(url);
+  ASSERT_TRUE(bus.good());
+  struct Fake {
+    lcm::LCM* bus;
+    std::vector<std::vector<uint8_t>> poses;
+    std::vector<std::chrono::steady_clock::time_point> truth_seen;
+    void on_truth(const lcm::ReceiveBuffer*, const std::string&, const wingman::ground_truth_t* t) {
+      truth_seen.push_back(std::chrono::steady_clock::now());
+      const wingman::setpoint_t sp = velocity_setpoint(t->utime, fake_follower_velocity(t->utime));
+      bus->publish("SETPOINT", &sp);
+    }
+    void on_pose(const lcm::ReceiveBuffer* rb, const std::string&, const wingman::own_pose_t*) {
+      poses.emplace_back(static_cast<const uint8_t*>(rb->data), static_cast<const uint8_t*>(rb->data) + rb->data_size);
+    }
+  } fake{&bus, {}, {}};
+  bus.subscribe("GROUND_TRUTH", &Fake::on_truth, &fake);
+  bus.subscribe("OWN_POSE", &Fake::on_pose, &fake);
+
+  Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
+  wingman::status_t hb{};
+  hb.process = "fake_follower";
+  hb.state = wingman::status_t::STATE_OK;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  int exit_code = -1;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fake.truth_seen.empty()) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
+    bus.handleTimeout(50);
+    if (!sim.running()) {
+      exit_code = sim.wait(1s);
+      break;
+    }
+  }
+  while (bus.handleTimeout(100) > 0) {
+  }
+  ASSERT_EQ(exit_code, 0) << sim.err();
+  ASSERT_EQ(fake.truth_seen.size(), 30u);
+  EXPECT_GE(fake.truth_seen.back() - fake.truth_seen.front(), std::chrono::microseconds(29 * 1000000 / 150 - 20000));
+  EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
+  EXPECT_EQ(fake.poses, library_own_poses(f.scenario));
+}
+
+TEST(SimProcess, NegativeMaxSpeedIsAConfigurationErrorNamingTheKey) {
+  Files f("sync:\n  max_speed: -1\nrender:\n  enabled: false\n");
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", "memq://"},
+                     10s);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("sync.max_speed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("must be 0 (no cap) or in (0, 1e6]"), std::string::npos) << r.err;
+}
+
 TEST(SimProcess, LockstepWithoutAFollowerTimesOutCountsAndGoesOn) {
   Files f("sync:\n  mode: lockstep\n  timeout_s: 0.2\nrender:\n  enabled: false\n",
           std::string(kTinyScenario).replace(kTinyScenario.find("duration_s: 1"), 13, "duration_s: 0.1"));

@@ -42,6 +42,8 @@ std::vector<std::string> SyncOptions::validate() const {
     p.push_back(problem("sync.mode", mode, "must be lockstep, free or realtime"));
   if (!(timeout_s > 0 && timeout_s <= 3600)) p.push_back(problem("sync.timeout_s", timeout_s, "must be in (0, 3600]"));
   if (!(speed > 0 && speed <= 1000)) p.push_back(problem("sync.speed", speed, "must be in (0, 1000]"));
+  if (!(max_speed >= 0 && max_speed <= 1e6))
+    p.push_back(problem("sync.max_speed", max_speed, "must be 0 (no cap) or in (0, 1e6]"));
   if (!(startup_timeout_s > 0 && startup_timeout_s <= 3600))
     p.push_back(problem("sync.startup_timeout_s", startup_timeout_s, "must be in (0, 3600]"));
   std::set<std::string> seen;

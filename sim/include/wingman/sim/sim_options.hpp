@@ -73,6 +73,10 @@ struct SyncOptions {
   std::string mode = "lockstep";
   double timeout_s = 5.0;  ///< lockstep: longest wall-clock wait for the setpoint of a frame, s (> 0)
   double speed = 1.0;      ///< realtime: simulated seconds per wall-clock second (> 0)
+  /// lockstep: at most this many simulated seconds per wall-clock second (frame k is published no earlier than
+  /// wall_start + (t_k - t_0) / max_speed), so processes outside the loop (a logger) see a bounded message rate;
+  /// 0 = no cap (as fast as the setpoints come back). >= 0.
+  double max_speed = 0.0;
   /// Process instance names whose STATUS_<NAME> heartbeat must be seen before the first frame, e.g.
   /// [detector, localizer, follower_ctrl].
   std::vector<std::string> wait_for;
@@ -83,6 +87,7 @@ struct SyncOptions {
     v("sync.mode", mode, "lockstep (wait for each frame's SETPOINT), free (never wait) or realtime (wall clock)");
     v("sync.timeout_s", timeout_s, "lockstep: longest wall-clock wait for a frame's setpoint, s (then go on)");
     v("sync.speed", speed, "realtime: simulated seconds per wall-clock second");
+    v("sync.max_speed", max_speed, "lockstep: at most this many simulated seconds per wall-clock second (0: no cap)");
     v("sync.wait_for", wait_for, "process instances whose STATUS_<NAME> must be seen before the first frame");
     v("sync.startup_timeout_s", startup_timeout_s, "longest wait for sync.wait_for, s (then exit 1 naming them)");
   }
