@@ -322,8 +322,8 @@ TEST(SimProcess, LockstepWithAMaxSpeedPublishesNoFasterAndStaysEqualToTheLibrary
 
 TEST(SimProcess, NegativeMaxSpeedIsAConfigurationErrorNamingTheKey) {
   Files f("sync:\n  max_speed: -1\nrender:\n  enabled: false\n");
-  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", "memq://"},
-                     10s);
+  const auto r =
+      run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", "memq://"}, 10s);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("sync.max_speed"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("must be 0 (no cap) or in (0, 1e6]"), std::string::npos) << r.err;
