@@ -224,26 +224,40 @@ TEST(SimProcess, LockstepFromASetpointLogEqualsTheLibrary) {
   EXPECT_GT(mid.p_body_in_world[0], 0.1);
 }
 
-TEST(SimProcess, LockstepWithAFakeFollowerOnTheBusEqualsTheLibrary) {
-  Files f(
-      "sync:\n  mode: lockstep\n  timeout_s: 10\n  wait_for: [fake_follower]\n  startup_timeout_s: 20\n"
-      "render:\n  enabled: false\n");
+/// What a run of the simulator against a fake follower on the bus saw.
+struct FakeFollowerRun {
+  int exit_code = -1;
+  std::string err;                                                ///< the simulator's stderr
+  std::vector<std::vector<uint8_t>> poses;                        ///< OWN_POSE payloads, in order
+  std::vector<std::chrono::steady_clock::time_point> truth_seen;  ///< when each GROUND_TRUTH arrived here
+  std::vector<std::vector<uint8_t>> library_poses;                ///< library_own_poses() of the same scenario
+};
+
+/// Runs wingman-sim on the tiny scenario with `sync_yaml` (the config's sync section, which must wait_for
+/// fake_follower) on the namespace's bus; a fake follower answers each GROUND_TRUTH with its setpoint and publishes
+/// STATUS_FAKE_FOLLOWER until the first frame. Bounded: 60 s.
+FakeFollowerRun run_with_fake_follower(const std::string& sync_yaml) {
+  Files f(sync_yaml + "render:\n  enabled: false\n");
   const std::string url = wingman::testing::netns_lcm_url();
   lcm::LCM bus(url);
-  ASSERT_TRUE(bus.good());
+  FakeFollowerRun out;
+  if (!bus.good()) {
+    out.err = "cannot open " + url;
+    return out;
+  }
   struct Fake {
     lcm::LCM* bus;
-    std::vector<std::vector<uint8_t>> poses;
-    int truths = 0;
+    FakeFollowerRun* out;
     void on_truth(const lcm::ReceiveBuffer*, const std::string&, const wingman::ground_truth_t* t) {
-      ++truths;
+      out->truth_seen.push_back(std::chrono::steady_clock::now());
       const wingman::setpoint_t sp = velocity_setpoint(t->utime, fake_follower_velocity(t->utime));
       bus->publish("SETPOINT", &sp);
     }
     void on_pose(const lcm::ReceiveBuffer* rb, const std::string&, const wingman::own_pose_t*) {
-      poses.emplace_back(static_cast<const uint8_t*>(rb->data), static_cast<const uint8_t*>(rb->data) + rb->data_size);
+      out->poses.emplace_back(static_cast<const uint8_t*>(rb->data),
+                              static_cast<const uint8_t*>(rb->data) + rb->data_size);
     }
-  } fake{&bus, {}, 0};
+  } fake{&bus, &out};
   bus.subscribe("GROUND_TRUTH", &Fake::on_truth, &fake);
   bus.subscribe("OWN_POSE", &Fake::on_pose, &fake);
 
@@ -252,72 +266,43 @@ TEST(SimProcess, LockstepWithAFakeFollowerOnTheBusEqualsTheLibrary) {
   hb.process = "fake_follower";
   hb.state = wingman::status_t::STATE_OK;
   const auto deadline = std::chrono::steady_clock::now() + 60s;
-  int exit_code = -1;
   while (std::chrono::steady_clock::now() < deadline) {
-    if (fake.truths == 0) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
+    if (out.truth_seen.empty()) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
     bus.handleTimeout(50);
     if (!sim.running()) {
-      exit_code = sim.wait(1s);
+      out.exit_code = sim.wait(1s);
       break;
     }
   }
   while (bus.handleTimeout(100) > 0) {
   }
-  ASSERT_EQ(exit_code, 0) << sim.err();
-  EXPECT_EQ(fake.truths, 30);
-  EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
-  EXPECT_EQ(fake.poses, library_own_poses(f.scenario));
+  out.err = sim.err();
+  out.library_poses = library_own_poses(f.scenario);
+  return out;
+}
+
+TEST(SimProcess, LockstepWithAFakeFollowerOnTheBusEqualsTheLibrary) {
+  const auto r = run_with_fake_follower(
+      "sync:\n  mode: lockstep\n  timeout_s: 10\n  wait_for: [fake_follower]\n  startup_timeout_s: 20\n");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.truth_seen.size(), 30u);
+  EXPECT_NE(r.err.find("0 lockstep timeouts"), std::string::npos) << r.err;
+  EXPECT_EQ(r.poses, r.library_poses);
 }
 
 TEST(SimProcess, LockstepWithAMaxSpeedPublishesNoFasterAndStaysEqualToTheLibrary) {
   // sync.max_speed 5: frame k (t_k - t_0 = k / 30 s) is published no earlier than k / 150 s of wall clock after the
   // start, so the 30 frames span at least 29 / 150 s = 0.193 s, less the first frame's delivery latency (20 ms
   // allowed: measured 26 us short once); load can only make it slower. Unpaced, the CI flight ran 600 frames in
-  // 0.23 s (~12 ms per 30).
-  // The poses do not depend on the pace.
-  Files f(
+  // 0.23 s (~12 ms per 30). The poses do not depend on the pace.
+  const auto r = run_with_fake_follower(
       "sync:\n  mode: lockstep\n  timeout_s: 10\n  max_speed: 5\n  wait_for: [fake_follower]\n"
-      "  startup_timeout_s: 20\nrender:\n  enabled: false\n");
-  const std::string url = wingman::testing::netns_lcm_url();
-  lcm::LCM bus(url);
-  ASSERT_TRUE(bus.good());
-  struct Fake {
-    lcm::LCM* bus;
-    std::vector<std::vector<uint8_t>> poses;
-    std::vector<std::chrono::steady_clock::time_point> truth_seen;
-    void on_truth(const lcm::ReceiveBuffer*, const std::string&, const wingman::ground_truth_t* t) {
-      truth_seen.push_back(std::chrono::steady_clock::now());
-      const wingman::setpoint_t sp = velocity_setpoint(t->utime, fake_follower_velocity(t->utime));
-      bus->publish("SETPOINT", &sp);
-    }
-    void on_pose(const lcm::ReceiveBuffer* rb, const std::string&, const wingman::own_pose_t*) {
-      poses.emplace_back(static_cast<const uint8_t*>(rb->data), static_cast<const uint8_t*>(rb->data) + rb->data_size);
-    }
-  } fake{&bus, {}, {}};
-  bus.subscribe("GROUND_TRUTH", &Fake::on_truth, &fake);
-  bus.subscribe("OWN_POSE", &Fake::on_pose, &fake);
-
-  Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
-  wingman::status_t hb{};
-  hb.process = "fake_follower";
-  hb.state = wingman::status_t::STATE_OK;
-  const auto deadline = std::chrono::steady_clock::now() + 60s;
-  int exit_code = -1;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (fake.truth_seen.empty()) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
-    bus.handleTimeout(50);
-    if (!sim.running()) {
-      exit_code = sim.wait(1s);
-      break;
-    }
-  }
-  while (bus.handleTimeout(100) > 0) {
-  }
-  ASSERT_EQ(exit_code, 0) << sim.err();
-  ASSERT_EQ(fake.truth_seen.size(), 30u);
-  EXPECT_GE(fake.truth_seen.back() - fake.truth_seen.front(), std::chrono::microseconds(29 * 1000000 / 150 - 20000));
-  EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
-  EXPECT_EQ(fake.poses, library_own_poses(f.scenario));
+      "  startup_timeout_s: 20\n");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(r.truth_seen.size(), 30u);
+  EXPECT_GE(r.truth_seen.back() - r.truth_seen.front(), std::chrono::microseconds(29 * 1000000 / 150 - 20000));
+  EXPECT_NE(r.err.find("0 lockstep timeouts"), std::string::npos) << r.err;
+  EXPECT_EQ(r.poses, r.library_poses);
 }
 
 TEST(SimProcess, NegativeMaxSpeedIsAConfigurationErrorNamingTheKey) {
