@@ -41,6 +41,22 @@ TEST(WingmanVal, JsonOfSavedPredictionsHasTheHandComputedAp) {
       wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--conf", "0.05"});
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("match centre in truth box"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("not found at confidence >= 0.05: 1 of 3 truths (0 missed: no detection overlaps them; 1 "
+                           "loose: overlapped, not matched)\n"),
+            std::string::npos)
+      << table.out;
+  EXPECT_NE(table.out.find("a.png truth 10x10 at (150, 50): loose, best 30x30 at (150, 52) IoU 0.11 confidence 0.60\n"),
+            std::string::npos)
+      << table.out;
+  EXPECT_NE(r.out.find("\"reason\": \"loose\""), std::string::npos) << r.out;
+  const auto unlisted = wingman(
+      {"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--list", "0", "--edge-margin", "2"});
+  ASSERT_EQ(unlisted.exit_code, 0) << unlisted.err;
+  EXPECT_EQ(unlisted.out.find("a.png truth"), std::string::npos) << unlisted.out;
+  const auto bad_margin =
+      wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--edge-margin", "-3"});
+  EXPECT_NE(bad_margin.exit_code, 0);
+  EXPECT_NE(bad_margin.err.find("edge_margin_px = -3"), std::string::npos) << bad_margin.err;
 }
 
 TEST(WingmanVal, BadOptionsAndFilesAreNamed) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 namespace wingman::training {
 namespace {
@@ -23,11 +24,18 @@ detector::Box box(float cx, float cy, float w, float h, float conf = 0.f) {
 //  B: truth T3 (100,100,40,40); P5 (102,100,40,40) 0.8: IoU 38*40 / (3200 - 1520) = 0.90476;
 //     P4 (100,100,40,40) 0.1: IoU 1, but T3 is already taken by the more confident P5.
 //  C: no truth; P6 (10,10,8,8) 0.5.
+ImageDetections image(std::vector<detector::Box> truths, std::vector<detector::Box> predictions) {
+  ImageDetections d;
+  d.truths = std::move(truths);
+  d.predictions = std::move(predictions);
+  return d;  // no name and no size: the edge test is off
+}
+
 std::vector<ImageDetections> hand_case() {
-  return {{{box(50, 50, 20, 20), box(150, 50, 10, 10)},
-           {box(52, 50, 20, 20, 0.9f), box(150, 52, 30, 30, 0.6f), box(300, 300, 10, 10, 0.3f)}},
-          {{box(100, 100, 40, 40)}, {box(100, 100, 40, 40, 0.1f), box(102, 100, 40, 40, 0.8f)}},
-          {{}, {box(10, 10, 8, 8, 0.5f)}}};
+  return {image({box(50, 50, 20, 20), box(150, 50, 10, 10)},
+                {box(52, 50, 20, 20, 0.9f), box(150, 52, 30, 30, 0.6f), box(300, 300, 10, 10, 0.3f)}),
+          image({box(100, 100, 40, 40)}, {box(100, 100, 40, 40, 0.1f), box(102, 100, 40, 40, 0.8f)}),
+          image({}, {box(10, 10, 8, 8, 0.5f)})};
 }
 
 constexpr double kIouP1 = 360.0 / 440.0;
@@ -127,16 +135,96 @@ TEST(DetectionMetrics, JsonAndReportCarryTheNumbers) {
   EXPECT_NE(m.one_line().find("AP 0.667"), std::string::npos) << m.one_line();
 }
 
+// The hand case plus image D (200 x 100, named "d"): truth T4 (11,50,20,20) reaches x = 1, the image's edge
+// at the default margin of 1 px; truth T5 (100,50,10,10). P7 (130,50,10,10) 0.7 overlaps neither (IoU 0);
+// P8 (100,50,10,10) 0.1 matches T5 exactly but is below the operating point, so T5 counts as missed there.
+std::vector<ImageDetections> hand_case_with_edge() {
+  std::vector<ImageDetections> images = hand_case();
+  ImageDetections d =
+      image({box(11, 50, 20, 20), box(100, 50, 10, 10)}, {box(130, 50, 10, 10, 0.7f), box(100, 50, 10, 10, 0.1f)});
+  d.name = "d", d.width = 200, d.height = 100;
+  images.push_back(d);
+  return images;
+}
+
+TEST(DetectionMetrics, UnmatchedTruthsSayWhatTheDetectorDidThere) {
+  const DetectionMetrics m = evaluate_detections(hand_case_with_edge(), MetricsOptions{});
+  // IoU: T2 is loose (P2's centre is inside, IoU 1/9); T4 and T5 are missed (P8 is under 0.2).
+  ASSERT_EQ(m.iou.unmatched.size(), 3u);
+  const UnmatchedTruth& t2 = m.iou.unmatched[0];
+  EXPECT_EQ(t2.image, 0u);
+  EXPECT_EQ(t2.reason, "loose");
+  EXPECT_NEAR(t2.best_iou, kIouP2, 1e-6);
+  EXPECT_FLOAT_EQ(t2.best.confidence, 0.6f);
+  EXPECT_FLOAT_EQ(t2.best.w, 30.f);
+  EXPECT_FALSE(t2.at_edge);  // image A's size is unknown
+  const UnmatchedTruth& t4 = m.iou.unmatched[1];
+  EXPECT_EQ(t4.image, 3u);
+  EXPECT_EQ(t4.image_name, "d");
+  EXPECT_EQ(t4.reason, "missed");
+  EXPECT_DOUBLE_EQ(t4.best_iou, 0.0);
+  EXPECT_TRUE(t4.at_edge);
+  EXPECT_EQ(m.iou.unmatched[2].reason, "missed");
+  EXPECT_FLOAT_EQ(m.iou.unmatched[2].truth.cx, 100.f);
+  EXPECT_FALSE(m.iou.unmatched[2].at_edge);
+  EXPECT_EQ(m.iou.edge_truths, 1);
+  EXPECT_EQ(m.iou.edge_found, 0);
+  // Centre in box: T1, T2 and T3 are found; T4 and T5 are not.
+  ASSERT_EQ(m.centre.unmatched.size(), 2u);
+  EXPECT_EQ(m.centre.unmatched[0].image_name, "d");
+  EXPECT_EQ(m.centre.unmatched[0].reason, "missed");
+
+  MetricsOptions narrow;
+  narrow.edge_margin_px = 0.5;  // T4's left side at x = 1 is now inside
+  const DetectionMetrics n = evaluate_detections(hand_case_with_edge(), narrow);
+  EXPECT_EQ(n.iou.edge_truths, 0);
+  EXPECT_FALSE(n.iou.unmatched[1].at_edge);
+
+  // The report lists the largest first (T4, then T2 and T5 in image order); the JSON lists every one.
+  const std::string r = m.report();
+  EXPECT_NE(r.find("not found at confidence >= 0.2: 3 of 5 truths (2 missed: no detection overlaps them; 1 loose"),
+            std::string::npos)
+      << r;
+  EXPECT_NE(r.find("at the image's edge: 1 of the 1 truths there"), std::string::npos) << r;
+  EXPECT_NE(r.find("    d truth 20x20 at (11, 50) at the edge: missed\n"
+                   "    image 0 truth 10x10 at (150, 50): loose, best 30x30 at (150, 52) IoU 0.11 confidence 0.60\n"
+                   "    d truth 10x10 at (100, 50): missed\n"),
+            std::string::npos)
+      << r;
+  EXPECT_EQ(m.report(1).find("image 0 truth"), std::string::npos) << m.report(1);
+  const std::string j = m.json();
+  EXPECT_NE(j.find("\"edge_truths\": 1, \"edge_found\": 0"), std::string::npos) << j;
+  EXPECT_NE(j.find("{\"image\": 0, \"name\": \"\", \"truth\": [150.00, 50.00, 10.00, 10.00], \"size_px\": 10.00, "
+                   "\"at_edge\": false, \"reason\": \"loose\", \"best_iou\": 0.111111, \"best\": [150.00, 52.00, "
+                   "30.00, 30.00, 0.600000]}"),
+            std::string::npos)
+      << j;
+  EXPECT_NE(j.find("\"name\": \"d\", \"truth\": [11.00, 50.00, 20.00, 20.00], \"size_px\": 20.00, \"at_edge\": true, "
+                   "\"reason\": \"missed\", \"best_iou\": 0.000000, \"best\": null}"),
+            std::string::npos)
+      << j;
+}
+
+TEST(DetectionMetrics, ImageNamesAreEscapedInTheJson) {
+  std::vector<ImageDetections> images(1);
+  images[0].truths = {box(10, 10, 4, 4)};
+  images[0].name = "a \"b\"\\c\n";
+  const std::string j = evaluate_detections(images, MetricsOptions{}).json();
+  EXPECT_NE(j.find("\"name\": \"a \\\"b\\\"\\\\c\\u000a\""), std::string::npos) << j;
+}
+
 TEST(DetectionMetrics, InvalidOptionsAreNamed) {
   MetricsOptions o;
   o.iou_thresh = 0;
   o.size_edges_px = {32, 16};
+  o.edge_margin_px = -1;
   try {
     evaluate_detections(hand_case(), o);
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("iou_thresh = 0"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("size_edges_px[1] = 16"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("edge_margin_px = -1: must be >= 0"), std::string::npos) << e.what();
   }
 }
 

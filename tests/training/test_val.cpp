@@ -51,6 +51,12 @@ TEST(Val, SavedPredictionsGiveTheHandComputedMetrics) {
   EXPECT_NEAR(m.iou.all.mean_iou, (360.0 / 440.0 + 1520.0 / 1680.0) / 2, 1e-4);
   EXPECT_EQ(m.centre.all.true_positives, 3);
   EXPECT_NEAR(m.centre.all.ap, 1.0, 1e-9);
+  // The one truth not found under IoU (T2: P2's box is three times too wide) is named by its image's path.
+  ASSERT_EQ(m.iou.unmatched.size(), 1u);
+  EXPECT_EQ(fs::path(m.iou.unmatched[0].image_name).lexically_normal(), fs::path(dir.file("images/val/a.png")));
+  EXPECT_EQ(m.iou.unmatched[0].reason, "loose");
+  EXPECT_EQ(m.iou.edge_truths, 0);  // no truth reaches the 400 x 400 images' edges
+  EXPECT_TRUE(m.centre.unmatched.empty());
 }
 
 TEST(Val, MissingPredictionFileIsNamed) {

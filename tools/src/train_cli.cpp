@@ -85,6 +85,7 @@ struct TrainingVerbs::State {
 
   training::ValOptions val_options;
   bool val_json = false;
+  size_t val_list = 10;
 
   training::HalmstadImportOptions import;
   bool no_tighten = false, no_negatives = false;
@@ -186,7 +187,11 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
   v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
   v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");
-  v->add_flag("--json", s.val_json, "Print one JSON object (with the PR curves) instead of the table");
+  v->add_option("--edge-margin", vo.metrics.edge_margin_px,
+                "A truth within this many pixels of the image's border touches the edge (default 1)");
+  v->add_option("--list", s.val_list, "List this many of the largest truths not found, per criterion (default 10)");
+  v->add_flag("--json", s.val_json,
+              "Print one JSON object (with the PR curves and every truth not found) instead of the table");
 
   // ---- import-halmstad ----
   s.halmstad = app.add_subcommand(
@@ -221,7 +226,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
             if (done % 100 == 0 || done == total) err << fmt::format("wingman val: {}/{} images\n", done, total);
           },
           [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
-      out << (s.val_json ? m.json() + "\n" : m.report()) << std::flush;
+      out << (s.val_json ? m.json() + "\n" : m.report(s.val_list)) << std::flush;
       return 0;
     } catch (const std::invalid_argument& e) {
       err << "wingman val: error: " << e.what() << "\n";

@@ -24,6 +24,7 @@ std::vector<std::string> MetricsOptions::validate() const {
     if (!(size_edges_px[i] > 0.0) || (i > 0 && !(size_edges_px[i] > size_edges_px[i - 1])))
       p.push_back(fmt::format("size_edges_px[{}] = {}: edges must be positive and increasing", i, size_edges_px[i]));
   if (pr_points < 2) p.push_back(fmt::format("pr_points = {}: must be >= 2", pr_points));
+  if (!(edge_margin_px >= 0.0)) p.push_back(fmt::format("edge_margin_px = {}: must be >= 0", edge_margin_px));
   return p;
 }
 
@@ -50,10 +51,13 @@ int size_bin(const detector::Box& b, const std::vector<double>& edges) {
 }
 
 /// Matches every image's predictions; returns records in image order, each image's in decreasing confidence.
+/// `found` (per image, per truth): whether a prediction >= conf_thresh took that truth.
 std::vector<Record> match_all(const std::vector<ImageDetections>& images, MatchCriterion criterion,
-                              const MetricsOptions& o) {
+                              const MetricsOptions& o, std::vector<std::vector<bool>>* found) {
   std::vector<Record> out;
+  found->clear();
   for (const ImageDetections& img : images) {
+    std::vector<bool>& img_found = found->emplace_back(img.truths.size(), false);
     std::vector<size_t> order(img.predictions.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(),
@@ -79,6 +83,7 @@ std::vector<Record> match_all(const std::vector<ImageDetections>& images, MatchC
       Record r{p.confidence, best >= 0, 0.0, size_bin(p, o.size_edges_px)};
       if (best >= 0) {
         taken[static_cast<size_t>(best)] = true;
+        if (p.confidence >= o.conf_thresh) img_found[static_cast<size_t>(best)] = true;
         r.iou = detector::iou(p, img.truths[static_cast<size_t>(best)]);
         r.bin = size_bin(img.truths[static_cast<size_t>(best)], o.size_edges_px);
       }
@@ -148,11 +153,48 @@ std::string bin_name(double lo, double hi) {
   return fmt::format("{}-{}px", lo, hi);
 }
 
+bool touches_edge(const detector::Box& t, const ImageDetections& img, double margin) {
+  if (img.width <= 0 || img.height <= 0) return false;
+  return t.cx - 0.5 * t.w <= margin || t.cy - 0.5 * t.h <= margin || t.cx + 0.5 * t.w >= img.width - margin ||
+         t.cy + 0.5 * t.h >= img.height - margin;
+}
+
+/// What the detections >= conf_thresh of `img` did at truth `t` (not found under the criterion).
+UnmatchedTruth describe_unmatched(size_t index, const ImageDetections& img, const detector::Box& t,
+                                  const MetricsOptions& o) {
+  UnmatchedTruth u;
+  u.image = index;
+  u.image_name = img.name;
+  u.truth = t;
+  u.at_edge = touches_edge(t, img, o.edge_margin_px);
+  for (const detector::Box& p : img.predictions) {
+    if (p.confidence < o.conf_thresh) continue;
+    const double v = detector::iou(p, t);
+    if (v > u.best_iou || (v == u.best_iou && v > 0.0 && p.confidence > u.best.confidence)) {
+      u.best_iou = v;
+      u.best = p;
+    }
+  }
+  u.reason = u.best_iou > 0.0 ? "loose" : "missed";
+  return u;
+}
+
 CriterionMetrics evaluate(const std::vector<ImageDetections>& images, MatchCriterion criterion,
                           const MetricsOptions& o) {
   CriterionMetrics c;
   c.criterion = criterion;
-  const std::vector<Record> records = match_all(images, criterion, o);
+  std::vector<std::vector<bool>> found;
+  const std::vector<Record> records = match_all(images, criterion, o, &found);
+  for (size_t i = 0; i < images.size(); ++i)
+    for (size_t ti = 0; ti < images[i].truths.size(); ++ti) {
+      const bool edge = touches_edge(images[i].truths[ti], images[i], o.edge_margin_px);
+      c.edge_truths += edge ? 1 : 0;
+      if (found[i][ti]) {
+        c.edge_found += edge ? 1 : 0;
+      } else {
+        c.unmatched.push_back(describe_unmatched(i, images[i], images[i].truths[ti], o));
+      }
+    }
   const int bins = static_cast<int>(o.size_edges_px.size()) + 1;
   std::vector<int64_t> truths_per_bin(static_cast<size_t>(bins), 0);
   int64_t truths = 0;
@@ -176,6 +218,22 @@ CriterionMetrics evaluate(const std::vector<ImageDetections>& images, MatchCrite
   return c;
 }
 
+std::string json_escape(const std::string& in) {
+  std::string out;
+  for (const char ch : in) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (u < 0x20) {
+      out += fmt::format("\\u{:04x}", u);
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 std::string stats_json(const MatchStats& s) {
   return fmt::format(
       "{{\"truths\": {}, \"detections\": {}, \"true_positives\": {}, \"false_positives\": {}, \"precision\": {:.6f}, "
@@ -195,10 +253,25 @@ std::string criterion_json(const CriterionMetrics& c) {
   for (size_t i = 0; i < c.pr_curve.size(); ++i)
     curve += fmt::format("{}[{:.4f}, {:.6f}, {:.6f}]", i ? ", " : "", c.pr_curve[i].recall, c.pr_curve[i].precision,
                          c.pr_curve[i].confidence);
+  std::string unmatched;
+  for (size_t i = 0; i < c.unmatched.size(); ++i) {
+    const UnmatchedTruth& u = c.unmatched[i];
+    const std::string best = u.reason == "missed" ? std::string("null")
+                                                  : fmt::format("[{:.2f}, {:.2f}, {:.2f}, {:.2f}, {:.6f}]", u.best.cx,
+                                                                u.best.cy, u.best.w, u.best.h, u.best.confidence);
+    unmatched += fmt::format(
+        "{}{{\"image\": {}, \"name\": \"{}\", \"truth\": [{:.2f}, {:.2f}, {:.2f}, {:.2f}], \"size_px\": {:.2f}, "
+        "\"at_edge\": {}, \"reason\": \"{}\", \"best_iou\": {:.6f}, \"best\": {}}}",
+        i ? ", " : "", u.image, json_escape(u.image_name), u.truth.cx, u.truth.cy, u.truth.w, u.truth.h,
+        std::sqrt(std::max(0.0, static_cast<double>(u.truth.w) * u.truth.h)), u.at_edge ? "true" : "false", u.reason,
+        u.best_iou, best);
+  }
   return fmt::format(
       "{{\"criterion\": \"{}\", \"all\": {}, \"by_size\": [{}], \"pr_curve_columns\": [\"recall\", \"precision\", "
-      "\"confidence\"], \"pr_curve\": [{}]}}",
-      criterion_name(c.criterion), stats_json(c.all), bins, curve);
+      "\"confidence\"], \"pr_curve\": [{}], \"edge_truths\": {}, \"edge_found\": {}, \"unmatched_columns\": "
+      "{{\"truth\": [\"cx\", \"cy\", \"w\", \"h\"], \"best\": [\"cx\", \"cy\", \"w\", \"h\", \"confidence\"]}}, "
+      "\"unmatched\": [{}]}}",
+      criterion_name(c.criterion), stats_json(c.all), bins, curve, c.edge_truths, c.edge_found, unmatched);
 }
 
 std::string report_rows(const CriterionMetrics& c) {
@@ -209,6 +282,38 @@ std::string report_rows(const CriterionMetrics& c) {
   };
   row("all", c.all);
   for (const SizeBinStats& b : c.by_size) row(b.name, b.stats);
+  return s;
+}
+
+/// "not found at confidence >= 0.2: 58 of 300 (24 missed: no detection overlaps; 34 loose) ..." and the
+/// `listed` largest unmatched truths.
+std::string report_unmatched(const CriterionMetrics& c, const MetricsOptions& o, size_t listed) {
+  int64_t missed = 0, edge = 0;
+  for (const UnmatchedTruth& u : c.unmatched) {
+    missed += u.reason == "missed" ? 1 : 0;
+    edge += u.at_edge ? 1 : 0;
+  }
+  std::string s = fmt::format(
+      "  not found at confidence >= {}: {} of {} truths ({} missed: no detection overlaps them; {} loose: "
+      "overlapped, not matched)",
+      o.conf_thresh, c.unmatched.size(), c.all.truths, missed, static_cast<int64_t>(c.unmatched.size()) - missed);
+  if (c.edge_truths > 0) s += fmt::format("; at the image's edge: {} of the {} truths there", edge, c.edge_truths);
+  s += "\n";
+  std::vector<const UnmatchedTruth*> by_size;
+  for (const UnmatchedTruth& u : c.unmatched) by_size.push_back(&u);
+  std::stable_sort(by_size.begin(), by_size.end(), [](const UnmatchedTruth* a, const UnmatchedTruth* b) {
+    return static_cast<double>(a->truth.w) * a->truth.h > static_cast<double>(b->truth.w) * b->truth.h;
+  });
+  if (by_size.size() > listed) by_size.resize(listed);
+  for (const UnmatchedTruth* u : by_size) {
+    s += fmt::format("    {} truth {:.0f}x{:.0f} at ({:.0f}, {:.0f}){}: {}",
+                     u->image_name.empty() ? fmt::format("image {}", u->image) : u->image_name, u->truth.w, u->truth.h,
+                     u->truth.cx, u->truth.cy, u->at_edge ? " at the edge" : "", u->reason);
+    if (u->reason == "loose")
+      s += fmt::format(", best {:.0f}x{:.0f} at ({:.0f}, {:.0f}) IoU {:.2f} confidence {:.2f}", u->best.w, u->best.h,
+                       u->best.cx, u->best.cy, u->best_iou, u->best.confidence);
+    s += "\n";
+  }
   return s;
 }
 
@@ -242,15 +347,15 @@ std::string DetectionMetrics::one_line() const {
       options.conf_thresh, centre.all.ap, centre.all.recall, centre.all.precision);
 }
 
-std::string DetectionMetrics::report() const {
+std::string DetectionMetrics::report(size_t listed) const {
   std::string s = fmt::format("{} images ({} without a drone), {} truth boxes, {} predictions\n", images,
                               negative_images, truths, predictions);
   const std::string header = fmt::format("  {:<9} {:>7} {:>7} {:>7} {:>7} {:>9} {:>7} {:>9} {:>7}\n", "size", "truths",
                                          "dets", "TP", "FP", "precision", "recall", "mean IoU", "AP");
   s += fmt::format("match IoU >= {} (counts at confidence >= {}; AP over all confidences):\n", options.iou_thresh,
                    options.conf_thresh);
-  s += header + report_rows(iou);
-  s += "match centre in truth box:\n" + header + report_rows(centre);
+  s += header + report_rows(iou) + report_unmatched(iou, options, listed);
+  s += "match centre in truth box:\n" + header + report_rows(centre) + report_unmatched(centre, options, listed);
   return s;
 }
 
@@ -260,9 +365,9 @@ std::string DetectionMetrics::json() const {
     edges += fmt::format("{}{}", i ? ", " : "", options.size_edges_px[i]);
   return fmt::format(
       "{{\"images\": {}, \"negative_images\": {}, \"truths\": {}, \"predictions\": {}, \"iou_thresh\": {}, "
-      "\"conf_thresh\": {}, \"size_edges_px\": [{}], \"iou\": {}, \"centre\": {}}}",
-      images, negative_images, truths, predictions, options.iou_thresh, options.conf_thresh, edges, criterion_json(iou),
-      criterion_json(centre));
+      "\"conf_thresh\": {}, \"size_edges_px\": [{}], \"edge_margin_px\": {}, \"iou\": {}, \"centre\": {}}}",
+      images, negative_images, truths, predictions, options.iou_thresh, options.conf_thresh, edges,
+      options.edge_margin_px, criterion_json(iou), criterion_json(centre));
 }
 
 }  // namespace wingman::training

@@ -418,6 +418,7 @@ DetectionMetrics Trainer::validate(const std::string& split, int max_images) con
     const torch::Tensor x = torch::from_blob(input.data(), {1, 3, net_size.height, net_size.width}, torch::kFloat32);
     const std::vector<torch::Tensor> outs = s.net->forward(x);
     ImageDetections d;
+    d.name = img.image_path, d.width = bgr.cols, d.height = bgr.rows;
     const double sx = static_cast<double>(bgr.cols) / net_size.width,
                  sy = static_cast<double>(bgr.rows) / net_size.height;
     for (detector::Box b : s.decode(outs, 0)) {

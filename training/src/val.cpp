@@ -85,6 +85,7 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
     if (bgr.empty()) throw DatasetError(fmt::format("{}: cannot read the image", img.image_path));
     const double W = bgr.cols, H = bgr.rows;
     ImageDetections d;
+    d.name = fs::path(img.image_path).lexically_normal().string(), d.width = bgr.cols, d.height = bgr.rows;
     for (const LabeledBox& t : img.boxes) {
       if (t.cls != o.class_id) continue;
       detector::Box b;

@@ -24,6 +24,9 @@ const char* criterion_name(MatchCriterion c);
 struct ImageDetections {
   std::vector<detector::Box> truths;
   std::vector<detector::Box> predictions;
+  std::string name;  ///< how reports name the image (its path); may be empty
+  int width = 0;     ///< the image's size in pixels, for the edge test of UnmatchedTruth; 0 = unknown
+  int height = 0;
 };
 
 /// How evaluate_detections() matches and bins.
@@ -35,6 +38,9 @@ struct MetricsOptions {
   /// [0, e0), [e0, e1), ..., [e_last, inf). Default: < 16, 16-32, 32-64, >= 64 px.
   std::vector<double> size_edges_px = {16.0, 32.0, 64.0};
   int pr_points = 101;  ///< the PR curve is reported at this many evenly spaced recalls 0..1, >= 2
+  /// A truth box touches the image's edge when it reaches within this many pixels of the border (a drone cut
+  /// off by the frame); needs ImageDetections::width and height. >= 0.
+  double edge_margin_px = 1.0;
 
   /// One "field = value: rule" line per invalid field; empty when valid.
   std::vector<std::string> validate() const;
@@ -69,12 +75,29 @@ struct SizeBinStats {
   MatchStats stats;
 };
 
+/// A truth box that no detection at conf_thresh found under one criterion: what the detector did there.
+struct UnmatchedTruth {
+  size_t image = 0;        ///< index of its image in the evaluated list
+  std::string image_name;  ///< ImageDetections::name
+  detector::Box truth;     ///< image pixels
+  bool at_edge = false;    ///< it touches the image's edge (MetricsOptions::edge_margin_px); false if size unknown
+  /// "loose": a detection >= conf_thresh overlaps it (IoU > 0) but none matched it: its box is not tight enough
+  /// (IoU criterion), its centre lies outside (centre criterion), or it went to another truth.
+  /// "missed": no detection >= conf_thresh overlaps it.
+  std::string reason;
+  double best_iou = 0.0;  ///< the largest IoU of a detection >= conf_thresh with it (0 when missed)
+  detector::Box best;     ///< that detection, confidence included (all zero when missed)
+};
+
 /// All metrics under one criterion.
 struct CriterionMetrics {
   MatchCriterion criterion = MatchCriterion::kIou;
   MatchStats all;
   std::vector<SizeBinStats> by_size;
-  std::vector<PrPoint> pr_curve;  ///< MetricsOptions::pr_points points, recall 0 .. 1
+  std::vector<PrPoint> pr_curve;          ///< MetricsOptions::pr_points points, recall 0 .. 1
+  std::vector<UnmatchedTruth> unmatched;  ///< every truth not found at conf_thresh, in image order
+  int64_t edge_truths = 0;                ///< truths that touch the image's edge (of images with a known size)
+  int64_t edge_found = 0;                 ///< of those, found at conf_thresh
 };
 
 /// The result of evaluating a set of images.
@@ -88,8 +111,11 @@ struct DetectionMetrics {
   CriterionMetrics centre;  ///< centre in truth box
 
   std::string one_line() const;  ///< "AP@0.5 0.812, recall 0.90, precision 0.85, mean IoU 0.71 (IoU); ..."
-  std::string report() const;    ///< a table for people
-  std::string json() const;      ///< one JSON object (every field above, both criteria, the PR curves)
+  /// A table for people, then per criterion the unmatched truths: missed / loose, at the edge, and the
+  /// `listed` largest of them (0 = none listed).
+  std::string report(size_t listed = 10) const;
+  std::string json()
+      const;  ///< one JSON object (every field above, both criteria, the PR curves, every unmatched truth)
 };
 
 /// Evaluates predictions against truths, image by image.
@@ -103,6 +129,7 @@ struct DetectionMetrics {
 /// Size bins use sqrt(w h) in pixels: a truth by its own size; a matched prediction follows its truth; an
 /// unmatched prediction counts in the bin of its own size (COCO's rule for area ranges).
 /// A box is inside when its centre is within [x - w/2, x + w/2] x [y - h/2, y + h/2] (edges included).
+/// A truth not taken by a prediction >= conf_thresh is unmatched (CriterionMetrics::unmatched).
 /// Throws std::invalid_argument listing the invalid options.
 DetectionMetrics evaluate_detections(const std::vector<ImageDetections>& images, const MetricsOptions& options);
 
