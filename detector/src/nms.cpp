@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Box IoU and non-maximum suppression (Algorithm 1).
+// Box IoU, clipping to the image, and non-maximum suppression (Algorithm 1).
 #include "wingman/detector/nms.hpp"
 
 #include <algorithm>
@@ -13,6 +13,15 @@ float iou(const Box& a, const Box& b) {
   const float inter = ix * iy;
   const float uni = a.w * a.h + b.w * b.h - inter;
   return uni > 0.0f ? inter / uni : 0.0f;
+}
+
+Box clip_to_image(const Box& b, float width, float height) {
+  const float x0 = std::clamp(b.cx - b.w / 2, 0.0f, width), x1 = std::clamp(b.cx + b.w / 2, 0.0f, width);
+  const float y0 = std::clamp(b.cy - b.h / 2, 0.0f, height), y1 = std::clamp(b.cy + b.h / 2, 0.0f, height);
+  Box c = b;
+  c.cx = 0.5f * (x0 + x1), c.cy = 0.5f * (y0 + y1);
+  c.w = x1 - x0, c.h = y1 - y0;
+  return c;
 }
 
 void non_max_suppression(std::vector<Box>& boxes, float o_thresh) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// IoU and non-maximum suppression (Algorithm 1) on hand-computed cases.
+// IoU, clipping to the image and non-maximum suppression (Algorithm 1) on hand-computed cases.
 #include <wingman/detector/nms.hpp>
 
 #include <gtest/gtest.h>
@@ -15,6 +15,29 @@ TEST(Iou, HandCases) {
   EXPECT_FLOAT_EQ(iou(box(5, 5, 10, 10, 1), box(10, 5, 10, 10, 1)), 50.0f / 150.0f);
   EXPECT_FLOAT_EQ(iou(box(0, 0, 2, 2, 1), box(2, 0, 2, 2, 1)), 0.0f);  // touching edges
   EXPECT_FLOAT_EQ(iou(box(0, 0, 0, 0, 1), box(0, 0, 0, 0, 1)), 0.0f);  // empty
+}
+
+TEST(ClipToImage, KeepsTheVisiblePart) {
+  // Inside: unchanged.
+  Box in = clip_to_image(box(50, 40, 20, 10, 0.7f), 100, 80);
+  EXPECT_FLOAT_EQ(in.cx, 50);
+  EXPECT_FLOAT_EQ(in.cy, 40);
+  EXPECT_FLOAT_EQ(in.w, 20);
+  EXPECT_FLOAT_EQ(in.h, 10);
+  EXPECT_FLOAT_EQ(in.confidence, 0.7f);
+  // Past the left and bottom edges: x -10..30 -> 0..30, y 60..100 -> 60..80.
+  Box cut = clip_to_image(box(10, 80, 40, 40, 0.5f), 100, 80);
+  EXPECT_FLOAT_EQ(cut.cx, 15);
+  EXPECT_FLOAT_EQ(cut.w, 30);
+  EXPECT_FLOAT_EQ(cut.cy, 70);
+  EXPECT_FLOAT_EQ(cut.h, 20);
+  EXPECT_FLOAT_EQ(cut.confidence, 0.5f);
+  // Taller than the image on both sides.
+  Box tall = clip_to_image(box(50, 40, 10, 200, 1), 100, 80);
+  EXPECT_FLOAT_EQ(tall.cy, 40);
+  EXPECT_FLOAT_EQ(tall.h, 80);
+  // Wholly outside: empty.
+  EXPECT_FLOAT_EQ(clip_to_image(box(150, 40, 10, 10, 1), 100, 80).w, 0.0f);
 }
 
 TEST(Nms, KeepsMostConfidentAndSortsDescending) {

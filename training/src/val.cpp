@@ -2,6 +2,8 @@
 // `wingman val`: dataset split + detector or predictions -> DetectionMetrics.
 #include "wingman/training/val.hpp"
 
+#include <wingman/detector/box.hpp>
+
 #include "wingman/training/yolo_dataset.hpp"
 
 #include <wingman/detector/input_size.hpp>
@@ -94,7 +96,11 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
       d.truths.push_back(b);
     }
     if (pipeline) {
-      d.predictions = pipeline->detect(bgr);
+      // As `wingman predict` writes them: the visible part of each box (the labels' convention).
+      for (const detector::Box& b : pipeline->detect(bgr)) {
+        const detector::Box c = detector::clip_to_image(b, static_cast<float>(W), static_cast<float>(H));
+        if (c.w > 0.0f && c.h > 0.0f) d.predictions.push_back(c);
+      }
     } else {
       const std::string file = (fs::path(o.predictions) / (fs::path(img.image_path).stem().string() + ".txt")).string();
       if (!fs::is_regular_file(file))

@@ -18,4 +18,9 @@ struct Box {
 /// Intersection over union of two boxes in the same pixel frame, 0..1 (0 when both are empty).
 float iou(const Box& a, const Box& b);
 
+/// The part of `b` inside the image [0, width] x [0, height] (pixels; width, height >= 0), as labels are: a box
+/// that reaches past the frame (a drone cut off by the border) keeps its visible part. Confidence and flags are
+/// kept; a box wholly outside the image comes back with w = 0 or h = 0.
+Box clip_to_image(const Box& b, float width, float height);
+
 }  // namespace wingman::detector
