@@ -24,6 +24,16 @@ Box clip_to_image(const Box& b, float width, float height) {
   return c;
 }
 
+std::vector<Box> clip_to_image(const std::vector<Box>& boxes, float width, float height) {
+  std::vector<Box> out;
+  out.reserve(boxes.size());
+  for (const Box& b : boxes) {
+    const Box c = clip_to_image(b, width, height);
+    if (c.w > 0.0f && c.h > 0.0f) out.push_back(c);
+  }
+  return out;
+}
+
 void non_max_suppression(std::vector<Box>& boxes, float o_thresh) {
   // Algorithm 1: sort by confidence, keep the best, drop those overlapping it by more than o_thresh, repeat.
   std::stable_sort(boxes.begin(), boxes.end(), [](const Box& a, const Box& b) { return a.confidence > b.confidence; });

@@ -38,6 +38,12 @@ TEST(ClipToImage, KeepsTheVisiblePart) {
   EXPECT_FLOAT_EQ(tall.h, 80);
   // Wholly outside: empty.
   EXPECT_FLOAT_EQ(clip_to_image(box(150, 40, 10, 10, 1), 100, 80).w, 0.0f);
+  // A list: each clipped, in order, the one outside left out.
+  const std::vector<Box> list =
+      clip_to_image({box(10, 80, 40, 40, 0.5f), box(150, 40, 10, 10, 0.9f), box(50, 40, 20, 10, 0.7f)}, 100, 80);
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_FLOAT_EQ(list[0].w, 30);
+  EXPECT_FLOAT_EQ(list[1].confidence, 0.7f);
 }
 
 TEST(Nms, KeepsMostConfidentAndSortsDescending) {

@@ -113,12 +113,9 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
     const fs::path txt = fs::path(options.out_dir) / (path.stem().string() + ".txt");
     std::ofstream f(txt);
     const double W = bgr.cols, H = bgr.rows;
-    for (const detector::Box& box : boxes) {
-      // YOLO labels are normalised to the image: a box past the frame is written as its visible part.
-      const detector::Box b = detector::clip_to_image(box, static_cast<float>(W), static_cast<float>(H));
-      if (b.w <= 0.0f || b.h <= 0.0f) continue;
+    // YOLO labels are normalised to the image: a box past the frame is written as its visible part.
+    for (const detector::Box& b : detector::clip_to_image(boxes, static_cast<float>(W), static_cast<float>(H)))
       f << fmt::format("0 {:.6f} {:.6f} {:.6f} {:.6f} {:.6f}\n", b.cx / W, b.cy / H, b.w / W, b.h / H, b.confidence);
-    }
     f.close();
     if (!f) {
       err << prefix << fmt::format("{}: cannot write", txt.string()) << "\n";

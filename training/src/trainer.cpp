@@ -424,9 +424,10 @@ DetectionMetrics Trainer::validate(const std::string& split, int max_images) con
     for (detector::Box b : s.decode(outs, 0)) {
       b.cx = static_cast<float>(b.cx * sx), b.w = static_cast<float>(b.w * sx);
       b.cy = static_cast<float>(b.cy * sy), b.h = static_cast<float>(b.h * sy);
-      b = detector::clip_to_image(b, static_cast<float>(bgr.cols), static_cast<float>(bgr.rows));  // as val does
-      if (b.w > 0.0f && b.h > 0.0f) d.predictions.push_back(b);
+      d.predictions.push_back(b);
     }
+    d.predictions = detector::clip_to_image(d.predictions, static_cast<float>(bgr.cols),
+                                            static_cast<float>(bgr.rows));  // as val does
     for (const LabeledBox& t : img.boxes) {
       if (t.cls != 0) continue;
       detector::Box b;

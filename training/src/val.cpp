@@ -97,10 +97,7 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
     }
     if (pipeline) {
       // As `wingman predict` writes them: the visible part of each box (the labels' convention).
-      for (const detector::Box& b : pipeline->detect(bgr)) {
-        const detector::Box c = detector::clip_to_image(b, static_cast<float>(W), static_cast<float>(H));
-        if (c.w > 0.0f && c.h > 0.0f) d.predictions.push_back(c);
-      }
+      d.predictions = detector::clip_to_image(pipeline->detect(bgr), static_cast<float>(W), static_cast<float>(H));
     } else {
       const std::string file = (fs::path(o.predictions) / (fs::path(img.image_path).stem().string() + ".txt")).string();
       if (!fs::is_regular_file(file))

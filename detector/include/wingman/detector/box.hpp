@@ -2,6 +2,8 @@
 // A detection box (centre, size, confidence) and its intersection over union.
 #pragma once
 
+#include <vector>
+
 namespace wingman::detector {
 
 /// One detection. Coordinates are pixels of the image the box refers to (network input, crop or full
@@ -22,5 +24,8 @@ float iou(const Box& a, const Box& b);
 /// that reaches past the frame (a drone cut off by the border) keeps its visible part. Confidence and flags are
 /// kept; a box wholly outside the image comes back with w = 0 or h = 0.
 Box clip_to_image(const Box& b, float width, float height);
+
+/// clip_to_image() of each box, in order, leaving out those wholly outside the image.
+std::vector<Box> clip_to_image(const std::vector<Box>& boxes, float width, float height);
 
 }  // namespace wingman::detector
