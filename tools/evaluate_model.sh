@@ -7,7 +7,9 @@
 # training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size).
 # wingman val runs the detector at its default input size (model.input_size auto: the cfg's 640 columns, the rows
 # fitted to each set's aspect, 640x512 for the Halmstad frames).
-# Writes OUT/*.json (wingman val --json, one pass per set), OUT/summary.md and OUT/bench.txt.
+# Writes OUT/*.json (wingman val --json, one pass per set, with every truth not found), OUT/summary.md (the metrics,
+# the negative clips' false positives, and the truths not found: missed or loose, at the frame's edge) and
+# OUT/bench.txt.
 #
 # Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
@@ -128,6 +130,16 @@ for kind in ("AIRPLANE", "BIRD", "HELICOPTER"):
     r = load("halmstad_val_" + kind)
     fp = r["centre"]["all"]["false_positives"]
     lines.append(f"| {kind.lower()} | {r['images']} | {fp} | {fp / max(1, r['images']):.3f} |")
+lines += ["", "| set | criterion | truths not found at conf 0.2 | missed (no box overlaps) | loose (overlapped, not matched) | "
+          "at the image's edge (of the truths there) |", "|---|---|---|---|---|---|"]
+for name, label in sets:
+    r = load(name)
+    for crit in ("iou", "centre"):
+        u = r[crit]["unmatched"]
+        missed = sum(1 for x in u if x["reason"] == "missed")
+        edge = sum(1 for x in u if x["at_edge"])
+        lines.append(f"| {label} | {'IoU >= 0.5' if crit == 'iou' else 'centre in box'} | {len(u)} of {r['truths']} | "
+                     f"{missed} | {len(u) - missed} | {edge} of {r[crit]['edge_truths']} |")
 open(os.path.join(out, "summary.md"), "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 PY
