@@ -17,33 +17,30 @@ TEST(Iou, HandCases) {
   EXPECT_FLOAT_EQ(iou(box(0, 0, 0, 0, 1), box(0, 0, 0, 0, 1)), 0.0f);  // empty
 }
 
+/// Expects `b` to be (cx, cy, w, h) with confidence `conf`.
+void expect_box(const Box& b, float cx, float cy, float w, float h, float conf) {
+  EXPECT_FLOAT_EQ(b.cx, cx);
+  EXPECT_FLOAT_EQ(b.cy, cy);
+  EXPECT_FLOAT_EQ(b.w, w);
+  EXPECT_FLOAT_EQ(b.h, h);
+  EXPECT_FLOAT_EQ(b.confidence, conf);
+}
+
 TEST(ClipToImage, KeepsTheVisiblePart) {
   // Inside: unchanged.
-  Box in = clip_to_image(box(50, 40, 20, 10, 0.7f), 100, 80);
-  EXPECT_FLOAT_EQ(in.cx, 50);
-  EXPECT_FLOAT_EQ(in.cy, 40);
-  EXPECT_FLOAT_EQ(in.w, 20);
-  EXPECT_FLOAT_EQ(in.h, 10);
-  EXPECT_FLOAT_EQ(in.confidence, 0.7f);
+  expect_box(clip_to_image(box(50, 40, 20, 10, 0.7f), 100, 80), 50, 40, 20, 10, 0.7f);
   // Past the left and bottom edges: x -10..30 -> 0..30, y 60..100 -> 60..80.
-  Box cut = clip_to_image(box(10, 80, 40, 40, 0.5f), 100, 80);
-  EXPECT_FLOAT_EQ(cut.cx, 15);
-  EXPECT_FLOAT_EQ(cut.w, 30);
-  EXPECT_FLOAT_EQ(cut.cy, 70);
-  EXPECT_FLOAT_EQ(cut.h, 20);
-  EXPECT_FLOAT_EQ(cut.confidence, 0.5f);
+  expect_box(clip_to_image(box(10, 80, 40, 40, 0.5f), 100, 80), 15, 70, 30, 20, 0.5f);
   // Taller than the image on both sides.
-  Box tall = clip_to_image(box(50, 40, 10, 200, 1), 100, 80);
-  EXPECT_FLOAT_EQ(tall.cy, 40);
-  EXPECT_FLOAT_EQ(tall.h, 80);
+  expect_box(clip_to_image(box(50, 40, 10, 200, 1), 100, 80), 50, 40, 10, 80, 1);
   // Wholly outside: empty.
   EXPECT_FLOAT_EQ(clip_to_image(box(150, 40, 10, 10, 1), 100, 80).w, 0.0f);
   // A list: each clipped, in order, the one outside left out.
   const std::vector<Box> list =
       clip_to_image({box(10, 80, 40, 40, 0.5f), box(150, 40, 10, 10, 0.9f), box(50, 40, 20, 10, 0.7f)}, 100, 80);
   ASSERT_EQ(list.size(), 2u);
-  EXPECT_FLOAT_EQ(list[0].w, 30);
-  EXPECT_FLOAT_EQ(list[1].confidence, 0.7f);
+  expect_box(list[0], 15, 70, 30, 20, 0.5f);
+  expect_box(list[1], 50, 40, 20, 10, 0.7f);
 }
 
 TEST(Nms, KeepsMostConfidentAndSortsDescending) {
