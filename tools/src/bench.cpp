@@ -4,6 +4,7 @@
 #include "wingman/tools/bench.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/json.hpp>
 #include <wingman/detector/cpu_backend.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
@@ -146,31 +147,7 @@ class TimedBackend : public InferenceBackend {
   ForwardStats* stats_;
 };
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20)
-          out += fmt::format("\\u{:04x}", static_cast<int>(c));
-        else
-          out += c;
-    }
-  }
-  return out + "\"";
-}
+using common::json_string;
 
 std::string json_timing(const TimingMs& t) {
   return fmt::format("{{\"median\": {:.4f}, \"min\": {:.4f}, \"max\": {:.4f}, \"runs\": {}}}", t.median, t.min, t.max,

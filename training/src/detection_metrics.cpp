@@ -3,6 +3,7 @@
 #include "wingman/training/detection_metrics.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -218,22 +219,6 @@ CriterionMetrics evaluate(const std::vector<ImageDetections>& images, MatchCrite
   return c;
 }
 
-std::string json_escape(const std::string& in) {
-  std::string out;
-  for (const char ch : in) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (u < 0x20) {
-      out += fmt::format("\\u{:04x}", u);
-    } else {
-      out += ch;
-    }
-  }
-  return out;
-}
-
 std::string stats_json(const MatchStats& s) {
   return fmt::format(
       "{{\"truths\": {}, \"detections\": {}, \"true_positives\": {}, \"false_positives\": {}, \"precision\": {:.6f}, "
@@ -260,9 +245,9 @@ std::string criterion_json(const CriterionMetrics& c) {
                                                   : fmt::format("[{:.2f}, {:.2f}, {:.2f}, {:.2f}, {:.6f}]", u.best.cx,
                                                                 u.best.cy, u.best.w, u.best.h, u.best.confidence);
     unmatched += fmt::format(
-        "{}{{\"image\": {}, \"name\": \"{}\", \"truth\": [{:.2f}, {:.2f}, {:.2f}, {:.2f}], \"size_px\": {:.2f}, "
+        "{}{{\"image\": {}, \"name\": {}, \"truth\": [{:.2f}, {:.2f}, {:.2f}, {:.2f}], \"size_px\": {:.2f}, "
         "\"at_edge\": {}, \"reason\": \"{}\", \"best_iou\": {:.6f}, \"best\": {}}}",
-        i ? ", " : "", u.image, json_escape(u.image_name), u.truth.cx, u.truth.cy, u.truth.w, u.truth.h,
+        i ? ", " : "", u.image, common::json_string(u.image_name), u.truth.cx, u.truth.cy, u.truth.w, u.truth.h,
         std::sqrt(std::max(0.0, static_cast<double>(u.truth.w) * u.truth.h)), u.at_edge ? "true" : "false", u.reason,
         u.best_iou, best);
   }
