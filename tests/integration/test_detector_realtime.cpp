@@ -159,9 +159,10 @@ TEST(DetectorRealtime, KeepsReadingTheBusAndBeatingWhileADetectionRuns) {
                        << bus.detections.size() << ", drops " << bus.status.drops_total << "; " << detector->err();
   EXPECT_EQ(bus.status.messages_handled, kFrames);
   EXPECT_EQ(static_cast<int64_t>(bus.detections.size()) + bus.status.drops_total, kFrames);
-  // The worker took the first frame (0, unless a newer one came before it woke); the rest but the newest were
-  // superseded while it ran; the newest is detected next.
-  ASSERT_GE(bus.detections.size(), 2u);
+  // The worker took the first frame (0, unless newer ones came before it woke: on a loaded machine it can wake
+  // after the whole burst and take the newest first, a single detection); the rest but the newest were superseded
+  // while it ran; the newest is detected next.
+  ASSERT_GE(bus.detections.size(), 1u);
   EXPECT_LE(bus.detections.size(), 3u);
   EXPECT_EQ(bus.detections.back().seq, kFrames - 1);
   for (size_t i = 1; i < bus.detections.size(); ++i) EXPECT_GT(bus.detections[i].seq, bus.detections[i - 1].seq);

@@ -2,9 +2,8 @@
 // `wingman predict`: detector on image files -> YOLO-format text files (and drawn images).
 #include "wingman/tools/predict.hpp"
 
-#include <wingman/detector/box.hpp>
-
 #include <fmt/format.h>
+#include <wingman/detector/box.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
 #include <wingman/detector/input_size.hpp>

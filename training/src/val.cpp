@@ -2,10 +2,9 @@
 // `wingman val`: dataset split + detector or predictions -> DetectionMetrics.
 #include "wingman/training/val.hpp"
 
-#include <wingman/detector/box.hpp>
-
 #include "wingman/training/yolo_dataset.hpp"
 
+#include <wingman/detector/box.hpp>
 #include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
 #include <wingman/detector/sized_detector.hpp>
