@@ -161,13 +161,13 @@ bool touches_edge(const detector::Box& t, const ImageDetections& img, double mar
 }
 
 /// What the detections >= conf_thresh of `img` did at truth `t` (not found under the criterion).
-UnmatchedTruth describe_unmatched(size_t index, const ImageDetections& img, const detector::Box& t,
+UnmatchedTruth describe_unmatched(size_t index, const ImageDetections& img, const detector::Box& t, bool at_edge,
                                   const MetricsOptions& o) {
   UnmatchedTruth u;
   u.image = index;
   u.image_name = img.name;
   u.truth = t;
-  u.at_edge = touches_edge(t, img, o.edge_margin_px);
+  u.at_edge = at_edge;
   for (const detector::Box& p : img.predictions) {
     if (p.confidence < o.conf_thresh) continue;
     const double v = detector::iou(p, t);
@@ -193,7 +193,7 @@ CriterionMetrics evaluate(const std::vector<ImageDetections>& images, MatchCrite
       if (found[i][ti]) {
         c.edge_found += edge ? 1 : 0;
       } else {
-        c.unmatched.push_back(describe_unmatched(i, images[i], images[i].truths[ti], o));
+        c.unmatched.push_back(describe_unmatched(i, images[i], images[i].truths[ti], edge, o));
       }
     }
   const int bins = static_cast<int>(o.size_edges_px.size()) + 1;
