@@ -16,7 +16,8 @@
 # Usage: tools/train_model.sh [--data DIR] [--out DIR] [--threads N] [--max-batches N] [--stage2-batches N]
 #                             [--stage3-batches N] [--stage4-batches N]
 #                             [--stage5-batches N] [--stage6-batches N] [--stage6-init FILE]
-#                             [--stage6-iou-loss KIND] [--stage6-iou-normalizer X] [--data-only]
+#                             [--stage6-iou-loss KIND] [--stage6-iou-normalizer X] [--stage6-mix s5|s6]
+#                             [--data-only]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
 #   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 to 5 in OUT/stage2 .. OUT/stage5
 #                     (default build/train-wingman-small)
@@ -35,6 +36,8 @@
 #                     trains a copy of the cfg with iou_loss=KIND in every [yolo] section (OUT/cfg-KIND), into
 #                     OUT/stage6-KIND (OUT/stage6-KIND-X with a normalizer X other than 0.75)
 #   --stage6-iou-normalizer X: that copy's iou_normalizer (default 0.75, the trainer's)
+#   --stage6-mix      s6 (default): stage 6 trains on stage 5's mix plus the second synthetic 1280x720 set; s5:
+#                     on stage 5's mix alone (the second set is not rendered), into OUT/stage6[-KIND[-X]]-s5mix
 #   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
@@ -44,7 +47,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
 stage3_batches=400 stage4_batches=600 stage5_batches=1000 stage6_batches=0 stage6_init="" data_only=0
-stage6_iou_loss=mse stage6_iou_normalizer=0.75
+stage6_iou_loss=mse stage6_iou_normalizer=0.75 stage6_mix=s6
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -59,6 +62,7 @@ while [ $# -gt 0 ]; do
     --stage6-init) stage6_init="$2"; shift 2 ;;
     --stage6-iou-loss) stage6_iou_loss="$2"; shift 2 ;;
     --stage6-iou-normalizer) stage6_iou_normalizer="$2"; shift 2 ;;
+    --stage6-mix) stage6_mix="$2"; shift 2 ;;
     --data-only) data_only=1; shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -81,6 +85,7 @@ for pair in "stage2 $stage2_batches" "stage3 $stage3_batches" "stage4 $stage4_ba
 done
 [ "$max_batches" -ge 5 ] || { echo "train_model: --max-batches $max_batches: expected at least 5 (its rate steps at 53, 77 and 90 % must increase)" >&2; exit 2; }
 case "$stage6_iou_loss" in mse|giou|diou|ciou) ;; *) echo "train_model: --stage6-iou-loss '$stage6_iou_loss': expected mse, giou, diou or ciou" >&2; exit 2 ;; esac
+case "$stage6_mix" in s5|s6) ;; *) echo "train_model: --stage6-mix '$stage6_mix': expected s5 or s6" >&2; exit 2 ;; esac
 case "$stage6_iou_normalizer" in ''|*[!0-9.]*|*.*.*|.) echo "train_model: --stage6-iou-normalizer '$stage6_iou_normalizer': expected a positive number" >&2; exit 2 ;; esac
 if [ -n "$stage6_init" ]; then
   [ -f "$stage6_init" ] || { echo "train_model: --stage6-init '$stage6_init': no such file" >&2; exit 2; }
@@ -288,8 +293,11 @@ if [ "$stage6_batches" -eq 0 ]; then
   exit 0
 fi
 # 9. Stage 6 (not in the shipped model): stage 5 trained longer with a second set of 2400 synthetic 1280x720 images
-# (seed 41) added: the synthetic 1280x720 target is the one the model misses (models/wingman-small.md).
-if [ ! -f "$data/synth720train2/data.yaml" ]; then
+# (seed 41) added: the synthetic 1280x720 target is the one the model misses (models/wingman-small.md). With
+# --stage6-mix s5, on stage 5's mix alone (the second set dilutes the training flights' small, distant leaders).
+mix6="$data/combined-s6.yaml"
+[ "$stage6_mix" = s5 ] && mix6="$data/combined-s5.yaml"
+if [ "$stage6_mix" = s6 ] && [ ! -f "$data/synth720train2/data.yaml" ]; then
   rm -rf "$data/synth720train2"
   "$bin/wingman" dataset synth --out "$data/synth720train2" --count 2400 --seed 41 \
     --config "$data/synth720train.yaml" --meshes "$src/../shared/meshes"
@@ -320,11 +328,12 @@ if [ "$stage6_iou_loss" != mse ]; then
   [ "$(grep -c "^iou_loss=$stage6_iou_loss\$" "$cfg6")" = "$(grep -c '^\[yolo\]$' "$src/models/wingman-small.cfg")" ] ||
     { echo "train_model: could not write iou_loss into every [yolo] section of $cfg6" >&2; exit 1; }
 fi
+[ "$stage6_mix" = s5 ] && out6="$out6-s5mix"
 [ -f "$out6/wingman-small_final.weights" ] && exit 0
 init6="${stage6_init:-$out/stage5/wingman-small_final.weights}"
 u1=$((stage6_batches / 2)) u2=$((stage6_batches * 8 / 10)) u3=$((stage6_batches * 9 / 10))
 resume=()
 [ -f "$out6/checkpoint.pt" ] && resume=(--resume)
-exec "$bin/wingman" train --cfg "$cfg6" "${augment[@]}" --data "$data/combined-s6.yaml" \
+exec "$bin/wingman" train --cfg "$cfg6" "${augment[@]}" --data "$mix6" \
   --out "$out6" --weights "$init6" --max-batches "$stage6_batches" \
   --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${resume[@]}"

@@ -24,6 +24,8 @@ std::vector<std::string> DetectorPipelineOptions::validate() const {
     p.push_back(problem("detection.policy", policy, "must be all or most_confident"));
   if (!(zoom_max_fraction > 0.0 && zoom_max_fraction <= 1.0))
     p.push_back(problem("detection.zoom_max_fraction", zoom_max_fraction, "must be in (0, 1]"));
+  if (!(fusion_iou >= 0.0 && fusion_iou <= 1.0))
+    p.push_back(problem("detection.fusion_iou", fusion_iou, "must be in 0..1"));
   if (max_detections < 1) p.push_back(problem("detection.max_detections", max_detections, "must be >= 1"));
   return p;
 }
@@ -68,6 +70,8 @@ DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::uniqu
   crops_.reserve(options_.max_detections);
   zoomed_.reserve(options_.max_detections);
   resized_.create(net_size_, CV_8UC3);
+  pass_floor_ = static_cast<float>(options_.flip_fusion ? options_.p_thresh / 2.0 : options_.p_thresh);
+  if (options_.flip_fusion) views_.reserve(2 * static_cast<size_t>(options_.max_detections));
 }
 
 void DetectionPipeline::run_and_decode(int count) {
@@ -77,8 +81,7 @@ void DetectionPipeline::run_and_decode(int count) {
     candidates_[i].clear();
     const float* raw = output_.data() + i * per_image;
     for (const Layer& h : heads_) {
-      decode_head(raw, h.input, h, net_size_.width, net_size_.height, static_cast<float>(options_.p_thresh),
-                  candidates_[i]);
+      decode_head(raw, h.input, h, net_size_.width, net_size_.height, pass_floor_, candidates_[i]);
       raw += h.input.size();
     }
   }
@@ -88,6 +91,31 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
   if (bgr_image.empty() || bgr_image.type() != CV_8UC3)
     throw std::invalid_argument(fmt::format("DetectionPipeline::detect: image {}x{} type {}: must be non-empty CV_8UC3",
                                             bgr_image.cols, bgr_image.rows, bgr_image.type()));
+  const size_t keep = options_.policy == "most_confident" ? 1 : static_cast<size_t>(options_.max_detections);
+  if (!options_.flip_fusion) {
+    detect_view(bgr_image, keep);
+    return detections_;
+  }
+  // Step 5: both views, fused.
+  const size_t per_view = static_cast<size_t>(options_.max_detections);
+  views_.clear();
+  detect_view(bgr_image, per_view);
+  for (const Box& b : detections_) views_.push_back({b, 0});
+  cv::flip(bgr_image, mirrored_, 1);
+  detect_view(mirrored_, per_view);
+  const float width = static_cast<float>(bgr_image.cols);
+  for (const Box& b : detections_) views_.push_back({mirror_horizontally(b, width), 1});
+  fuse_boxes(views_, 2, static_cast<float>(options_.fusion_iou), detections_);
+  const float p_thresh = static_cast<float>(options_.p_thresh);
+  detections_.erase(std::remove_if(detections_.begin(), detections_.end(),
+                                   [p_thresh](const Box& b) { return b.confidence < p_thresh; }),
+                    detections_.end());
+  non_max_suppression(detections_, static_cast<float>(options_.o_thresh));
+  if (detections_.size() > keep) detections_.resize(keep);
+  return detections_;
+}
+
+void DetectionPipeline::detect_view(const cv::Mat& bgr_image, size_t keep) {
   const float o_thresh = static_cast<float>(options_.o_thresh);
   const size_t input_size = static_cast<size_t>(backend_->input_shape().size());
 
@@ -97,7 +125,6 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
   run_and_decode(1);
   // Step 3: NMS (Algorithm 1), policy, cap.
   non_max_suppression(candidates_[0], o_thresh);
-  const size_t keep = options_.policy == "most_confident" ? 1 : static_cast<size_t>(options_.max_detections);
   if (candidates_[0].size() > keep) candidates_[0].resize(keep);
   detections_.clear();
   for (const Box& b : candidates_[0]) detections_.push_back(network_to_image(b, roi, net_size_));
@@ -141,7 +168,6 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
     }
     non_max_suppression(detections_, o_thresh);
   }
-  return detections_;
 }
 
 }  // namespace wingman::detector

@@ -453,6 +453,72 @@ TEST(Algorithm2, ZoomInCropsRunAsBatches) {
   EXPECT_EQ(boxes.size(), 3u);
 }
 
+TEST(Algorithm2, FlipFusionFusesTheMirroredPassAndHalvesOneViewBoxes) {
+  // Call 0 is the image, call 1 its mirror (network pixels; the 1280x720 image stretched to 416x416).
+  //  - a drone at network (216, 208) in the image, 0.8; the mirror sees it at (416 - 216, 216) = (200, 216), 1.5x as
+  //    wide, 0.6: fused at the confidence-weighted mean, confidence 0.7;
+  //  - a box at cell (2, 2), 0.5, that the mirror finds at 0.15 (under p_thresh 0.2, above the passes' floor 0.1):
+  //    (0.5 + 0.15) / 2 = 0.325;
+  //  - a box only the mirror finds, 0.3: 0.15 after fusion, under p_thresh: dropped.
+  const float quarter = logit(0.25f), three_quarters = logit(0.75f);
+  const std::vector<std::vector<std::vector<Cell>>> script = {
+      {{{0, 6, 6, three_quarters, 0, 0, 0, 0.8f}, {0, 2, 2, 0, 0, 0, 0, 0.5f}}},
+      {{{0, 6, 6, quarter, three_quarters, std::log(1.5f), 0, 0.6f},
+        {0, 2, 10, 0, 0, 0, 0, 0.15f},
+        {0, 10, 10, 0, 0, 0, 0, 0.3f}}}};
+  DetectorPipelineOptions o;
+  o.flip_fusion = true;
+  std::vector<int> batches;
+  auto boxes = make(o, script, &batches).detect(image_1280x720());
+  EXPECT_EQ(batches, (std::vector<int>{1, 1}));  // one pass per view
+  ASSERT_EQ(boxes.size(), 2u);
+  const float sx = 1280.0f / 416, sy = 720.0f / 416;
+  EXPECT_NEAR(boxes[0].confidence, 0.7f, 1e-5);
+  EXPECT_NEAR(boxes[0].cx, 216 * sx, 1e-2);
+  EXPECT_NEAR(boxes[0].cy, (0.8f * 208 + 0.6f * 216) / 1.4f * sy, 1e-2);
+  EXPECT_NEAR(boxes[0].w, (0.8f * 1.08f + 0.6f * 1.08f * 1.5f) / 1.4f * kCell * sx, 1e-2);
+  EXPECT_NEAR(boxes[0].h, 1.19f * kCell * sy, 1e-2);
+  EXPECT_NEAR(boxes[1].confidence, 0.325f, 1e-5);
+  EXPECT_NEAR(boxes[1].cx, 80 * sx, 1e-2);
+  EXPECT_NEAR(boxes[1].cy, 80 * sy, 1e-2);
+  // Without flip_fusion the same first call gives its own two boxes at their own confidences.
+  o.flip_fusion = false;
+  boxes = make(o, script).detect(image_1280x720());
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_NEAR(boxes[0].confidence, 0.8f, 1e-5);
+  EXPECT_NEAR(boxes[1].confidence, 0.5f, 1e-5);
+}
+
+TEST(Algorithm2, FlipFusionAppliesPolicyAfterFusing) {
+  // most_confident: each pass keeps its boxes; the fused list is cut to one. The image alone is more confident in
+  // the box at (2, 2) (0.5 against 0.4), but the mirror agrees only on the drone at (6, 6): fused 0.45 against 0.25.
+  const std::vector<std::vector<std::vector<Cell>>> script = {
+      {{{0, 2, 2, 0, 0, 0, 0, 0.5f}, {0, 6, 6, 0, 0, 0, 0, 0.4f}}}, {{{0, 6, 6, 0, 0, 0, 0, 0.5f}}}};
+  DetectorPipelineOptions o;
+  o.flip_fusion = true;
+  o.policy = "most_confident";
+  const auto boxes = make(o, script).detect(image_1280x720());
+  ASSERT_EQ(boxes.size(), 1u);
+  EXPECT_NEAR(boxes[0].confidence, 0.45f, 1e-5);
+  EXPECT_NEAR(boxes[0].cx, 6.5f * kCell * 1280 / 416, 1e-2);
+}
+
+TEST(DetectorPipelineOptions, FusionIouOutsideZeroToOneIsNamed) {
+  DetectorPipelineOptions o;
+  EXPECT_DOUBLE_EQ(o.fusion_iou, 0.3);  // the documented default
+  EXPECT_FALSE(o.flip_fusion);
+  for (const double bad : {-0.1, 1.5, std::nan("")}) {
+    o.fusion_iou = bad;
+    const auto problems = o.validate();
+    ASSERT_EQ(problems.size(), 1u) << bad;
+    EXPECT_NE(problems[0].find("detection.fusion_iou"), std::string::npos) << problems[0];
+  }
+  const auto loaded = common::load_options_from_string<DetectorPipelineOptions>(
+      "detection: {flip_fusion: true, fusion_iou: 0.5}", "t.yaml");
+  EXPECT_TRUE(loaded.flip_fusion);
+  EXPECT_DOUBLE_EQ(loaded.fusion_iou, 0.5);
+}
+
 TEST(Algorithm2, RejectsABackendThatDoesNotFitTheModel) {
   class Wrong : public FakeBackend {
    public:
@@ -538,6 +604,23 @@ TEST(Algorithm2, RunsOnTheCpuBackendWithRandomWeights) {
   const auto boxes = p.detect(img);
   EXPECT_LE(boxes.size(), 10u);
   for (size_t i = 1; i < boxes.size(); ++i) EXPECT_GE(boxes[i - 1].confidence, boxes[i].confidence);
+}
+
+TEST(Algorithm2, FlipFusionWithZoomInRunsOnTheCpuBackendWithRandomWeights) {
+  DarknetModel m = thesis();
+  randomize_weights(m, 99);
+  DetectorPipelineOptions o;
+  o.zoom_in = true;
+  o.flip_fusion = true;
+  o.p_thresh = 0.0;  // random weights: keep every box
+  DetectionPipeline p(o, std::make_unique<CpuBackend>(m, 4), m);
+  cv::Mat img(720, 1280, CV_8UC3);
+  cv::randu(img, 0, 255);
+  const auto boxes = p.detect(img);
+  ASSERT_FALSE(boxes.empty());
+  EXPECT_LE(boxes.size(), 10u);
+  for (size_t i = 1; i < boxes.size(); ++i) EXPECT_GE(boxes[i - 1].confidence, boxes[i].confidence);
+  for (const Box& b : boxes) EXPECT_TRUE(b.confidence >= 0.0f && b.confidence <= 1.0f && b.w > 0 && b.h > 0);
 }
 
 }  // namespace

@@ -111,6 +111,10 @@ int main(int argc, char** argv) {
   pr->add_option("--o-thresh", predict.detection.o_thresh, "Non-max suppression IoU threshold (default 0.2)");
   pr->add_flag("--subsquare", predict.detection.subsquare, "Detect in the centred h x h square of a wide image");
   pr->add_flag("--zoom-in", predict.detection.zoom_in, "Re-detect in full-resolution crops around detections");
+  pr->add_flag("--flip-fusion", predict.detection.flip_fusion,
+               "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
+  pr->add_option("--fusion-iou", predict.detection.fusion_iou,
+                 "--flip-fusion: fuse the passes' boxes overlapping above this IoU (default 0.3)");
   pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
   pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
 

@@ -184,6 +184,10 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
   v->add_option("--zoom-max-fraction", vo.detection.zoom_max_fraction,
                 "Zoom in only on boxes at most this fraction of the crop's width and height (default 0.25)");
+  v->add_flag("--flip-fusion", vo.detection.flip_fusion,
+              "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
+  v->add_option("--fusion-iou", vo.detection.fusion_iou,
+                "--flip-fusion: fuse the passes' boxes overlapping above this IoU (default 0.3)");
   v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
   v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
   v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");

@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: MIT
+// Weighted box fusion: hand-computed groups, the rules (one box per view per group, strict IoU threshold, half
+// confidence for a box one view found), invariants on seeded random boxes, and the horizontal mirror.
+#include <wingman/detector/box_fusion.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <stdexcept>
+
+namespace wingman::detector {
+namespace {
+
+Box box(float cx, float cy, float w, float h, float confidence, bool refined = false) {
+  Box b;
+  b.cx = cx;
+  b.cy = cy;
+  b.w = w;
+  b.h = h;
+  b.confidence = confidence;
+  b.zoom_refined = refined;
+  return b;
+}
+
+TEST(FuseBoxes, HandComputedPairAndASingleViewBox) {
+  // View 0: a drone at (100, 50) 40x20, 0.8, and a box elsewhere at 0.5. View 1: the drone at (104, 52) 44x20, 0.6
+  // (IoU with the first: 0.71).
+  std::vector<ViewBox> in = {
+      {box(100, 50, 40, 20, 0.8f), 0}, {box(300, 200, 10, 10, 0.5f), 0}, {box(104, 52, 44, 20, 0.6f, true), 1}};
+  std::vector<Box> out;
+  fuse_boxes(in, 2, 0.3f, out);
+  ASSERT_EQ(out.size(), 2u);
+  // Weighted means: cx = (0.8 x 100 + 0.6 x 104) / 1.4 = 101.714, cy = (0.8 x 50 + 0.6 x 52) / 1.4 = 50.857,
+  // w = (0.8 x 40 + 0.6 x 44) / 1.4 = 41.714, h = 20; confidence (0.8 + 0.6) / 2 = 0.7.
+  EXPECT_NEAR(out[0].cx, 101.7143f, 1e-3);
+  EXPECT_NEAR(out[0].cy, 50.8571f, 1e-3);
+  EXPECT_NEAR(out[0].w, 41.7143f, 1e-3);
+  EXPECT_NEAR(out[0].h, 20.0f, 1e-4);
+  EXPECT_NEAR(out[0].confidence, 0.7f, 1e-6);
+  EXPECT_TRUE(out[0].zoom_refined);  // one member was refined
+  // Found by one view of two: its box, half its confidence.
+  EXPECT_FLOAT_EQ(out[1].cx, 300.0f);
+  EXPECT_FLOAT_EQ(out[1].w, 10.0f);
+  EXPECT_NEAR(out[1].confidence, 0.25f, 1e-6);
+  EXPECT_FALSE(out[1].zoom_refined);
+  // The input is left most confident first.
+  EXPECT_FLOAT_EQ(in[0].box.confidence, 0.8f);
+  EXPECT_FLOAT_EQ(in[1].box.confidence, 0.6f);
+  EXPECT_FLOAT_EQ(in[2].box.confidence, 0.5f);
+}
+
+TEST(FuseBoxes, TwoBoxesOfOneViewNeverFuse) {
+  std::vector<ViewBox> in = {{box(100, 50, 40, 20, 0.8f), 0}, {box(101, 50, 40, 20, 0.7f), 0}};
+  std::vector<Box> out;
+  fuse_boxes(in, 2, 0.3f, out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out[0].confidence, 0.4f, 1e-6);
+  EXPECT_NEAR(out[1].confidence, 0.35f, 1e-6);
+}
+
+TEST(FuseBoxes, JoinsTheGroupItOverlapsMostAboveTheThreshold) {
+  // Two view-0 groups, 10x10 boxes at x 4 and 8; the view-1 box at x 10 overlaps both: [5, 15] against [-1, 9]
+  // (40 of 160: IoU 0.25) and against [3, 13] (80 of 120: IoU 0.667). It joins the second.
+  std::vector<ViewBox> in = {{box(4, 0, 10, 10, 0.9f), 0}, {box(8, 0, 10, 10, 0.8f), 0}, {box(10, 0, 10, 10, 0.5f), 1}};
+  std::vector<Box> out;
+  fuse_boxes(in, 2, 0.1f, out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out[0].confidence, 0.45f, 1e-6);  // alone
+  EXPECT_FLOAT_EQ(out[0].cx, 4.0f);
+  EXPECT_NEAR(out[1].confidence, 0.65f, 1e-6);  // (0.8 + 0.5) / 2
+  EXPECT_NEAR(out[1].cx, (0.8f * 8 + 0.5f * 10) / 1.3f, 1e-4);
+  // The threshold is strict: at IoU 0.667 exactly the two stay apart; just under it they fuse.
+  std::vector<ViewBox> apart = {{box(8, 0, 10, 10, 0.8f), 0}, {box(10, 0, 10, 10, 0.5f), 1}};
+  fuse_boxes(apart, 2, iou(apart[0].box, apart[1].box), out);
+  EXPECT_EQ(out.size(), 2u);
+  fuse_boxes(apart, 2, 0.66f, out);
+  EXPECT_EQ(out.size(), 1u);
+}
+
+TEST(FuseBoxes, OneViewIsTheIdentity) {
+  std::vector<ViewBox> in = {{box(10, 10, 4, 4, 0.3f), 0}, {box(50, 10, 4, 4, 0.6f), 0}};
+  std::vector<Box> out;
+  fuse_boxes(in, 1, 0.3f, out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_FLOAT_EQ(out[0].cx, 50.0f);  // most confident first
+  EXPECT_FLOAT_EQ(out[0].confidence, 0.6f);
+  EXPECT_FLOAT_EQ(out[1].confidence, 0.3f);
+}
+
+TEST(FuseBoxes, SeededRandomBoxesKeepTheirConfidenceMassAndOneBoxPerViewPerGroup) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> pos(0.0f, 200.0f), size(5.0f, 60.0f), conf(0.0f, 1.0f);
+  std::uniform_int_distribution<int> view(0, 2);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<ViewBox> in;
+    double mass = 0.0;
+    for (int k = 0; k < 30; ++k) {
+      in.push_back({box(pos(rng), pos(rng), size(rng), size(rng), conf(rng)), view(rng)});
+      mass += in.back().box.confidence;
+    }
+    std::vector<Box> out;
+    fuse_boxes(in, 3, 0.3f, out);
+    double fused_mass = 0.0;
+    for (const Box& b : out) {
+      fused_mass += b.confidence;
+      EXPECT_LE(b.confidence, 1.0f + 1e-6f);  // at most one box per view: at most the mean of three <= 1
+      EXPECT_GE(b.w, 5.0f - 1e-3f);           // a weighted mean of sizes in [5, 60]
+      EXPECT_LE(b.w, 60.0f + 1e-3f);
+    }
+    EXPECT_NEAR(fused_mass * 3.0, mass, 1e-3) << "trial " << trial;
+    EXPECT_GE(out.size() * 3, in.size()) << "a group holds at most one box of each of the 3 views";
+  }
+}
+
+TEST(FuseBoxes, RejectsBadArguments) {
+  std::vector<Box> out;
+  std::vector<ViewBox> in = {{box(1, 1, 1, 1, 0.5f), 2}};
+  EXPECT_THROW(fuse_boxes(in, 2, 0.3f, out), std::invalid_argument);  // view 2 of views 0..1
+  in[0].view = 0;
+  EXPECT_THROW(fuse_boxes(in, 0, 0.3f, out), std::invalid_argument);
+  EXPECT_THROW(fuse_boxes(in, 33, 0.3f, out), std::invalid_argument);
+  EXPECT_THROW(fuse_boxes(in, 2, 1.5f, out), std::invalid_argument);
+  EXPECT_NO_THROW(fuse_boxes(in, 2, 0.3f, out));
+}
+
+TEST(MirrorHorizontally, MirrorsTheCentreAndKeepsTheRest) {
+  const Box m = mirror_horizontally(box(100, 50, 40, 20, 0.8f, true), 640.0f);
+  EXPECT_FLOAT_EQ(m.cx, 540.0f);
+  EXPECT_FLOAT_EQ(m.cy, 50.0f);
+  EXPECT_FLOAT_EQ(m.w, 40.0f);
+  EXPECT_FLOAT_EQ(m.h, 20.0f);
+  EXPECT_FLOAT_EQ(m.confidence, 0.8f);
+  EXPECT_TRUE(m.zoom_refined);
+  // A box flush with the left border ([0, 40]) mirrors to one flush with the right ([600, 640]).
+  EXPECT_FLOAT_EQ(mirror_horizontally(box(20, 5, 40, 10, 0.5f), 640.0f).cx, 620.0f);
+}
+
+}  // namespace
+}  // namespace wingman::detector
