@@ -11,17 +11,19 @@
 # the negative clips' false positives, and the truths not found: missed or loose, at the frame's edge) and
 # OUT/bench.txt.
 #
-# Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench]
+# Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench] [--val-args ARGS]
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
 #   --cfg      default builtin:wingman-small; --weights default builtin:wingman-small (the shipped model)
 #   --out      default build/model-eval
+#   --val-args more wingman val options for every set, one word each (e.g. "--zoom-in --flip-fusion": the detector's
+#              zoom-in and mirrored second pass); default none (the detector's defaults: a single pass)
 set -euo pipefail
 caller=$(pwd)
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" cfg=builtin:wingman-small weights=builtin:wingman-small out="$src/build/model-eval"
-bench=true
+bench=true val_args=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -29,6 +31,7 @@ while [ $# -gt 0 ]; do
     --weights) weights="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --no-bench) bench=false; shift ;;
+    --val-args) read -r -a val_args <<<"$2"; shift 2 ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "evaluate_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -48,7 +51,8 @@ done
 val() {  # name data.yaml [args]
   local name="$1" yaml="$2"; shift 2
   echo "evaluate_model: $name" >&2
-  "$bin/wingman" val --data "$yaml" --cfg "$cfg" --weights "$weights" --backend opencl "$@" --json > "$out/$name.json"
+  "$bin/wingman" val --data "$yaml" --cfg "$cfg" --weights "$weights" --backend opencl "${val_args[@]}" "$@" --json \
+    > "$out/$name.json"
 }
 val halmstad_val "$data/halmstad/data.yaml"
 for kind in DRONE AIRPLANE BIRD HELICOPTER; do val "halmstad_val_$kind" "$out/val_$kind.yaml"; done

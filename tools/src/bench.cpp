@@ -375,18 +375,21 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
     if (best) r.speedup_vs_dnn = best->ms.median / r.ms.median;
   }
 
-  // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on.
+  // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on, each
+  // with flip fusion off/on.
   cv::setNumThreads(max_threads);
   for (const std::string& size_option : o.pipeline ? o.sizes : std::vector<std::string>{}) {
     const DarknetModel model = bench_model(size_option, o);
     const std::string size = size_label(model.net.width, model.net.height);
     for (const std::string kind : {"opencl", "cpu"}) {
-      for (const bool zoom : {false, true}) {
+      for (const int mode : {0, 1, 2, 3}) {
+        const bool zoom = (mode & 1) != 0, flip = (mode & 2) != 0;
         PipelineResult r;
         r.backend = kind;
         r.size = size;
         r.threads = kind == "opencl" ? ocl_threads : max_threads;
         r.zoom_in = zoom;
+        r.flip_fusion = flip;
         try {
           ForwardStats stats;
           std::unique_ptr<InferenceBackend> inner;
@@ -399,6 +402,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
           }
           detector::DetectorPipelineOptions popt;
           popt.zoom_in = zoom;
+          popt.flip_fusion = flip;
           detector::DetectionPipeline pipeline(popt, std::make_unique<TimedBackend>(std::move(inner), &stats), model);
           size_t frame = 0;
           int64_t boxes = 0;
@@ -481,22 +485,25 @@ std::string BenchDetectorReport::table() const {
   if (pipeline.empty()) return s.str();
   s << fmt::format("pipeline: DetectionPipeline::detect() on a synthetic {}x{} BGR stream (default options)\n",
                    stream_width, stream_height);
-  s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend", "size",
-                   "threads", "zoom", "median", "min", "max", "fps", "forwards", "images", "boxes", "not-fwd %");
+  s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend",
+                   "size", "threads", "zoom", "flip", "median", "min", "max", "fps", "forwards", "images", "boxes",
+                   "not-fwd %");
   for (const PipelineResult& r : pipeline) {
     if (!r.error.empty()) {
-      s << fmt::format("{:<8} {:>7} {:>7} {:>5}  error: {}\n", r.backend, r.size, r.threads, r.zoom_in ? "on" : "off",
-                       r.error);
+      s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>5}  error: {}\n", r.backend, r.size, r.threads,
+                       r.zoom_in ? "on" : "off", r.flip_fusion ? "on" : "off", r.error);
       continue;
     }
     s << fmt::format(
-        "{:<8} {:>7} {:>7} {:>5} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} {:>9.1f}%\n", r.backend,
-        r.size, r.threads, r.zoom_in ? "on" : "off", r.ms.median, r.ms.min, r.ms.max, r.frames_per_s,
-        r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, 100.0 * r.non_forward_share);
+        "{:<8} {:>7} {:>7} {:>5} {:>5} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} {:>9.1f}%\n",
+        r.backend, r.size, r.threads, r.zoom_in ? "on" : "off", r.flip_fusion ? "on" : "off", r.ms.median, r.ms.min,
+        r.ms.max, r.frames_per_s, r.forwards_per_frame, r.images_per_frame, r.detections_per_frame,
+        100.0 * r.non_forward_share);
   }
   s << "\n  ms per frame; forwards/images/boxes: mean per frame; not-fwd %: share of detect() time outside\n"
        "  backend.forward() (resize, decode, NMS), summed over the timed frames. images - 1 = zoom-in crops: only\n"
-       "  boxes that fit the crop and overlap no more confident box are zoomed (random weights' boxes rarely are).\n";
+       "  boxes that fit the crop and overlap no more confident box are zoomed (random weights' boxes rarely are).\n"
+       "  flip: detection.flip_fusion, a second pass (and its crops) on the mirrored frame, boxes fused.\n";
   return s.str();
 }
 
@@ -533,12 +540,12 @@ std::string BenchDetectorReport::json() const {
     const PipelineResult& r = pipeline[i];
     s << (i ? ",\n  " : "\n  ")
       << fmt::format(
-             "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"ms\": {}, "
+             "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"flip_fusion\": {}, \"ms\": {}, "
              "\"frames_per_s\": {:.4f}, \"forwards_per_frame\": {:.4f}, \"images_per_frame\": {:.4f}, "
              "\"detections_per_frame\": {:.4f}, \"non_forward_share\": {:.4f}, \"error\": {}}}",
-             json_string(r.backend), json_string(r.size), r.threads, r.zoom_in ? "true" : "false", json_timing(r.ms),
-             r.frames_per_s, r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, r.non_forward_share,
-             json_string(r.error));
+             json_string(r.backend), json_string(r.size), r.threads, r.zoom_in ? "true" : "false",
+             r.flip_fusion ? "true" : "false", json_timing(r.ms), r.frames_per_s, r.forwards_per_frame,
+             r.images_per_frame, r.detections_per_frame, r.non_forward_share, json_string(r.error));
   }
   s << "]}\n";
   return s.str();

@@ -62,12 +62,13 @@ struct LayerResult {
   double share = 0;        ///< median / sum of the medians of all commands at this size
 };
 
-/// DetectionPipeline::detect() on the synthetic stream, one backend, zoom-in on or off.
+/// DetectionPipeline::detect() on the synthetic stream, one backend, zoom-in and flip fusion each on or off.
 struct PipelineResult {
   std::string backend;              ///< "opencl" or "cpu"
   std::string size;                 ///< network input: "416" (square) or "640x352" (width x height)
   int threads = 0;                  ///< threads (as in ForwardResult)
   bool zoom_in = false;             ///< DetectorPipelineOptions::zoom_in
+  bool flip_fusion = false;         ///< DetectorPipelineOptions::flip_fusion (a second, mirrored pass)
   TimingMs ms;                      ///< per frame (one detect() call)
   double frames_per_s = 0;          ///< 1000 / median
   double forwards_per_frame = 0;    ///< backend.forward() calls per frame, mean
