@@ -423,11 +423,12 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
           r.images_per_frame = static_cast<double>(stats.images) / n;
           r.detections_per_frame = static_cast<double>(boxes) / n;
           r.non_forward_share = total > 0 ? std::max(0.0, (total - stats.ms) / total) : 0;
-          say(fmt::format("pipeline {} {} px zoom-in {}: median {:.2f} ms/frame", kind, size, zoom ? "on" : "off",
-                          r.ms.median));
+          say(fmt::format("pipeline {} {} px zoom-in {} flip fusion {}: median {:.2f} ms/frame", kind, size,
+                          zoom ? "on" : "off", flip ? "on" : "off", r.ms.median));
         } catch (const std::exception& e) {
           r.error = e.what();
-          say(fmt::format("pipeline {} {} px zoom-in {}: {}", kind, size, zoom ? "on" : "off", r.error));
+          say(fmt::format("pipeline {} {} px zoom-in {} flip fusion {}: {}", kind, size, zoom ? "on" : "off",
+                          flip ? "on" : "off", r.error));
         }
         report.pipeline.push_back(std::move(r));
       }
