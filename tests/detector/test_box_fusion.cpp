@@ -12,14 +12,7 @@ namespace wingman::detector {
 namespace {
 
 Box box(float cx, float cy, float w, float h, float confidence, bool refined = false) {
-  Box b;
-  b.cx = cx;
-  b.cy = cy;
-  b.w = w;
-  b.h = h;
-  b.confidence = confidence;
-  b.zoom_refined = refined;
-  return b;
+  return Box{cx, cy, w, h, confidence, refined};
 }
 
 TEST(FuseBoxes, HandComputedPairAndASingleViewBox) {

@@ -73,7 +73,8 @@ struct DetectorPipelineOptions {
 ///     `max_detections` as in step 3;
 ///  6. boxes are returned in full-image pixels, most confident first.
 /// Buffers (network input batch, output tensor, box lists, resize scratch) are allocated at construction;
-/// detect() allocates only the returned vector (and a new image size's resize scratch).
+/// detect() allocates only the returned vector (and, for a new image size, the resize scratch and with flip_fusion the
+/// mirrored image).
 class DetectionPipeline {
  public:
   /// @param options  validated here (std::invalid_argument listing every problem).
