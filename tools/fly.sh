@@ -7,7 +7,7 @@
 #
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
-#                     [--localizer-config FILE]
+#                     [--flip-fusion] [--localizer-config FILE]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -21,6 +21,7 @@
 #   --truth-box      ground-truth detections: the bounding sphere's exact box, the localizer's model (default), or
 #                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
 #   --zoom-in        the detector re-detects each box in a full-resolution crop (Algorithm 2's zoom-in)
+#   --flip-fusion    the detector also detects in the mirrored frame and fuses both passes' boxes (docs/detector.md)
 #   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any; else with
 #                    cnn detections config/flights/cnn.localizer.yaml, the range calibrated to the shipped model's
 #                    boxes; else the defaults)
@@ -30,7 +31,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
-zoom_in=false localizer_config=""
+zoom_in=false flip_fusion=false localizer_config=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -38,6 +39,7 @@ while [ $# -gt 0 ]; do
     --duration) duration="$2"; shift 2 ;;
     --detections) detections="$2"; shift 2 ;;
     --zoom-in) zoom_in=true; shift ;;
+    --flip-fusion) flip_fusion=true; shift ;;
     --localizer-config) localizer_config=$(realpath "$2"); shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
@@ -64,6 +66,7 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   [ "$render" != false ] || again+=(--no-render)
   [ "$record_images" != true ] || again+=(--record-images)
   [ "$zoom_in" != true ] || again+=(--zoom-in)
+  [ "$flip_fusion" != true ] || again+=(--flip-fusion)
   [ -z "$localizer_config" ] || again+=(--localizer-config "$localizer_config")
   exec tools/netns_run.sh "$0" "${again[@]}"
 fi
@@ -118,8 +121,8 @@ detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.
 render: {enabled: $render}
 YAML
 if [ "$detections" = cnn ]; then
-  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s}\n' \
-    "$model_cfg" "$model_weights" "$zoom_in" > "$out/detector.yaml"
+  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s, flip_fusion: %s}\n' \
+    "$model_cfg" "$model_weights" "$zoom_in" "$flip_fusion" > "$out/detector.yaml"
 else
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {weights: ""}\n' > "$out/detector.yaml"
 fi
