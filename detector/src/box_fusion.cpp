@@ -16,8 +16,7 @@ namespace {
 struct Group {
   double weight = 0.0, cx = 0.0, cy = 0.0, w = 0.0, h = 0.0;
   uint32_t views = 0;  ///< bit v set: the group holds a box of view v
-  bool zoom_refined = false;
-  Box fused;
+  Box fused;           ///< the weighted mean so far; zoom_refined when any member is
 };
 
 }  // namespace
@@ -58,7 +57,7 @@ void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, s
     best->w += c * vb.box.w;
     best->h += c * vb.box.h;
     best->views |= bit;
-    best->zoom_refined = best->zoom_refined || vb.box.zoom_refined;
+    const bool refined = best->fused.zoom_refined || vb.box.zoom_refined;
     if (best->weight > 0.0) {
       best->fused.cx = static_cast<float>(best->cx / best->weight);
       best->fused.cy = static_cast<float>(best->cy / best->weight);
@@ -68,16 +67,10 @@ void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, s
       best->fused = vb.box;
     }
     best->fused.confidence = static_cast<float>(best->weight / view_count);
-    best->fused.zoom_refined = best->zoom_refined;
+    best->fused.zoom_refined = refined;
   }
   fused.clear();
   for (const Group& g : groups) fused.push_back(g.fused);
-}
-
-Box mirror_horizontally(const Box& b, float width) {
-  Box m = b;
-  m.cx = width - b.cx;
-  return m;
 }
 
 }  // namespace wingman::detector

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Box IoU, clipping to the image, and non-maximum suppression (Algorithm 1).
+// Box IoU, clipping to the image, mirroring, and non-maximum suppression (Algorithm 1).
 #include "wingman/detector/nms.hpp"
 
 #include <algorithm>
@@ -32,6 +32,12 @@ std::vector<Box> clip_to_image(const std::vector<Box>& boxes, float width, float
     if (c.w > 0.0f && c.h > 0.0f) out.push_back(c);
   }
   return out;
+}
+
+Box mirror_horizontally(const Box& b, float width) {
+  Box m = b;
+  m.cx = width - b.cx;
+  return m;
 }
 
 void non_max_suppression(std::vector<Box>& boxes, float o_thresh) {

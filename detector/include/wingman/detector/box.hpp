@@ -28,4 +28,8 @@ Box clip_to_image(const Box& b, float width, float height);
 /// clip_to_image() of each box, in order, leaving out those wholly outside the image.
 std::vector<Box> clip_to_image(const std::vector<Box>& boxes, float width, float height);
 
+/// The box mirrored about the vertical centre line of an image `width` pixels wide (a horizontal flip: x -> width - x,
+/// the origin at the top-left corner of the top-left pixel). Size, confidence and flags are kept.
+Box mirror_horizontally(const Box& b, float width);
+
 }  // namespace wingman::detector

@@ -30,8 +30,4 @@ struct ViewBox {
 /// 0 <= iou_thresh <= 1; std::invalid_argument otherwise.
 void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, std::vector<Box>& fused);
 
-/// The box mirrored about the vertical centre line of an image `width` pixels wide (a horizontal flip: x -> width - x,
-/// the origin at the top-left corner of the top-left pixel). Size, confidence and flags are kept.
-Box mirror_horizontally(const Box& b, float width);
-
 }  // namespace wingman::detector
