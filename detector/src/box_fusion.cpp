@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 
@@ -19,9 +20,9 @@ struct Group {
   Box fused;           ///< the weighted mean so far; zoom_refined when any member is
 };
 
-}  // namespace
-
-void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, std::vector<Box>& fused) {
+/// Both overloads: `min_size` null (every view sees every size) or view_count minimum sizes.
+void fuse(std::vector<ViewBox>& boxes, int view_count, const float* min_size, float iou_thresh,
+          std::vector<Box>& fused) {
   if (view_count < 1 || view_count > 32)
     throw std::invalid_argument(fmt::format("fuse_boxes: view_count {} must be in 1..32", view_count));
   if (!(iou_thresh >= 0.0f && iou_thresh <= 1.0f))
@@ -70,7 +71,33 @@ void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, s
     best->fused.zoom_refined = refined;
   }
   fused.clear();
-  for (const Group& g : groups) fused.push_back(g.fused);
+  for (const Group& g : groups) {
+    fused.push_back(g.fused);
+    if (min_size == nullptr) continue;
+    // Only the views that see a box this size count; at least those that found it.
+    const float size = std::sqrt(std::max(0.0f, g.fused.w) * std::max(0.0f, g.fused.h));
+    int seeing = 0, holding = 0;
+    for (int v = 0; v < view_count; ++v) {
+      seeing += size >= min_size[v] ? 1 : 0;
+      holding += (g.views >> v) & 1u ? 1 : 0;
+    }
+    fused.back().confidence = static_cast<float>(g.weight / std::max(seeing, holding));
+  }
+}
+
+}  // namespace
+
+void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, std::vector<Box>& fused) {
+  fuse(boxes, view_count, nullptr, iou_thresh, fused);
+}
+
+void fuse_boxes(std::vector<ViewBox>& boxes, const std::vector<float>& view_min_size_px, float iou_thresh,
+                std::vector<Box>& fused) {
+  for (size_t v = 0; v < view_min_size_px.size(); ++v)
+    if (!(std::isfinite(view_min_size_px[v]) && view_min_size_px[v] >= 0.0f))
+      throw std::invalid_argument(
+          fmt::format("fuse_boxes: view {}'s minimum box size {} must be finite and >= 0", v, view_min_size_px[v]));
+  fuse(boxes, static_cast<int>(view_min_size_px.size()), view_min_size_px.data(), iou_thresh, fused);
 }
 
 }  // namespace wingman::detector

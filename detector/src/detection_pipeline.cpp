@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace wingman::detector {
@@ -26,13 +27,32 @@ std::vector<std::string> DetectorPipelineOptions::validate() const {
     p.push_back(problem("detection.zoom_max_fraction", zoom_max_fraction, "must be in (0, 1]"));
   if (!(fusion_iou >= 0.0 && fusion_iou <= 1.0))
     p.push_back(problem("detection.fusion_iou", fusion_iou, "must be in 0..1"));
+  if (!(coarse_scale > 0.0 && coarse_scale < 1.0))
+    p.push_back(problem("detection.coarse_scale", coarse_scale, "must be in (0, 1)"));
+  if (!(std::isfinite(coarse_min_size) && coarse_min_size >= 0.0))
+    p.push_back(problem("detection.coarse_min_size", coarse_min_size, "must be a finite number >= 0 (pixels)"));
   if (max_detections < 1) p.push_back(problem("detection.max_detections", max_detections, "must be >= 1"));
   return p;
 }
 
+cv::Size coarse_net_size(cv::Size net, double scale) {
+  if (net.width <= 0 || net.height <= 0 || !(scale > 0.0 && scale < 1.0))
+    throw std::invalid_argument(fmt::format("coarse_net_size: network {}x{} must be positive, scale {} in (0, 1)",
+                                            net.width, net.height, scale));
+  const auto side = [scale](int n) { return std::max(32, static_cast<int>(std::floor(n * scale / 32.0 + 0.5)) * 32); };
+  return {side(net.width), side(net.height)};
+}
+
+DetectorPipelineOptions coarse_pass_options(const DetectorPipelineOptions& options) {
+  DetectorPipelineOptions coarse = options;
+  coarse.zoom_in = false;
+  coarse.coarse_pass = false;
+  return coarse;
+}
+
 DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::unique_ptr<InferenceBackend> backend,
-                                     const DarknetModel& model)
-    : options_(std::move(options)), backend_(std::move(backend)) {
+                                     const DarknetModel& model, std::unique_ptr<DetectionPipeline> coarse)
+    : options_(std::move(options)), backend_(std::move(backend)), coarse_(std::move(coarse)) {
   const std::vector<std::string> problems = options_.validate();
   if (!problems.empty()) {
     std::string all;
@@ -40,6 +60,14 @@ DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::uniqu
     throw std::invalid_argument("DetectorPipelineOptions: " + all);
   }
   if (!backend_) throw std::invalid_argument("DetectionPipeline: backend is null");
+  if (options_.coarse_pass != (coarse_ != nullptr))
+    throw std::invalid_argument(options_.coarse_pass
+                                    ? "DetectionPipeline: detection.coarse_pass needs the coarse pipeline"
+                                    : "DetectionPipeline: a coarse pipeline without detection.coarse_pass");
+  if (coarse_ && (coarse_->options_.coarse_pass || coarse_->options_.zoom_in))
+    throw std::invalid_argument(
+        "DetectionPipeline: the coarse pipeline must have neither coarse_pass nor zoom_in "
+        "(coarse_pass_options())");
   for (const int h : model.heads()) heads_.push_back(model.layers[h]);
   if (heads_.empty())
     throw std::invalid_argument(
@@ -70,8 +98,11 @@ DetectionPipeline::DetectionPipeline(DetectorPipelineOptions options, std::uniqu
   crops_.reserve(options_.max_detections);
   zoomed_.reserve(options_.max_detections);
   resized_.create(net_size_, CV_8UC3);
-  pass_floor_ = static_cast<float>(options_.flip_fusion ? options_.p_thresh / 2.0 : options_.p_thresh);
-  if (options_.flip_fusion) views_.reserve(2 * static_cast<size_t>(options_.max_detections));
+  const int passes = (options_.flip_fusion ? 2 : 1) * (options_.coarse_pass ? 2 : 1);
+  pass_floor_ = static_cast<float>(options_.p_thresh / passes);
+  if (coarse_) coarse_->pass_floor_ = pass_floor_;
+  if (passes > 1) views_.reserve(static_cast<size_t>(passes) * static_cast<size_t>(options_.max_detections));
+  view_min_size_.reserve(static_cast<size_t>(passes));
 }
 
 void DetectionPipeline::run_and_decode(int count) {
@@ -92,20 +123,22 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
     throw std::invalid_argument(fmt::format("DetectionPipeline::detect: image {}x{} type {}: must be non-empty CV_8UC3",
                                             bgr_image.cols, bgr_image.rows, bgr_image.type()));
   const size_t keep = options_.policy == "most_confident" ? 1 : static_cast<size_t>(options_.max_detections);
-  if (!options_.flip_fusion) {
+  if (!options_.flip_fusion && !options_.coarse_pass) {
     detect_view(bgr_image, keep);
     return detections_;
   }
-  // Step 5: both views, fused.
-  const size_t per_view = static_cast<size_t>(options_.max_detections);
+  // Steps 5-6: every pass, fused.
   views_.clear();
-  detect_view(bgr_image, per_view);
-  for (const Box& b : detections_) views_.push_back({b, 0});
-  cv::flip(bgr_image, mirrored_, 1);
-  detect_view(mirrored_, per_view);
-  const float width = static_cast<float>(bgr_image.cols);
-  for (const Box& b : detections_) views_.push_back({mirror_horizontally(b, width), 1});
-  fuse_boxes(views_, 2, static_cast<float>(options_.fusion_iou), detections_);
+  view_min_size_.clear();
+  if (options_.flip_fusion) cv::flip(bgr_image, mirrored_, 1);  // once, for both sizes' passes
+  const int fine = append_views(bgr_image, mirrored_, 0, 0.0f, views_);
+  view_min_size_.assign(static_cast<size_t>(fine), 0.0f);
+  if (coarse_) {
+    const float min_size = static_cast<float>(options_.coarse_min_size);
+    const int coarse = coarse_->append_views(bgr_image, mirrored_, fine, min_size, views_);
+    view_min_size_.insert(view_min_size_.end(), static_cast<size_t>(coarse), min_size);
+  }
+  fuse_boxes(views_, view_min_size_, static_cast<float>(options_.fusion_iou), detections_);
   const float p_thresh = static_cast<float>(options_.p_thresh);
   detections_.erase(std::remove_if(detections_.begin(), detections_.end(),
                                    [p_thresh](const Box& b) { return b.confidence < p_thresh; }),
@@ -113,6 +146,25 @@ std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
   non_max_suppression(detections_, static_cast<float>(options_.o_thresh));
   if (detections_.size() > keep) detections_.resize(keep);
   return detections_;
+}
+
+int DetectionPipeline::append_views(const cv::Mat& bgr_image, const cv::Mat& mirrored, int first_view, float min_size,
+                                    std::vector<ViewBox>& views) {
+  const size_t per_view = static_cast<size_t>(options_.max_detections);
+  const auto big_enough = [min_size](const Box& b) {
+    return std::sqrt(std::max(0.0f, b.w) * std::max(0.0f, b.h)) >= min_size;
+  };
+  detect_view(bgr_image, per_view);
+  for (const Box& b : detections_)
+    if (big_enough(b)) views.push_back({b, first_view});
+  if (!options_.flip_fusion) return 1;
+  detect_view(mirrored, per_view);
+  const float width = static_cast<float>(bgr_image.cols);
+  for (const Box& b : detections_) {
+    const Box back = mirror_horizontally(b, width);
+    if (big_enough(back)) views.push_back({back, first_view + 1});
+  }
+  return 2;
 }
 
 void DetectionPipeline::detect_view(const cv::Mat& bgr_image, size_t keep) {

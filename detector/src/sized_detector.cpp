@@ -64,7 +64,16 @@ DetectionPipeline& SizedDetector::build(cv::Size net, cv::Size image) {
   sized.net.width = net.width;
   sized.net.height = net.height;
   compute_shapes(sized);
-  auto pipeline = std::make_unique<DetectionPipeline>(options_, make_backend_(sized), sized);
+  std::unique_ptr<DetectionPipeline> coarse;
+  if (options_.coarse_pass) {  // step 6's pipeline, at coarse_scale of this network input
+    DarknetModel small = model_;
+    const cv::Size coarse_net = coarse_net_size(net, options_.coarse_scale);
+    small.net.width = coarse_net.width;
+    small.net.height = coarse_net.height;
+    compute_shapes(small);
+    coarse = std::make_unique<DetectionPipeline>(coarse_pass_options(options_), make_backend_(small), small);
+  }
+  auto pipeline = std::make_unique<DetectionPipeline>(options_, make_backend_(sized), sized, std::move(coarse));
   if (pipelines_.size() >= kMaxPipelines) pipelines_.pop_back();
   pipelines_.insert(pipelines_.begin(), Entry{net, std::move(pipeline)});
   ++builds_;

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <stdexcept>
 
@@ -114,6 +115,46 @@ TEST(FuseBoxes, RejectsBadArguments) {
   EXPECT_THROW(fuse_boxes(in, 33, 0.3f, out), std::invalid_argument);
   EXPECT_THROW(fuse_boxes(in, 2, 1.5f, out), std::invalid_argument);
   EXPECT_NO_THROW(fuse_boxes(in, 2, 0.3f, out));
+}
+
+TEST(FuseBoxes, PerViewMinimumSizesCountOnlyTheViewsThatSeeABoxThatSize) {
+  // Views 0 and 1 see every size, views 2 and 3 (a coarse pass and its mirror) boxes of sqrt(w h) >= 50 only.
+  //  - a small drone (20x20) both fine views found at 0.6 and 0.4: (0.6 + 0.4) / 2 = 0.5, the coarse views do not
+  //    count (with 4 views throughout it would be 0.25);
+  //  - a large one (100x80, sqrt 89.4) only the coarse views found, 0.8 and 0.6: (0.8 + 0.6) / 4 = 0.35;
+  //  - a large one all four found at 0.9, 0.7, 0.5, 0.3: 2.4 / 4 = 0.6.
+  std::vector<ViewBox> in = {{box(30, 30, 20, 20, 0.6f), 0},    {box(31, 30, 20, 20, 0.4f), 1},
+                             {box(300, 200, 100, 80, 0.8f), 2}, {box(302, 200, 100, 80, 0.6f), 3},
+                             {box(600, 300, 120, 90, 0.9f), 0}, {box(602, 300, 120, 90, 0.7f), 1},
+                             {box(598, 302, 120, 90, 0.5f), 2}, {box(600, 298, 120, 90, 0.3f), 3}};
+  std::vector<Box> out;
+  fuse_boxes(in, std::vector<float>{0, 0, 50, 50}, 0.3f, out);
+  ASSERT_EQ(out.size(), 3u);
+  // Groups in the order they started: the 0.9 box, the 0.8 box, the 0.6 box.
+  EXPECT_NEAR(out[0].confidence, 0.6f, 1e-6);
+  EXPECT_NEAR(out[0].cx, (0.9f * 600 + 0.7f * 602 + 0.5f * 598 + 0.3f * 600) / 2.4f, 1e-3);
+  EXPECT_NEAR(out[1].confidence, 0.35f, 1e-6);
+  EXPECT_NEAR(out[1].cx, (0.8f * 300 + 0.6f * 302) / 1.4f, 1e-3);
+  EXPECT_NEAR(out[2].confidence, 0.5f, 1e-6);
+  EXPECT_NEAR(out[2].cx, 30.4f, 1e-4);
+  // All zeros is the view-count overload.
+  std::vector<Box> plain;
+  fuse_boxes(in, std::vector<float>(4, 0.0f), 0.3f, out);
+  fuse_boxes(in, 4, 0.3f, plain);
+  ASSERT_EQ(out.size(), plain.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_FLOAT_EQ(out[i].cx, plain[i].cx);
+    EXPECT_FLOAT_EQ(out[i].confidence, plain[i].confidence);
+  }
+  EXPECT_NEAR(out[2].confidence, 0.25f, 1e-6);
+  // A group holding more views than see its size (a fused box below a coarse view's minimum) counts its own views.
+  std::vector<ViewBox> shrunk = {{box(30, 30, 40, 40, 0.5f), 0}, {box(30, 30, 60, 60, 0.5f), 2}};
+  fuse_boxes(shrunk, std::vector<float>{0, 0, 55, 55}, 0.3f, out);
+  ASSERT_EQ(out.size(), 1u);  // 50x50, below 55: one view sees it, two hold it
+  EXPECT_NEAR(out[0].confidence, 0.5f, 1e-6);
+  for (const float bad : {-1.0f, std::nanf(""), INFINITY})
+    EXPECT_THROW(fuse_boxes(in, std::vector<float>{0, 0, bad, 50}, 0.3f, out), std::invalid_argument) << bad;
+  EXPECT_THROW(fuse_boxes(in, std::vector<float>{0, 0}, 0.3f, out), std::invalid_argument);  // a box of view 2
 }
 
 TEST(MirrorHorizontally, MirrorsTheCentreAndKeepsTheRest) {

@@ -33,18 +33,20 @@ struct Cell {
   float tx, ty, tw, th, confidence;
 };
 
-/// InferenceBackend returning scripted [region] tensors: call k, image i gets the cells script[k][i];
-/// every other cell has confidence ~0. Records the batch size of every call.
+/// InferenceBackend returning scripted [region] tensors of the thesis network at grid x grid cells (its input
+/// 32 grid x 32 grid): call k, image i gets the cells script[k][i]; every other cell has confidence ~0. Records the
+/// batch size of every call.
 class FakeBackend : public InferenceBackend {
  public:
-  FakeBackend(std::vector<std::vector<std::vector<Cell>>> script, int max_batch, std::vector<int>* batches)
-      : script_(std::move(script)), max_batch_(max_batch), batches_(batches) {}
+  FakeBackend(std::vector<std::vector<std::vector<Cell>>> script, int max_batch, std::vector<int>* batches,
+              int grid = 13)
+      : script_(std::move(script)), max_batch_(max_batch), batches_(batches), grid_(grid) {}
   std::string name() const override { return "fake"; }
-  Shape input_shape() const override { return {3, 416, 416}; }
-  std::vector<Shape> output_shapes() const override { return {{30, 13, 13}}; }
+  Shape input_shape() const override { return {3, 32 * grid_, 32 * grid_}; }
+  std::vector<Shape> output_shapes() const override { return {{30, grid_, grid_}}; }
   int max_batch() const override { return max_batch_; }
   void forward(const float*, int batch, std::vector<float>& output) override {
-    const int plane = 13 * 13;
+    const int plane = grid_ * grid_;
     output.assign(static_cast<size_t>(batch) * 30 * plane, 0.0f);
     for (int i = 0; i < batch; ++i) {
       float* o = output.data() + static_cast<size_t>(i) * 30 * plane;
@@ -52,7 +54,7 @@ class FakeBackend : public InferenceBackend {
         for (int p = 0; p < plane; ++p) o[(a * 6 + 4) * plane + p] = -30.0f;
       if (call_ < script_.size() && static_cast<size_t>(i) < script_[call_].size())
         for (const Cell& c : script_[call_][i]) {
-          const int p = c.row * 13 + c.col;
+          const int p = c.row * grid_ + c.col;
           float* base = o + static_cast<size_t>(c.anchor) * 6 * plane;
           base[p] = c.tx;
           base[plane + p] = c.ty;
@@ -69,6 +71,7 @@ class FakeBackend : public InferenceBackend {
   std::vector<std::vector<std::vector<Cell>>> script_;
   int max_batch_;
   std::vector<int>* batches_;
+  int grid_;
   size_t call_ = 0;
 };
 
@@ -501,6 +504,150 @@ TEST(Algorithm2, FlipFusionAppliesPolicyAfterFusing) {
   ASSERT_EQ(boxes.size(), 1u);
   EXPECT_NEAR(boxes[0].confidence, 0.45f, 1e-5);
   EXPECT_NEAR(boxes[0].cx, 6.5f * kCell * 1280 / 416, 1e-2);
+}
+
+/// The thesis network at 224 x 224 (grid 7): the coarse pass of a 416 x 416 one at coarse_scale 0.5.
+DarknetModel thesis_224() {
+  DarknetModel m = thesis();
+  m.net.width = m.net.height = 224;
+  compute_shapes(m);
+  return m;
+}
+
+TEST(Algorithm2, CoarsePassFusesItsLargeBoxesAndCountsOnlyThePassesThatSeeASize) {
+  // The 1280x720 image stretched to 416x416 (grid 13) and, coarse, to 224x224 (grid 7: a cell is 1280/7 x 720/7 image
+  // pixels). The thesis network's anchor 0 is 1.08 x 1.19 cells.
+  DetectorPipelineOptions o;
+  o.coarse_pass = true;
+  o.coarse_min_size = 100;
+  ASSERT_EQ(coarse_net_size({416, 416}, o.coarse_scale), cv::Size(224, 224));
+  const float two = std::log(2.0f), half = std::log(0.5f);
+  const float fx = 1280.0f / 416, fy = 720.0f / 416, cx7 = 1280.0f / 7, cy7 = 720.0f / 7;
+  // Full size: a drone at the centre (cell 6, 6; twice the anchor: 212.7 x 131.8 px), 0.7; a small one (the anchor,
+  // 106.3 x 65.9: sqrt 83.7, under coarse_min_size) at row 10, column 2, 0.55.
+  const std::vector<std::vector<std::vector<Cell>>> fine = {
+      {{{0, 6, 6, 0, 0, two, two, 0.7f}, {0, 10, 2, 0, 0, 0, 0, 0.55f}}}};
+  // Coarse: the centre drone (cell 3, 3; the anchor: 197.5 x 122.4 px), 0.5; a large drone only it finds at (1, 1),
+  // 0.8; a small box (half the anchor: sqrt 77.7) at (5, 5), 0.9: dropped; a large box only it finds at (5, 3), 0.3:
+  // 0.15 after fusion, under p_thresh.
+  const std::vector<std::vector<std::vector<Cell>>> coarse = {{{{0, 3, 3, 0, 0, 0, 0, 0.5f},
+                                                                {0, 1, 1, 0, 0, 0, 0, 0.8f},
+                                                                {0, 5, 5, 0, 0, half, half, 0.9f},
+                                                                {0, 5, 3, 0, 0, 0, 0, 0.3f}}}};
+  std::vector<int> fine_batches, coarse_batches;
+  auto nested = std::make_unique<DetectionPipeline>(
+      coarse_pass_options(o), std::make_unique<FakeBackend>(coarse, 8, &coarse_batches, 7), thesis_224());
+  DetectionPipeline p(o, std::make_unique<FakeBackend>(fine, 8, &fine_batches), thesis(), std::move(nested));
+  ASSERT_NE(p.coarse(), nullptr);
+  const std::vector<Box> boxes = p.detect(image_1280x720());
+  EXPECT_EQ(fine_batches, (std::vector<int>{1}));
+  EXPECT_EQ(coarse_batches, (std::vector<int>{1}));
+  ASSERT_EQ(boxes.size(), 3u);
+  // Both passes' centre drone: (0.7 + 0.5) / 2, the confidence-weighted mean box.
+  EXPECT_NEAR(boxes[0].confidence, 0.6f, 1e-5);
+  EXPECT_NEAR(boxes[0].cx, 640.0f, 1e-2);
+  EXPECT_NEAR(boxes[0].cy, 360.0f, 1e-2);
+  EXPECT_NEAR(boxes[0].w, (0.7f * 2 * 1.08f * kCell * fx + 0.5f * 1.08f * cx7) / 1.2f, 1e-2);
+  EXPECT_NEAR(boxes[0].h, (0.7f * 2 * 1.19f * kCell * fy + 0.5f * 1.19f * cy7) / 1.2f, 1e-2);
+  // The small drone: only the full-size pass sees its size, so it keeps its confidence.
+  EXPECT_NEAR(boxes[1].confidence, 0.55f, 1e-5);
+  EXPECT_NEAR(boxes[1].cx, 2.5f * kCell * fx, 1e-2);
+  EXPECT_NEAR(boxes[1].cy, 10.5f * kCell * fy, 1e-2);
+  // The large drone only the coarse pass found: half its confidence.
+  EXPECT_NEAR(boxes[2].confidence, 0.4f, 1e-5);
+  EXPECT_NEAR(boxes[2].cx, 1.5f * cx7, 1e-2);
+  EXPECT_NEAR(boxes[2].cy, 1.5f * cy7, 1e-2);
+  EXPECT_NEAR(boxes[2].w, 1.08f * cx7, 1e-2);
+}
+
+TEST(Algorithm2, CoarsePassWithFlipFusionRunsFourPassesAndNeedsItsPipeline) {
+  // A drone at the centre that every pass finds at 0.8: four passes, fused at 0.8; the coarse pipeline's zoom-in is
+  // off (coarse_pass_options()) while the full-size one zooms (1280x720 is larger than 416x416): one crop per view, at
+  // full resolution around the centre, re-detects the drone at the first pass's size (106.3 x 65.9 px). The coarse
+  // passes see it at 0.6 of their anchor (118.5 x 73.4 px; IoU 0.81 with it).
+  DetectorPipelineOptions o;
+  o.coarse_pass = true;
+  o.flip_fusion = true;
+  o.zoom_in = true;
+  o.zoom_max_fraction = 0.5;  // the box is 0.26 of the network's width
+  const float fx = 1280.0f / 416, fy = 720.0f / 416, shrink = std::log(0.6f);
+  const std::vector<Cell> first = {{0, 6, 6, 0, 0, 0, 0, 0.8f}};
+  const std::vector<Cell> crop = {{0, 6, 6, 0, 0, std::log(fx), std::log(fy), 0.8f}};
+  const std::vector<Cell> coarse = {{0, 3, 3, 0, 0, shrink, shrink, 0.8f}};
+  std::vector<int> fine_batches, coarse_batches;
+  auto nested = std::make_unique<DetectionPipeline>(
+      coarse_pass_options(o),
+      std::make_unique<FakeBackend>(std::vector<std::vector<std::vector<Cell>>>{{coarse}, {coarse}}, 8, &coarse_batches,
+                                    7),
+      thesis_224());
+  EXPECT_FALSE(nested->options().zoom_in);
+  EXPECT_FALSE(nested->options().coarse_pass);
+  DetectionPipeline p(
+      o,
+      std::make_unique<FakeBackend>(std::vector<std::vector<std::vector<Cell>>>{{first}, {crop}, {first}, {crop}}, 8,
+                                    &fine_batches),
+      thesis(), std::move(nested));
+  const std::vector<Box> boxes = p.detect(image_1280x720());
+  EXPECT_EQ(fine_batches, (std::vector<int>{1, 1, 1, 1}));  // image, its crop, mirror, its crop
+  EXPECT_EQ(coarse_batches, (std::vector<int>{1, 1}));      // image, mirror
+  ASSERT_EQ(boxes.size(), 1u);
+  EXPECT_NEAR(boxes[0].confidence, 0.8f, 1e-5);
+  EXPECT_NEAR(boxes[0].cx, 640.0f, 1.0f);
+
+  // coarse_pass and the coarse pipeline go together, and the nested one must not zoom or nest again.
+  const auto fake = [] {
+    return std::make_unique<FakeBackend>(std::vector<std::vector<std::vector<Cell>>>{}, 1, nullptr);
+  };
+  const auto fake7 = [] {
+    return std::make_unique<FakeBackend>(std::vector<std::vector<std::vector<Cell>>>{}, 1, nullptr, 7);
+  };
+  EXPECT_THROW(DetectionPipeline(o, fake(), thesis()), std::invalid_argument);
+  DetectorPipelineOptions plain;
+  EXPECT_THROW(
+      DetectionPipeline(plain, fake(), thesis(),
+                        std::make_unique<DetectionPipeline>(coarse_pass_options(plain), fake7(), thesis_224())),
+      std::invalid_argument);
+  DetectorPipelineOptions zooming;
+  zooming.zoom_in = true;
+  EXPECT_THROW(
+      DetectionPipeline(o, fake(), thesis(), std::make_unique<DetectionPipeline>(zooming, fake7(), thesis_224())),
+      std::invalid_argument);
+}
+
+TEST(DetectorPipelineOptions, CoarsePassKeysAndItsNetworkSize) {
+  DetectorPipelineOptions o;
+  EXPECT_FALSE(o.coarse_pass);  // the documented defaults
+  EXPECT_DOUBLE_EQ(o.coarse_scale, 0.5);
+  EXPECT_DOUBLE_EQ(o.coarse_min_size, 48.0);
+  for (const double bad : {0.0, 1.0, -0.5, std::nan("")}) {
+    o.coarse_scale = bad;
+    const auto problems = o.validate();
+    ASSERT_EQ(problems.size(), 1u) << bad;
+    EXPECT_NE(problems[0].find("detection.coarse_scale"), std::string::npos) << problems[0];
+  }
+  o.coarse_scale = 0.5;
+  for (const double bad : {-1.0, std::nan(""), HUGE_VAL}) {
+    o.coarse_min_size = bad;
+    const auto problems = o.validate();
+    ASSERT_EQ(problems.size(), 1u) << bad;
+    EXPECT_NE(problems[0].find("detection.coarse_min_size"), std::string::npos) << problems[0];
+  }
+  const auto loaded = common::load_options_from_string<DetectorPipelineOptions>(
+      "detection: {coarse_pass: true, coarse_scale: 0.6, coarse_min_size: 32}", "t.yaml");
+  EXPECT_TRUE(loaded.coarse_pass);
+  EXPECT_DOUBLE_EQ(loaded.coarse_scale, 0.6);
+  EXPECT_DOUBLE_EQ(loaded.coarse_min_size, 32.0);
+  // Sides times the scale, to the nearest multiple of 32 (halves up), at least 32.
+  EXPECT_EQ(coarse_net_size({640, 352}, 0.5), cv::Size(320, 192));  // 176 is 5.5 x 32: up
+  EXPECT_EQ(coarse_net_size({640, 352}, 0.4), cv::Size(256, 128));  // 140.8
+  EXPECT_EQ(coarse_net_size({640, 352}, 0.6), cv::Size(384, 224));  // 211.2
+  EXPECT_EQ(coarse_net_size({64, 32}, 0.1), cv::Size(32, 32));
+  EXPECT_THROW(coarse_net_size({640, 352}, 1.0), std::invalid_argument);
+  EXPECT_THROW(coarse_net_size({0, 352}, 0.5), std::invalid_argument);
+  const DetectorPipelineOptions nested = coarse_pass_options(loaded);
+  EXPECT_FALSE(nested.coarse_pass);
+  EXPECT_FALSE(nested.zoom_in);
+  EXPECT_DOUBLE_EQ(nested.p_thresh, loaded.p_thresh);
 }
 
 TEST(DetectorPipelineOptions, FusionIouOutsideZeroToOneIsNamed) {

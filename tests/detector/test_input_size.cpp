@@ -158,6 +158,48 @@ TEST(SizedDetector, AutoBuildsOnePipelinePerAspectAndMatchesAHandBuiltOne) {
   EXPECT_EQ(d.builds(), 2);
 }
 
+TEST(SizedDetector, CoarsePassBuildsItsBackendAtHalfTheInputAndMatchesAHandBuiltPipeline) {
+  const DarknetModel model = small_two_head_model();
+  DetectorPipelineOptions o = keep_many();
+  o.coarse_pass = true;
+  o.coarse_min_size = 0;           // random weights: keep the coarse boxes of every size
+  std::vector<cv::Size> backends;  // the network input of every backend made
+  SizedDetector d(o, model, *InputSize::parse("auto"), [&](const DarknetModel& m) {
+    backends.emplace_back(m.net.width, m.net.height);
+    return std::make_unique<CpuBackend>(m, 1);
+  });
+  // The coarse backend first (the nested pipeline is built before the one holding it), at 64 x 32.
+  EXPECT_EQ(backends, (std::vector<cv::Size>{{64, 32}, {128, 64}}));
+  EXPECT_EQ(d.builds(), 1);
+  const cv::Mat wide = noise(1280, 720, 3);
+  DetectionPipeline& p = d.pipeline_for(wide.size());
+  ASSERT_NE(p.coarse(), nullptr);
+  EXPECT_EQ(p.coarse()->backend().input_shape(), (Shape{3, 32, 64}));
+  EXPECT_FALSE(p.coarse()->options().coarse_pass);
+  const std::vector<Box> boxes = d.detect(wide);
+
+  DarknetModel coarse_model = model;
+  coarse_model.net.width = 64;
+  coarse_model.net.height = 32;
+  compute_shapes(coarse_model);
+  DetectionPipeline reference(o, std::make_unique<CpuBackend>(model, 1), model,
+                              std::make_unique<DetectionPipeline>(
+                                  coarse_pass_options(o), std::make_unique<CpuBackend>(coarse_model, 1), coarse_model));
+  const std::vector<Box> want = reference.detect(wide);
+  ASSERT_EQ(boxes.size(), want.size());
+  EXPECT_FALSE(want.empty());
+  for (size_t i = 0; i < want.size(); ++i) {
+    EXPECT_FLOAT_EQ(boxes[i].cx, want[i].cx);
+    EXPECT_FLOAT_EQ(boxes[i].w, want[i].w);
+    EXPECT_FLOAT_EQ(boxes[i].confidence, want[i].confidence);
+  }
+  // Not the full-size pass alone: the coarse boxes joined and halved the confidences of the boxes one pass found.
+  const std::vector<Box> alone = reference_detect(model, keep_many(), {128, 64}, wide);
+  bool differs = alone.size() != want.size();
+  for (size_t i = 0; !differs && i < want.size(); ++i) differs = alone[i].confidence != want[i].confidence;
+  EXPECT_TRUE(differs);
+}
+
 TEST(SizedDetector, KeepsTheLastFewSizesAndRebuildsAnEvictedOne) {
   SizedDetector d(keep_many(), small_two_head_model(), *InputSize::parse("auto"),
                   [](const DarknetModel& m) { return std::make_unique<CpuBackend>(m, 1); });

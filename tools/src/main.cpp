@@ -114,7 +114,13 @@ int main(int argc, char** argv) {
   pr->add_flag("--flip-fusion", predict.detection.flip_fusion,
                "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
   pr->add_option("--fusion-iou", predict.detection.fusion_iou,
-                 "--flip-fusion: fuse the passes' boxes overlapping above this IoU (default 0.3)");
+                 "--flip-fusion, --coarse-pass: fuse the passes' boxes overlapping above this IoU (default 0.3)");
+  pr->add_flag("--coarse-pass", predict.detection.coarse_pass,
+               "Also detect at --coarse-scale of the network input and fuse its large boxes (close drones)");
+  pr->add_option("--coarse-scale", predict.detection.coarse_scale,
+                 "--coarse-pass: network input sides times this, multiples of 32 (default 0.5)");
+  pr->add_option("--coarse-min-size", predict.detection.coarse_min_size,
+                 "--coarse-pass: drop its boxes below this sqrt(w h), image pixels (default 48)");
   pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
   pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
 

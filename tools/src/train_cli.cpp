@@ -187,7 +187,13 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_flag("--flip-fusion", vo.detection.flip_fusion,
               "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
   v->add_option("--fusion-iou", vo.detection.fusion_iou,
-                "--flip-fusion: fuse the passes' boxes overlapping above this IoU (default 0.3)");
+                "--flip-fusion, --coarse-pass: fuse the passes' boxes overlapping above this IoU (default 0.3)");
+  v->add_flag("--coarse-pass", vo.detection.coarse_pass,
+              "Also detect at --coarse-scale of the network input and fuse its large boxes (close drones)");
+  v->add_option("--coarse-scale", vo.detection.coarse_scale,
+                "--coarse-pass: network input sides times this, multiples of 32 (default 0.5)");
+  v->add_option("--coarse-min-size", vo.detection.coarse_min_size,
+                "--coarse-pass: drop its boxes below this sqrt(w h), image pixels (default 48)");
   v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
   v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
   v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");

@@ -30,4 +30,13 @@ struct ViewBox {
 /// 0 <= iou_thresh <= 1; std::invalid_argument otherwise.
 void fuse_boxes(std::vector<ViewBox>& boxes, int view_count, float iou_thresh, std::vector<Box>& fused);
 
+/// fuse_boxes() for views that do not all see every box size (a coarse pass at a fraction of the network input
+/// cannot find a small drone): `view_min_size_px[v]` is the smallest box, sqrt(w h) in image pixels, that view v
+/// reports; its view_count is the vector's size. The caller drops view v's boxes below it before fusing. A group's
+/// confidence is the sum of its members' over the number of views that see a box of the fused box's size (those
+/// whose minimum it reaches; at least the views it holds), so that a small drone the fine views both found keeps its
+/// confidence. All zeros is the fuse_boxes() above. Preconditions as above, and every minimum finite and >= 0.
+void fuse_boxes(std::vector<ViewBox>& boxes, const std::vector<float>& view_min_size_px, float iou_thresh,
+                std::vector<Box>& fused);
+
 }  // namespace wingman::detector

@@ -27,9 +27,15 @@ struct DetectorPipelineOptions {
   /// also detect in the horizontally mirrored image and fuse the two passes' boxes (weighted box fusion,
   /// fuse_boxes()): tighter boxes and fewer one-view false positives, for twice the network work
   bool flip_fusion = false;
-  double fusion_iou = 0.3;     ///< flip_fusion: boxes of the two passes overlapping at IoU > this are one drone, 0..1
-  std::string policy = "all";  ///< which detections to return: "all" or "most_confident"
-  int max_detections = 10;     ///< at most this many boxes per image (and zoom-in crops), >= 1
+  double fusion_iou = 0.3;  ///< flip_fusion, coarse_pass: boxes of two passes overlapping at IoU > this are fused, 0..1
+  /// also detect with the network input scaled by coarse_scale (the whole image; with flip_fusion its mirror too) and
+  /// fuse those boxes of at least coarse_min_size with the full-size passes' (step 6): finds the close drones too large
+  /// for the full-size network's receptive field and largest anchors, for about coarse_scale^2 more network work
+  bool coarse_pass = false;
+  double coarse_scale = 0.5;      ///< coarse_pass: network input sides times this (multiples of 32), (0, 1)
+  double coarse_min_size = 48.0;  ///< coarse_pass: its boxes below this sqrt(w h), image pixels, are dropped, >= 0
+  std::string policy = "all";     ///< which detections to return: "all" or "most_confident"
+  int max_detections = 10;        ///< at most this many boxes per image (and zoom-in crops), >= 1
 
   template <class V>
   void visit(V& v) {
@@ -42,13 +48,26 @@ struct DetectorPipelineOptions {
     v("detection.flip_fusion", flip_fusion,
       "also detect in the mirrored image and fuse both passes' boxes (weighted box fusion; twice the work)");
     v("detection.fusion_iou", fusion_iou,
-      "flip_fusion: boxes of the two passes overlapping above this IoU are fused (0..1)");
+      "flip_fusion, coarse_pass: boxes of two passes overlapping above this IoU are fused (0..1)");
+    v("detection.coarse_pass", coarse_pass,
+      "also detect at coarse_scale of the network input and fuse its large boxes (close drones)");
+    v("detection.coarse_scale", coarse_scale, "coarse_pass: network input sides times this, multiples of 32 (0..1)");
+    v("detection.coarse_min_size", coarse_min_size,
+      "coarse_pass: its boxes smaller than this sqrt(w h), image pixels, are dropped (>= 0)");
     v("detection.policy", policy, "all or most_confident");
     v("detection.max_detections", max_detections, "at most this many boxes per image (>= 1)");
   }
   /// One "key = value: rule" line per invalid field; empty when valid.
   std::vector<std::string> validate() const;
 };
+
+/// coarse_pass: the coarse pass's network input for a full-size one of `net`: each side times `scale`, rounded to
+/// the nearest multiple of 32 (halves up), at least 32 (640x352 at 0.5: 320x192). Preconditions: `net` positive,
+/// 0 < scale < 1 (std::invalid_argument otherwise).
+cv::Size coarse_net_size(cv::Size net, double scale);
+/// coarse_pass: the options of the nested coarse pipeline for the full-size pipeline's `options`: no zoom-in (a crop
+/// is finer than the full-size pass already) and no coarse pass of its own; the rest as given.
+DetectorPipelineOptions coarse_pass_options(const DetectorPipelineOptions& options);
 
 /// Algorithm 2, on one BGR image at a time, with any InferenceBackend whose network has [region] or [yolo]
 /// heads (the thesis network: one [region]; a tiny-YOLOv3: two [yolo]):
@@ -71,10 +90,16 @@ struct DetectorPipelineOptions {
 ///     are fused (fuse_boxes(), IoU > fusion_iou: a box both passes found is their confidence-weighted mean with the
 ///     mean confidence; one only one pass found keeps half its confidence); then >= p_thresh, NMS, `policy` and
 ///     `max_detections` as in step 3;
-///  6. boxes are returned in full-image pixels, most confident first.
+///  6. with `coarse_pass`, a nested DetectionPipeline at coarse_net_size() (coarse_pass_options(): no zoom-in) runs
+///     steps 1-3 on the image (and with flip_fusion on its mirror too); its boxes of sqrt(w h) >= coarse_min_size
+///     join the full-size passes' and all are fused (fuse_boxes() with per-view minimum sizes, IoU > fusion_iou: a
+///     box's confidence is its group's sum over the passes that see its size, so a small drone keeps the full-size
+///     passes' confidence and a large one only the coarse passes found keeps half); each pass keeps boxes >=
+///     p_thresh / (number of passes); then >= p_thresh, NMS, `policy` and `max_detections` as in step 3;
+///  7. boxes are returned in full-image pixels, most confident first.
 /// Buffers (network input batch, output tensor, box lists, resize scratch) are allocated at construction;
 /// detect() allocates only the returned vector (and, for a new image size, the resize scratch and with flip_fusion the
-/// mirrored image).
+/// mirrored image; the coarse pipeline likewise).
 class DetectionPipeline {
  public:
   /// @param options  validated here (std::invalid_argument listing every problem).
@@ -82,8 +107,10 @@ class DetectionPipeline {
   ///                 heads' inputs, in order (std::invalid_argument otherwise).
   /// @param model    the network the backend runs; must have at least one [region] or [yolo] head (the
   ///                 anchors are taken from them).
+  /// @param coarse   with options.coarse_pass (and only then; std::invalid_argument otherwise), the step 6 pipeline:
+  ///                 built with coarse_pass_options(options) on the model at coarse_net_size() of its size.
   DetectionPipeline(DetectorPipelineOptions options, std::unique_ptr<InferenceBackend> backend,
-                    const DarknetModel& model);
+                    const DarknetModel& model, std::unique_ptr<DetectionPipeline> coarse = nullptr);
 
   /// Detects drones in `bgr_image` (CV_8UC3, any size >= 1 x 1; std::invalid_argument otherwise).
   /// Returns boxes in full-image pixels, most confident first.
@@ -91,6 +118,8 @@ class DetectionPipeline {
 
   const DetectorPipelineOptions& options() const { return options_; }
   InferenceBackend& backend() { return *backend_; }
+  /// coarse_pass: the nested coarse pipeline; null otherwise.
+  DetectionPipeline* coarse() { return coarse_.get(); }
 
  private:
   /// Runs `count` images already in input_ through the backend and decodes image i's boxes from every head
@@ -98,22 +127,29 @@ class DetectionPipeline {
   void run_and_decode(int count);
   /// Steps 1-4 on one view (the image or its mirror), keeping at most `keep` first-pass boxes; into detections_.
   void detect_view(const cv::Mat& bgr_image, size_t keep);
+  /// Steps 1-4 on the image and, with flip_fusion, on `mirrored` (the image's horizontal mirror); appends the boxes
+  /// of at least `min_size` (sqrt(w h), image pixels; the mirror's mirrored back) to `views` as views first_view and
+  /// first_view + 1. Returns the number of views run (1 or 2).
+  int append_views(const cv::Mat& bgr_image, const cv::Mat& mirrored, int first_view, float min_size,
+                   std::vector<ViewBox>& views);
 
   DetectorPipelineOptions options_;
   std::unique_ptr<InferenceBackend> backend_;
-  std::vector<Layer> heads_;                  ///< the [region]/[yolo] layers, in the backend's output order
-  cv::Size net_size_;                         ///< network input, pixels
-  int batch_capacity_ = 1;                    ///< images input_ holds: min(max_batch, max_detections), >= 1
-  std::vector<float> input_;                  ///< batch_capacity_ x 3 x H x W network inputs
-  std::vector<float> output_;                 ///< raw output tensor of the last forward()
-  std::vector<std::vector<Box>> candidates_;  ///< per batch slot: decoded boxes
-  std::vector<Box> detections_;               ///< current detections, full-image pixels
-  std::vector<cv::Rect> crops_;               ///< zoom-in crops, full-image pixels
-  std::vector<size_t> zoomed_;                ///< per crop: the index in detections_ it re-detects
-  cv::Mat resized_;                           ///< resize scratch
-  float pass_floor_ = 0.0f;     ///< confidence floor of each pass: p_thresh, p_thresh / 2 with flip_fusion
-  cv::Mat mirrored_;            ///< flip_fusion: the mirrored image
-  std::vector<ViewBox> views_;  ///< flip_fusion: both passes' boxes, full-image pixels
+  std::vector<Layer> heads_;                   ///< the [region]/[yolo] layers, in the backend's output order
+  cv::Size net_size_;                          ///< network input, pixels
+  int batch_capacity_ = 1;                     ///< images input_ holds: min(max_batch, max_detections), >= 1
+  std::vector<float> input_;                   ///< batch_capacity_ x 3 x H x W network inputs
+  std::vector<float> output_;                  ///< raw output tensor of the last forward()
+  std::vector<std::vector<Box>> candidates_;   ///< per batch slot: decoded boxes
+  std::vector<Box> detections_;                ///< current detections, full-image pixels
+  std::vector<cv::Rect> crops_;                ///< zoom-in crops, full-image pixels
+  std::vector<size_t> zoomed_;                 ///< per crop: the index in detections_ it re-detects
+  cv::Mat resized_;                            ///< resize scratch
+  float pass_floor_ = 0.0f;                    ///< confidence floor of each pass: p_thresh over the number of passes
+  cv::Mat mirrored_;                           ///< flip_fusion: the mirrored image
+  std::vector<ViewBox> views_;                 ///< flip_fusion, coarse_pass: every pass's boxes, full-image pixels
+  std::vector<float> view_min_size_;           ///< coarse_pass: per pass, the smallest box it reports (fuse_boxes())
+  std::unique_ptr<DetectionPipeline> coarse_;  ///< coarse_pass: the step 6 pipeline
 };
 
 }  // namespace wingman::detector

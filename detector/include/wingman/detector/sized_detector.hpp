@@ -19,7 +19,8 @@ namespace wingman::detector {
 /// input size that the images call for, through `make_backend`, and keeps the last few (images of a few sizes
 /// alternating do not rebuild). With kCfg and kFixed there is one pipeline, built at construction; kAuto builds the
 /// cfg-sized one at construction (so that a bad model or backend fails at start-up) and another when an image's
-/// region calls for another size.
+/// region calls for another size. With detection.coarse_pass each pipeline holds its coarse one (a second backend,
+/// at coarse_net_size() of the pipeline's input).
 class SizedDetector {
  public:
   /// Creates the backend for `model` at the model's (already set) net size; throws what it likes.
