@@ -15,8 +15,9 @@
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
 #   --cfg      default builtin:wingman-small; --weights default builtin:wingman-small (the shipped model)
 #   --out      default build/model-eval
-#   --val-args more wingman val options for every set, one word each (e.g. "--zoom-in --flip-fusion": the detector's
-#              zoom-in and mirrored second pass); default none (the detector's defaults: a single pass)
+#   --val-args more wingman val options for every set, one word each (e.g. "--zoom-in --flip-fusion --coarse-pass":
+#              the detector's zoom-in, mirrored second pass and half-size pass); default none (the detector's
+#              defaults: a single pass)
 set -euo pipefail
 caller=$(pwd)
 cd "$(dirname "$0")/.."

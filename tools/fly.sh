@@ -7,7 +7,7 @@
 #
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
-#                     [--flip-fusion] [--localizer-config FILE]
+#                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -22,6 +22,7 @@
 #                    the drone's silhouette box (what a perfect detector draws; see docs/simulation.md for the bias)
 #   --zoom-in        the detector re-detects each box in a full-resolution crop (Algorithm 2's zoom-in)
 #   --flip-fusion    the detector also detects in the mirrored frame and fuses both passes' boxes (docs/detector.md)
+#   --coarse-pass    the detector also detects at half the network input and fuses its large boxes (close drones)
 #   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any; else with
 #                    cnn detections config/flights/cnn.localizer.yaml, the range calibrated to the shipped model's
 #                    boxes; else the defaults)
@@ -31,7 +32,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
-zoom_in=false flip_fusion=false localizer_config=""
+zoom_in=false flip_fusion=false coarse_pass=false localizer_config=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -40,6 +41,7 @@ while [ $# -gt 0 ]; do
     --detections) detections="$2"; shift 2 ;;
     --zoom-in) zoom_in=true; shift ;;
     --flip-fusion) flip_fusion=true; shift ;;
+    --coarse-pass) coarse_pass=true; shift ;;
     --localizer-config) localizer_config=$(realpath "$2"); shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
@@ -67,6 +69,7 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   [ "$record_images" != true ] || again+=(--record-images)
   [ "$zoom_in" != true ] || again+=(--zoom-in)
   [ "$flip_fusion" != true ] || again+=(--flip-fusion)
+  [ "$coarse_pass" != true ] || again+=(--coarse-pass)
   [ -z "$localizer_config" ] || again+=(--localizer-config "$localizer_config")
   exec tools/netns_run.sh "$0" "${again[@]}"
 fi
@@ -121,8 +124,8 @@ detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.
 render: {enabled: $render}
 YAML
 if [ "$detections" = cnn ]; then
-  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s, flip_fusion: %s}\n' \
-    "$model_cfg" "$model_weights" "$zoom_in" "$flip_fusion" > "$out/detector.yaml"
+  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s, flip_fusion: %s, coarse_pass: %s}\n' \
+    "$model_cfg" "$model_weights" "$zoom_in" "$flip_fusion" "$coarse_pass" > "$out/detector.yaml"
 else
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {weights: ""}\n' > "$out/detector.yaml"
 fi

@@ -376,34 +376,52 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
   }
 
   // Whole pipeline on the synthetic stream, per size, OpenCL and CpuBackend (most threads), zoom-in off/on, each
-  // with flip fusion off/on.
+  // with flip fusion off/on; then the coarse pass alone and with both.
   cv::setNumThreads(max_threads);
   for (const std::string& size_option : o.pipeline ? o.sizes : std::vector<std::string>{}) {
     const DarknetModel model = bench_model(size_option, o);
     const std::string size = size_label(model.net.width, model.net.height);
     for (const std::string kind : {"opencl", "cpu"}) {
-      for (const int mode : {0, 1, 2, 3}) {
-        const bool zoom = (mode & 1) != 0, flip = (mode & 2) != 0;
+      for (const int mode : {0, 1, 2, 3, 4, 7}) {
+        const bool zoom = (mode & 1) != 0, flip = (mode & 2) != 0, coarse = (mode & 4) != 0;
+        const std::string label = fmt::format("pipeline {} {} px zoom-in {} flip fusion {} coarse pass {}", kind, size,
+                                              zoom ? "on" : "off", flip ? "on" : "off", coarse ? "on" : "off");
         PipelineResult r;
         r.backend = kind;
         r.size = size;
         r.threads = kind == "opencl" ? ocl_threads : max_threads;
         r.zoom_in = zoom;
         r.flip_fusion = flip;
+        r.coarse_pass = coarse;
         try {
-          ForwardStats stats;
-          std::unique_ptr<InferenceBackend> inner;
-          if (kind == "opencl") {
-            detector::OpenClOptions ocl;
-            ocl.max_batch = o.pipeline_max_batch;
-            inner = std::make_unique<detector::OpenClBackend>(model, ocl);
-          } else {
-            inner = std::make_unique<detector::CpuBackend>(model, o.pipeline_max_batch);
-          }
+          ForwardStats stats;  // both pipelines' forwards with the coarse pass
+          auto timed_backend = [&](const DarknetModel& m) -> std::unique_ptr<InferenceBackend> {
+            std::unique_ptr<InferenceBackend> inner;
+            if (kind == "opencl") {
+              detector::OpenClOptions ocl;
+              ocl.max_batch = o.pipeline_max_batch;
+              inner = std::make_unique<detector::OpenClBackend>(m, ocl);
+            } else {
+              inner = std::make_unique<detector::CpuBackend>(m, o.pipeline_max_batch);
+            }
+            return std::make_unique<TimedBackend>(std::move(inner), &stats);
+          };
           detector::DetectorPipelineOptions popt;
           popt.zoom_in = zoom;
           popt.flip_fusion = flip;
-          detector::DetectionPipeline pipeline(popt, std::make_unique<TimedBackend>(std::move(inner), &stats), model);
+          popt.coarse_pass = coarse;
+          std::unique_ptr<detector::DetectionPipeline> coarse_pipeline;
+          if (coarse) {  // as SizedDetector builds it: the same weights at coarse_net_size()
+            DarknetModel small = model;
+            const cv::Size coarse_net =
+                detector::coarse_net_size(cv::Size(model.net.width, model.net.height), popt.coarse_scale);
+            small.net.width = coarse_net.width;
+            small.net.height = coarse_net.height;
+            detector::compute_shapes(small);
+            coarse_pipeline = std::make_unique<detector::DetectionPipeline>(detector::coarse_pass_options(popt),
+                                                                            timed_backend(small), small);
+          }
+          detector::DetectionPipeline pipeline(popt, timed_backend(model), model, std::move(coarse_pipeline));
           size_t frame = 0;
           int64_t boxes = 0;
           for (int i = 0; i < o.warmup; ++i) pipeline.detect(stream[frame++ % stream.size()]);
@@ -423,12 +441,10 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
           r.images_per_frame = static_cast<double>(stats.images) / n;
           r.detections_per_frame = static_cast<double>(boxes) / n;
           r.non_forward_share = total > 0 ? std::max(0.0, (total - stats.ms) / total) : 0;
-          say(fmt::format("pipeline {} {} px zoom-in {} flip fusion {}: median {:.2f} ms/frame", kind, size,
-                          zoom ? "on" : "off", flip ? "on" : "off", r.ms.median));
+          say(fmt::format("{}: median {:.2f} ms/frame", label, r.ms.median));
         } catch (const std::exception& e) {
           r.error = e.what();
-          say(fmt::format("pipeline {} {} px zoom-in {} flip fusion {}: {}", kind, size, zoom ? "on" : "off",
-                          flip ? "on" : "off", r.error));
+          say(fmt::format("{}: {}", label, r.error));
         }
         report.pipeline.push_back(std::move(r));
       }
@@ -486,25 +502,27 @@ std::string BenchDetectorReport::table() const {
   if (pipeline.empty()) return s.str();
   s << fmt::format("pipeline: DetectionPipeline::detect() on a synthetic {}x{} BGR stream (default options)\n",
                    stream_width, stream_height);
-  s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>5} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend",
-                   "size", "threads", "zoom", "flip", "median", "min", "max", "fps", "forwards", "images", "boxes",
-                   "not-fwd %");
+  s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>5} {:>6} {:>9} {:>9} {:>9} {:>7} {:>9} {:>8} {:>6} {:>10}\n", "backend",
+                   "size", "threads", "zoom", "flip", "coarse", "median", "min", "max", "fps", "forwards", "images",
+                   "boxes", "not-fwd %");
   for (const PipelineResult& r : pipeline) {
     if (!r.error.empty()) {
-      s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>5}  error: {}\n", r.backend, r.size, r.threads,
-                       r.zoom_in ? "on" : "off", r.flip_fusion ? "on" : "off", r.error);
+      s << fmt::format("{:<8} {:>7} {:>7} {:>5} {:>5} {:>6}  error: {}\n", r.backend, r.size, r.threads,
+                       r.zoom_in ? "on" : "off", r.flip_fusion ? "on" : "off", r.coarse_pass ? "on" : "off", r.error);
       continue;
     }
     s << fmt::format(
-        "{:<8} {:>7} {:>7} {:>5} {:>5} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} {:>9.1f}%\n",
-        r.backend, r.size, r.threads, r.zoom_in ? "on" : "off", r.flip_fusion ? "on" : "off", r.ms.median, r.ms.min,
-        r.ms.max, r.frames_per_s, r.forwards_per_frame, r.images_per_frame, r.detections_per_frame,
-        100.0 * r.non_forward_share);
+        "{:<8} {:>7} {:>7} {:>5} {:>5} {:>6} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.2f} {:>9.2f} {:>8.2f} {:>6.2f} "
+        "{:>9.1f}%\n",
+        r.backend, r.size, r.threads, r.zoom_in ? "on" : "off", r.flip_fusion ? "on" : "off",
+        r.coarse_pass ? "on" : "off", r.ms.median, r.ms.min, r.ms.max, r.frames_per_s, r.forwards_per_frame,
+        r.images_per_frame, r.detections_per_frame, 100.0 * r.non_forward_share);
   }
   s << "\n  ms per frame; forwards/images/boxes: mean per frame; not-fwd %: share of detect() time outside\n"
        "  backend.forward() (resize, decode, NMS), summed over the timed frames. images - 1 = zoom-in crops: only\n"
        "  boxes that fit the crop and overlap no more confident box are zoomed (random weights' boxes rarely are).\n"
-       "  flip: detection.flip_fusion, a second pass (and its crops) on the mirrored frame, boxes fused.\n";
+       "  flip: detection.flip_fusion, a second pass (and its crops) on the mirrored frame, boxes fused.\n"
+       "  coarse: detection.coarse_pass, one more pass (two with flip) at coarse_scale of the network input.\n";
   return s.str();
 }
 
@@ -541,12 +559,14 @@ std::string BenchDetectorReport::json() const {
     const PipelineResult& r = pipeline[i];
     s << (i ? ",\n  " : "\n  ")
       << fmt::format(
-             "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"flip_fusion\": {}, \"ms\": {}, "
+             "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"flip_fusion\": {}, \"coarse_pass\": "
+             "{}, \"ms\": {}, "
              "\"frames_per_s\": {:.4f}, \"forwards_per_frame\": {:.4f}, \"images_per_frame\": {:.4f}, "
              "\"detections_per_frame\": {:.4f}, \"non_forward_share\": {:.4f}, \"error\": {}}}",
              json_string(r.backend), json_string(r.size), r.threads, r.zoom_in ? "true" : "false",
-             r.flip_fusion ? "true" : "false", json_timing(r.ms), r.frames_per_s, r.forwards_per_frame,
-             r.images_per_frame, r.detections_per_frame, r.non_forward_share, json_string(r.error));
+             r.flip_fusion ? "true" : "false", r.coarse_pass ? "true" : "false", json_timing(r.ms), r.frames_per_s,
+             r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, r.non_forward_share,
+             json_string(r.error));
   }
   s << "]}\n";
   return s.str();

@@ -69,6 +69,7 @@ struct PipelineResult {
   int threads = 0;                  ///< threads (as in ForwardResult)
   bool zoom_in = false;             ///< DetectorPipelineOptions::zoom_in
   bool flip_fusion = false;         ///< DetectorPipelineOptions::flip_fusion (a second, mirrored pass)
+  bool coarse_pass = false;         ///< DetectorPipelineOptions::coarse_pass (the pass at coarse_scale)
   TimingMs ms;                      ///< per frame (one detect() call)
   double frames_per_s = 0;          ///< 1000 / median
   double forwards_per_frame = 0;    ///< backend.forward() calls per frame, mean
