@@ -17,6 +17,7 @@
 #                             [--stage3-batches N] [--stage4-batches N]
 #                             [--stage5-batches N] [--stage6-batches N] [--stage6-init FILE]
 #                             [--stage6-iou-loss KIND] [--stage6-iou-normalizer X] [--stage6-mix s5|s6]
+#                             [--stage6-ema DECAY]
 #                             [--data-only]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
 #   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 to 5 in OUT/stage2 .. OUT/stage5
@@ -38,6 +39,9 @@
 #   --stage6-iou-normalizer X: that copy's iou_normalizer (default 0.75, the trainer's)
 #   --stage6-mix      s6 (default): stage 6 trains on stage 5's mix plus the second synthetic 1280x720 set; s5:
 #                     on stage 5's mix alone (the second set is not rendered), into OUT/stage6[-KIND[-X]]-s5mix
+#   --stage6-ema      DECAY: stage 6 keeps an exponential moving average of its weights (`wingman train --ema-decay`)
+#                     and exports it; its trained weights stay beside it as wingman-small_raw_*.weights. Into
+#                     OUT/stage6[-KIND[-X]][-s5mix]-emaDECAY (default: no average)
 #   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
@@ -47,7 +51,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
 stage3_batches=400 stage4_batches=600 stage5_batches=1000 stage6_batches=0 stage6_init="" data_only=0
-stage6_iou_loss=mse stage6_iou_normalizer=0.75 stage6_mix=s6
+stage6_iou_loss=mse stage6_iou_normalizer=0.75 stage6_mix=s6 stage6_ema=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -63,6 +67,7 @@ while [ $# -gt 0 ]; do
     --stage6-iou-loss) stage6_iou_loss="$2"; shift 2 ;;
     --stage6-iou-normalizer) stage6_iou_normalizer="$2"; shift 2 ;;
     --stage6-mix) stage6_mix="$2"; shift 2 ;;
+    --stage6-ema) stage6_ema="$2"; shift 2 ;;
     --data-only) data_only=1; shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -86,6 +91,13 @@ done
 [ "$max_batches" -ge 5 ] || { echo "train_model: --max-batches $max_batches: expected at least 5 (its rate steps at 53, 77 and 90 % must increase)" >&2; exit 2; }
 case "$stage6_iou_loss" in mse|giou|diou|ciou) ;; *) echo "train_model: --stage6-iou-loss '$stage6_iou_loss': expected mse, giou, diou or ciou" >&2; exit 2 ;; esac
 case "$stage6_mix" in s5|s6) ;; *) echo "train_model: --stage6-mix '$stage6_mix': expected s5 or s6" >&2; exit 2 ;; esac
+case "$stage6_ema" in
+  ''|0.*[1-9]*) ;;
+  *) echo "train_model: --stage6-ema '$stage6_ema': expected a decay in (0, 1), e.g. 0.99" >&2; exit 2 ;;
+esac
+case "$stage6_ema" in
+  *[!0-9.]*|*.*.*) echo "train_model: --stage6-ema '$stage6_ema': expected a decay in (0, 1), e.g. 0.99" >&2; exit 2 ;;
+esac
 case "$stage6_iou_normalizer" in ''|*[!0-9.]*|*.*.*|.) echo "train_model: --stage6-iou-normalizer '$stage6_iou_normalizer': expected a positive number" >&2; exit 2 ;; esac
 if [ -n "$stage6_init" ]; then
   [ -f "$stage6_init" ] || { echo "train_model: --stage6-init '$stage6_init': no such file" >&2; exit 2; }
@@ -329,6 +341,11 @@ if [ "$stage6_iou_loss" != mse ]; then
     { echo "train_model: could not write iou_loss into every [yolo] section of $cfg6" >&2; exit 1; }
 fi
 [ "$stage6_mix" = s5 ] && out6="$out6-s5mix"
+ema6=()
+if [ -n "$stage6_ema" ]; then
+  out6="$out6-ema$stage6_ema"
+  ema6=(--ema-decay "$stage6_ema")
+fi
 [ -f "$out6/wingman-small_final.weights" ] && exit 0
 init6="${stage6_init:-$out/stage5/wingman-small_final.weights}"
 u1=$((stage6_batches / 2)) u2=$((stage6_batches * 8 / 10)) u3=$((stage6_batches * 9 / 10))
@@ -336,4 +353,4 @@ resume=()
 [ -f "$out6/checkpoint.pt" ] && resume=(--resume)
 exec "$bin/wingman" train --cfg "$cfg6" "${augment[@]}" --data "$mix6" \
   --out "$out6" --weights "$init6" --max-batches "$stage6_batches" \
-  --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${resume[@]}"
+  --burn-in 30 --learning-rate 0.001 --steps "$u1,$u2,$u3" --weights-interval 100 "${ema6[@]}" "${resume[@]}"

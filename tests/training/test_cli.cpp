@@ -187,6 +187,45 @@ TEST(WingmanTrain, GrowsANetworkOnPartialWeights) {
   EXPECT_NE(alone.err.find("init_partial"), std::string::npos) << alone.err;
 }
 
+TEST(WingmanTrain, EmaDecayExportsTheAverageAndKeepsTheTrainedWeights) {
+  testing::TempDir dir;
+  write_tiny_training_set(dir);
+  auto args = std::vector<std::string>{"train",
+                                       "--cfg",
+                                       dir.file("tiny.cfg"),
+                                       "--data",
+                                       dir.file("data"),
+                                       "--out",
+                                       dir.file("out"),
+                                       "--batch",
+                                       "4",
+                                       "--subdivisions",
+                                       "2",
+                                       "--threads",
+                                       "1",
+                                       "--max-batches",
+                                       "3",
+                                       "--val-split",
+                                       "",
+                                       "--ema-decay",
+                                       "0.9",
+                                       "--ema-ramp",
+                                       "1"};
+  const auto r = wingman(args, 120);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("trained weights (not averaged): " + dir.file("out/tiny_raw_final.weights")), std::string::npos)
+      << r.out;
+  std::ifstream a(dir.file("out/tiny_final.weights"), std::ios::binary),
+      b(dir.file("out/tiny_raw_final.weights"), std::ios::binary);
+  const std::string averaged{std::istreambuf_iterator<char>(a), {}}, trained{std::istreambuf_iterator<char>(b), {}};
+  EXPECT_EQ(averaged.size(), trained.size());
+  EXPECT_NE(averaged, trained);
+  args.back() = "0";  // --ema-ramp 0
+  const auto bad = wingman(args);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("ema_ramp = 0: must be > 0"), std::string::npos) << bad.err;
+}
+
 #else
 TEST(WingmanTrain, SaysHowToGetTheTrainer) {
   testing::TempDir dir;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -225,6 +226,72 @@ TEST(DarknetNet, MismatchedWeightsAreNamed) {
   }
   const DarknetModel other = detector::parse_darknet_cfg(testing::source_path("models/tiny-yolo-thesis.cfg"));
   EXPECT_THROW(net->load_weights(other), std::invalid_argument);
+}
+
+/// Every float of the network's Darknet export (weights and batch-norm statistics), in file order.
+std::vector<float> exported_floats(const DarknetNet& net) {
+  DarknetModel m = net->model();
+  net->store_weights(m);
+  std::vector<float> v;
+  for (const auto& l : m.layers)
+    for (const auto* part : {&l.biases, &l.scales, &l.rolling_mean, &l.rolling_variance, &l.weights})
+      v.insert(v.end(), part->begin(), part->end());
+  return v;
+}
+
+TEST(WeightAverage, UpdatesMatchAPlainReference) {
+  const DarknetModel m = detector::parse_darknet_cfg_string(kTwoHeadCfg, "two_heads.cfg");
+  torch::manual_seed(3);
+  DarknetNet current(m);
+  DarknetNet average(m);
+  copy_weights(*average, *current);
+  std::vector<float> expected = exported_floats(average);
+  ASSERT_EQ(expected, exported_floats(current));
+  ASSERT_GT(expected.size(), 1000u);
+  // Three steps, each after the weights and batch-norm statistics moved (a forward in training mode and a step).
+  const std::vector<double> decays = {0.0, 0.5, 0.9};
+  for (size_t k = 0; k < decays.size(); ++k) {
+    {
+      torch::NoGradGuard no_grad;
+      for (torch::Tensor& p : current->parameters()) p.add_(torch::randn_like(p) * 0.1);
+    }
+    current->forward(torch::from_blob(random_input(m, 2, 11 + static_cast<uint32_t>(k)).data(),
+                                      {2, m.net.channels, m.net.height, m.net.width})
+                         .clone());
+    const std::vector<float> now = exported_floats(current);
+    update_weight_average(*average, *current, decays[k]);
+    for (size_t i = 0; i < expected.size(); ++i)
+      expected[i] = static_cast<float>(decays[k] * expected[i] + (1.0 - decays[k]) * now[i]);
+    const std::vector<float> got = exported_floats(average);
+    ASSERT_EQ(got.size(), expected.size());
+    for (size_t i = 0; i < got.size(); ++i)
+      ASSERT_NEAR(got[i], expected[i], 1e-6f * std::max(1.0f, std::fabs(expected[i])))
+          << "step " << k << " float " << i;
+  }
+  // The integer batch counts are copied, not averaged.
+  for (size_t i = 0; i < average->buffers().size(); ++i)
+    if (!average->buffers()[i].is_floating_point())
+      EXPECT_TRUE(torch::equal(average->buffers()[i], current->buffers()[i])) << "buffer " << i;
+}
+
+TEST(WeightAverage, AnotherNetworkOrABadDecayIsRefused) {
+  const DarknetModel a = detector::parse_darknet_cfg_string(kTwoHeadCfg, "two_heads.cfg");
+  const DarknetModel b = detector::parse_darknet_cfg(testing::source_path("models/tiny-yolo-thesis.cfg"));
+  DarknetNet x(a), y(b);
+  try {
+    copy_weights(*x, *y);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("weight average:"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(update_weight_average(*x, *y, 0.5), std::invalid_argument);
+  DarknetNet z(a);
+  try {
+    update_weight_average(*x, *z, 1.5);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("decay 1.5 not in [0, 1]"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

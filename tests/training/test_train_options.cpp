@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace wingman::training {
 namespace {
 
@@ -77,6 +79,34 @@ TEST(TrainOptions, ValidateNamesEachBadField) {
   EXPECT_NE(p[0].find("subdivisions = 3: must be >= 1 and divide batch = 10"), std::string::npos) << p[0];
   EXPECT_NE(p[1].find("momentum = 1"), std::string::npos) << p[1];
   EXPECT_NE(p[2].find("threads = 0"), std::string::npos) << p[2];
+}
+
+TEST(WeightAverageOptions, DecayRampsUpToTheGivenValue) {
+  WeightAverageOptions ema;
+  EXPECT_FALSE(ema.enabled());  // off by default
+  EXPECT_TRUE(ema.validate().empty());
+  ema.decay = 0.99;
+  ema.ramp = 10;
+  EXPECT_TRUE(ema.enabled());
+  EXPECT_NEAR(ema.decay_at(1), 0.99 * (1 - std::exp(-0.1)), 1e-12);  // 0.0942: the first updates follow the weights
+  EXPECT_NEAR(ema.decay_at(10), 0.99 * (1 - std::exp(-1.0)), 1e-12);
+  EXPECT_NEAR(ema.decay_at(1000), 0.99, 1e-12);
+  for (int64_t i = 1; i < 100; ++i) EXPECT_LT(ema.decay_at(i), ema.decay_at(i + 1)) << i;
+}
+
+TEST(WeightAverageOptions, ValidateNamesEachBadFieldInTheTrainOptions) {
+  TrainOptions o;
+  o.cfg = "a.cfg";
+  o.data = "d";
+  o.ema.decay = 1.0;
+  o.ema.ramp = 0;
+  const auto p = o.validate();
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NE(p[0].find("ema_decay = 1: must be in [0, 1)"), std::string::npos) << p[0];
+  EXPECT_NE(p[1].find("ema_ramp = 0: must be > 0"), std::string::npos) << p[1];
+  o.ema.decay = -0.5;
+  o.ema.ramp = 5;
+  ASSERT_EQ(o.validate().size(), 1u);
 }
 
 }  // namespace

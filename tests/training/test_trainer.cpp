@@ -18,7 +18,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -441,6 +444,101 @@ TEST_F(TrainerTest, StoppedAndResumedRunEqualsAnUninterruptedOne) {
   }
   RecordProperty("differing_floats", static_cast<int>(differing));
   EXPECT_NEAR(a.loss_avg, c.loss_avg, 1e-6 * std::max(1.0, a.loss_avg));
+}
+
+/// The floats of a .weights file after its 20-byte header.
+std::vector<float> weight_floats(const std::string& path) {
+  const std::vector<char> bytes = file_bytes(path);
+  std::vector<float> v((bytes.size() - 20) / 4);
+  std::memcpy(v.data(), bytes.data() + 20, v.size() * 4);
+  return v;
+}
+
+TEST_F(TrainerTest, WeightAverageIsThePlainAverageOfEachIterationsWeightsAndResumesExactly) {
+  // Reference run without the average: its weights before the first update and after each of the 6.
+  TrainOptions o = options_for(dir_, kRegionCfg, "plain");
+  o.max_batches = 6;
+  o.val_split = "";
+  o.weights_interval = 1;
+  {
+    Trainer plain(o);
+    plain.save_weights(dir_.file("plain/tiny_0.weights"));
+    plain.run();
+  }
+  // With the average: the training itself must not change (the raw weights equal the plain run's), and the
+  // exported weights must be the average computed here in plain floats.
+  o.out_dir = dir_.file("averaged");
+  o.weights_interval = 4;
+  o.ema.decay = 0.8;
+  o.ema.ramp = 2;
+  const TrainSummary s = Trainer(o).run();
+  EXPECT_EQ(s.weights, dir_.file("averaged/tiny_final.weights"));
+  EXPECT_EQ(s.raw_weights, dir_.file("averaged/tiny_raw_final.weights"));
+  EXPECT_NE(s.report().find("tiny_raw_final.weights"), std::string::npos) << s.report();
+  const std::vector<float> raw = weight_floats(s.raw_weights);
+  const std::vector<float> plain_final = weight_floats(dir_.file("plain/tiny_final.weights"));
+  ASSERT_EQ(raw.size(), plain_final.size());
+  for (size_t i = 0; i < raw.size(); ++i)
+    ASSERT_NEAR(raw[i], plain_final[i], 1e-5f * std::max(1.0f, std::fabs(plain_final[i]))) << "float " << i;
+  std::vector<double> expected(raw.size());
+  {
+    const std::vector<float> w0 = weight_floats(dir_.file("plain/tiny_0.weights"));
+    std::copy(w0.begin(), w0.end(), expected.begin());
+  }
+  for (int i = 1; i <= 6; ++i) {
+    const std::vector<float> w = weight_floats(dir_.file(fmt::format("plain/tiny_{}.weights", i)));
+    const double d = o.ema.decay_at(i);
+    for (size_t k = 0; k < expected.size(); ++k) expected[k] = d * expected[k] + (1 - d) * w[k];
+  }
+  const std::vector<float> averaged = weight_floats(s.weights);
+  size_t differs_from_raw = 0;
+  for (size_t i = 0; i < averaged.size(); ++i) {
+    ASSERT_NEAR(averaged[i], expected[i], 1e-5 * std::max(1.0, std::fabs(expected[i]))) << "float " << i;
+    differs_from_raw += averaged[i] != raw[i];
+  }
+  EXPECT_GT(differs_from_raw, averaged.size() / 2);  // the average is not the last weights
+  // At the weights interval both are kept: iteration 4's trained weights are the plain run's.
+  const std::vector<float> raw4 = weight_floats(dir_.file("averaged/tiny_raw_4.weights"));
+  const std::vector<float> plain4 = weight_floats(dir_.file("plain/tiny_4.weights"));
+  ASSERT_EQ(raw4.size(), plain4.size());
+  for (size_t i = 0; i < raw4.size(); ++i)
+    ASSERT_NEAR(raw4[i], plain4[i], 1e-5f * std::max(1.0f, std::fabs(plain4[i]))) << "float " << i;
+  EXPECT_NE(weight_floats(dir_.file("averaged/tiny_4.weights")), raw4);
+  expect_detector_runs_export(dir_.file("tiny.cfg"), s.weights);
+
+  // Stopped after 3 iterations and resumed: the same average.
+  o.out_dir = dir_.file("halves");
+  std::atomic<bool> stop{false};
+  Trainer(o).run(
+      [&](const TrainProgress& p) {
+        if (p.iteration == 3) stop = true;
+      },
+      &stop);
+  o.resume = true;
+  const TrainSummary c = Trainer(o).run();
+  EXPECT_EQ(c.start_iteration, 3);
+  const std::vector<float> resumed = weight_floats(c.weights);
+  ASSERT_EQ(resumed.size(), averaged.size());
+  for (size_t i = 0; i < resumed.size(); ++i)
+    ASSERT_NEAR(resumed[i], averaged[i], 1e-5f * std::max(1.0f, std::fabs(averaged[i]))) << "float " << i;
+
+  // A checkpoint with an average is not resumed without it or with another one, nor one without it with it.
+  auto refusal = [&](const TrainOptions& bad) -> std::string {
+    try {
+      Trainer t(bad);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "(no exception)";
+  };
+  TrainOptions other = o;
+  other.ema.decay = 0;
+  EXPECT_NE(refusal(other).find("made with a weight average"), std::string::npos) << refusal(other);
+  other.ema.decay = 0.9;
+  EXPECT_NE(refusal(other).find("made with --ema-decay 0.8 --ema-ramp 2"), std::string::npos) << refusal(other);
+  other = o;
+  other.out_dir = dir_.file("plain");
+  EXPECT_NE(refusal(other).find("made without a weight average"), std::string::npos) << refusal(other);
 }
 
 TEST_F(TrainerTest, BadResumesAreRefusedWithAReason) {

@@ -78,6 +78,7 @@ struct TrainingVerbs::State {
   int64_t max_batches = 0;
   uint64_t seed = 1;
   double learning_rate = 0, momentum = 0, decay = 0;
+  training::WeightAverageOptions ema;
   std::vector<int> steps;
   std::vector<double> scales;
   training::AugmentOptions augment;
@@ -116,6 +117,11 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   t->add_option("--weights-interval", s.weights_interval,
                 "Keep <stem>_<iteration>.weights every this many iterations, 0 = never (default 1000)");
   t->add_option("--log-interval", s.log_interval, "Print progress every this many iterations (default 1)");
+  t->add_option("--ema-decay", s.ema.decay,
+                "Keep an exponential moving average of the weights with this decay (e.g. 0.99: about the last 100 "
+                "iterations) and export it; <stem>_raw_final.weights keeps the trained weights (default 0: none)");
+  t->add_option("--ema-ramp", s.ema.ramp,
+                "The average's decay rises to --ema-decay over about this many iterations (default 100)");
   auto over = [&](CLI::Option* o, std::function<void(TrainOptions&)> apply) { s.overrides.emplace_back(o, apply); };
   over(t->add_option("--batch", s.batch, "Images per iteration (default: [net] batch)"),
        [&s](TrainOptions& o) { o.batch = s.batch; });
@@ -290,6 +296,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     o.checkpoint_interval = s.checkpoint_interval;
     o.weights_interval = s.weights_interval;
     o.log_interval = s.log_interval;
+    o.ema = s.ema;
     for (auto& [option, apply] : s.overrides)
       if (option->count() > 0) apply(o);
     restart_with_thread_settings(err);

@@ -13,6 +13,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace wingman::training {
 
@@ -47,6 +49,33 @@ std::vector<float> copy_out(const torch::Tensor& t) {
   std::vector<float> v(static_cast<size_t>(c.numel()));
   std::memcpy(v.data(), c.data_ptr<float>(), v.size() * sizeof(float));
   return v;
+}
+
+/// The parameters then the buffers of `m`, in registration order, with their names.
+std::vector<std::pair<std::string, torch::Tensor>> state_tensors(const torch::nn::Module& m) {
+  std::vector<std::pair<std::string, torch::Tensor>> t;
+  for (const auto& p : m.named_parameters()) t.emplace_back(p.key(), p.value());
+  for (const auto& b : m.named_buffers()) t.emplace_back(b.key(), b.value());
+  return t;
+}
+
+/// (average's, current's) tensor pairs; throws std::invalid_argument at the first that differs in name or shape.
+std::vector<std::pair<torch::Tensor, torch::Tensor>> matched_state(const torch::nn::Module& average,
+                                                                   const torch::nn::Module& current) {
+  const auto a = state_tensors(average), c = state_tensors(current);
+  if (a.size() != c.size())
+    throw std::invalid_argument(
+        fmt::format("weight average: {} parameters and buffers, the network has {}", a.size(), c.size()));
+  std::vector<std::pair<torch::Tensor, torch::Tensor>> out;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i].first != c[i].first || !a[i].second.sizes().equals(c[i].second.sizes()) ||
+        a[i].second.scalar_type() != c[i].second.scalar_type())
+      throw std::invalid_argument(fmt::format("weight average: '{}' ({}) does not match the network's '{}' ({})",
+                                              a[i].first, shape_text(a[i].second), c[i].first,
+                                              shape_text(c[i].second)));
+    out.emplace_back(a[i].second, c[i].second);
+  }
+  return out;
 }
 
 void check_same_layers(const detector::DarknetModel& built, const detector::DarknetModel& other) {
@@ -217,6 +246,22 @@ std::vector<torch::Tensor> DarknetNetImpl::other_parameters() const {
     }
   }
   return out;
+}
+
+void copy_weights(torch::nn::Module& average, const torch::nn::Module& current) {
+  torch::NoGradGuard no_grad;
+  for (auto& [a, c] : matched_state(average, current)) a.copy_(c);
+}
+
+void update_weight_average(torch::nn::Module& average, const torch::nn::Module& current, double d) {
+  if (!(d >= 0.0 && d <= 1.0)) throw std::invalid_argument(fmt::format("weight average: decay {} not in [0, 1]", d));
+  torch::NoGradGuard no_grad;
+  for (auto& [a, c] : matched_state(average, current)) {
+    if (a.is_floating_point())
+      a.mul_(d).add_(c, 1.0 - d);
+    else
+      a.copy_(c);
+  }
 }
 
 }  // namespace wingman::training

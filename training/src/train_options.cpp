@@ -27,6 +27,7 @@ std::vector<std::string> TrainOptions::validate() const {
   if (!(decay >= 0.0)) p.push_back(fmt::format("decay = {}: must be >= 0", decay));
   for (const auto& s : lr.validate()) p.push_back(s);
   for (const auto& s : augment.validate()) p.push_back(s);
+  for (const auto& s : ema.validate()) p.push_back(s);
   if (threads < 1) p.push_back(fmt::format("threads = {}: must be >= 1", threads));
   if (checkpoint_interval < 1) p.push_back(fmt::format("checkpoint_interval = {}: must be >= 1", checkpoint_interval));
   if (weights_interval < 0) p.push_back(fmt::format("weights_interval = {}: must be >= 0", weights_interval));

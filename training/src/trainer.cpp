@@ -86,6 +86,7 @@ std::string TrainSummary::one_line() const {
 std::string TrainSummary::report() const {
   std::string s = one_line() + "\n";
   s += fmt::format("checkpoint: {}\nelapsed: {}\n", checkpoint, duration_text(elapsed_s));
+  if (!raw_weights.empty()) s += fmt::format("trained weights (not averaged): {}\n", raw_weights);
   if (validation) s += "validation:\n" + validation->report();
   return s;
 }
@@ -97,7 +98,8 @@ struct Trainer::Impl {
   YoloDataset train;
   YoloDataset val;  // the val_split, read at construction (empty without one)
   DarknetNet net{nullptr};
-  int init_layers = 0;  // [convolutional] layers taken from o.init_weights
+  DarknetNet average{nullptr};  // the weight average (o.ema), in eval mode; null when off
+  int init_layers = 0;          // [convolutional] layers taken from o.init_weights
   std::unique_ptr<torch::optim::SGD> optimizer;
   int64_t iteration = 0;
   double loss_avg = -1.0;
@@ -161,9 +163,12 @@ struct Trainer::Impl {
     }
   }
 
-  void save_weights(const std::string& path) const {
+  /// The network the run exports and validates: the weight average when there is one.
+  DarknetNet exported() const { return average ? average : net; }
+
+  void save_weights(const std::string& path, const DarknetNet& which) const {
     detector::DarknetModel m = model;
-    net->store_weights(m);
+    which->store_weights(m);
     m.seen = static_cast<uint64_t>(iteration) * static_cast<uint64_t>(o.batch);
     detector::save_darknet_weights(m, path);
   }
@@ -180,6 +185,13 @@ struct Trainer::Impl {
     a.write("batch", torch::tensor(static_cast<int64_t>(o.batch), torch::kInt64));
     a.write("train_images", torch::tensor(static_cast<int64_t>(train.images.size()), torch::kInt64));
     a.write("cfg_text", bytes_tensor(cfg_text));
+    if (average) {
+      torch::serialize::OutputArchive avg;
+      average->save(avg);
+      a.write("weight_average", avg);
+      a.write("ema_decay", torch::tensor(o.ema.decay, torch::kFloat64));
+      a.write("ema_ramp", torch::tensor(o.ema.ramp, torch::kFloat64));
+    }
     const std::string path = out(kCheckpointName);
     const std::string tmp = path + ".tmp";
     a.save_to(tmp);
@@ -217,6 +229,27 @@ struct Trainer::Impl {
           "order would change: resume with the same seed, batch and data)",
           path, seed, batch, images, o.seed, o.batch, train.images.size()));
     net->load(a);
+    torch::serialize::InputArchive average_archive;
+    const bool has_average = a.try_read("weight_average", average_archive);
+    if (has_average != o.ema.enabled())
+      throw std::runtime_error(
+          has_average ? fmt::format("{}: made with a weight average (--ema-decay); resume with the same --ema-decay "
+                                    "and --ema-ramp",
+                                    path)
+                      : fmt::format("{}: made without a weight average; resume without --ema-decay {} (or train anew "
+                                    "in another folder)",
+                                    path, o.ema.decay));
+    if (has_average) {
+      torch::Tensor decay, ramp;
+      a.read("ema_decay", decay);
+      a.read("ema_ramp", ramp);
+      if (decay.item<double>() != o.ema.decay || ramp.item<double>() != o.ema.ramp)
+        throw std::runtime_error(fmt::format(
+            "{}: made with --ema-decay {} --ema-ramp {}; this run has {} and {} (resume with the same average)", path,
+            decay.item<double>(), ramp.item<double>(), o.ema.decay, o.ema.ramp));
+      average->load(average_archive);
+      average->eval();
+    }
     torch::serialize::InputArchive opt;
     a.read("optimizer", opt);
     optimizer->load(opt);
@@ -281,6 +314,12 @@ Trainer::Trainer(TrainOptions options) : impl_(std::make_unique<Impl>()) {
           m.layers.begin(), m.layers.end(), [](const auto& l) { return l.type == LayerType::kConvolutional; }));
     }
   }
+  if (s.o.ema.enabled()) {
+    // Built after the network so that the network's seeded initialisation is the same with or without it.
+    s.average = DarknetNet(s.model);
+    copy_weights(*s.average, *s.net);
+    s.average->eval();
+  }
   std::vector<torch::optim::OptimizerParamGroup> groups;
   groups.emplace_back(s.net->kernel_parameters(),
                       std::make_unique<torch::optim::SGDOptions>(
@@ -302,7 +341,7 @@ int64_t Trainer::iteration() const { return impl_->iteration; }
 const TrainOptions& Trainer::options() const { return impl_->o; }
 size_t Trainer::train_images() const { return impl_->train.images.size(); }
 int Trainer::init_layers() const { return impl_->init_layers; }
-void Trainer::save_weights(const std::string& path) const { impl_->save_weights(path); }
+void Trainer::save_weights(const std::string& path) const { impl_->save_weights(path, impl_->exported()); }
 
 TrainSummary Trainer::run(const std::function<void(const TrainProgress&)>& progress, const std::atomic<bool>* stop) {
   Impl& s = *impl_;
@@ -361,6 +400,7 @@ TrainSummary Trainer::run(const std::function<void(const TrainProgress&)>& progr
       static_cast<torch::optim::SGDOptions&>(group.options()).lr(p.learning_rate);
     s.optimizer->step();
     ++s.iteration;
+    if (s.average) update_weight_average(*s.average, *s.net, s.o.ema.decay_at(s.iteration));
     images += s.o.batch;
     s.loss_avg = s.loss_avg < 0 ? p.loss : 0.9 * s.loss_avg + 0.1 * p.loss;
     if (first) summary.first_loss = p.loss, first = false;
@@ -378,11 +418,13 @@ TrainSummary Trainer::run(const std::function<void(const TrainProgress&)>& progr
     const bool stopping = stop && stop->load();
     if (s.iteration % s.o.checkpoint_interval == 0 || s.iteration == s.o.max_batches || stopping) {
       s.save_checkpoint();
-      s.save_weights(s.out(s.stem + "_last.weights"));
+      s.save_weights(s.out(s.stem + "_last.weights"), s.exported());
       summary.weights = s.out(s.stem + "_last.weights");
     }
-    if (s.o.weights_interval > 0 && s.iteration % s.o.weights_interval == 0)
-      s.save_weights(s.out(fmt::format("{}_{}.weights", s.stem, s.iteration)));
+    if (s.o.weights_interval > 0 && s.iteration % s.o.weights_interval == 0) {
+      s.save_weights(s.out(fmt::format("{}_{}.weights", s.stem, s.iteration)), s.exported());
+      if (s.average) s.save_weights(s.out(fmt::format("{}_raw_{}.weights", s.stem, s.iteration)), s.net);
+    }
     if (stopping && s.iteration < s.o.max_batches) {
       summary.interrupted = true;
       break;
@@ -394,7 +436,11 @@ TrainSummary Trainer::run(const std::function<void(const TrainProgress&)>& progr
   summary.loss_avg = s.loss_avg;
   if (!summary.interrupted) {
     summary.weights = s.out(s.stem + "_final.weights");
-    s.save_weights(summary.weights);
+    s.save_weights(summary.weights, s.exported());
+    if (s.average) {
+      summary.raw_weights = s.out(s.stem + "_raw_final.weights");
+      s.save_weights(summary.raw_weights, s.net);
+    }
     if (!fs::is_regular_file(s.out(kCheckpointName))) s.save_checkpoint();
     if (!s.o.val_split.empty()) summary.validation = validate(s.o.val_split, s.o.val_max_images);
   }
@@ -405,7 +451,8 @@ DetectionMetrics Trainer::validate(const std::string& split, int max_images) con
   Impl& s = *impl_;
   const YoloDataset val = split == s.o.val_split ? s.val : load_yolo_dataset(s.o.data, split);
   torch::NoGradGuard no_grad;
-  s.net->eval();
+  DarknetNet net = s.exported();
+  net->eval();
   const cv::Size net_size(s.model.net.width, s.model.net.height);
   std::vector<float> input(static_cast<size_t>(3) * net_size.area());
   std::vector<ImageDetections> results;
@@ -416,7 +463,7 @@ DetectionMetrics Trainer::validate(const std::string& split, int max_images) con
     const AugmentedImage a = augment_image(bgr, {}, net_size, AugmentOptions::none(), 0);
     bgr_to_chw(a.bgr, input.data());
     const torch::Tensor x = torch::from_blob(input.data(), {1, 3, net_size.height, net_size.width}, torch::kFloat32);
-    const std::vector<torch::Tensor> outs = s.net->forward(x);
+    const std::vector<torch::Tensor> outs = net->forward(x);
     ImageDetections d;
     d.name = img.image_path, d.width = bgr.cols, d.height = bgr.rows;
     const double sx = static_cast<double>(bgr.cols) / net_size.width,
@@ -436,7 +483,7 @@ DetectionMetrics Trainer::validate(const std::string& split, int max_images) con
     }
     results.push_back(std::move(d));
   }
-  s.net->train();
+  if (!s.average) s.net->train();  // the average stays in eval mode
   return evaluate_detections(results, MetricsOptions{});
 }
 

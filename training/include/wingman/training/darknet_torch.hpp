@@ -80,4 +80,14 @@ class DarknetNetImpl : public torch::nn::Module {
 };
 TORCH_MODULE(DarknetNet);
 
+/// Sets every parameter and buffer of `average` to `current`'s. Both must be the same network (the same
+/// parameters and buffers, in order, of the same shapes and types): std::invalid_argument naming the first mismatch.
+void copy_weights(torch::nn::Module& average, const torch::nn::Module& current);
+
+/// One step of a weight average (WeightAverageOptions, weight_average.hpp): average = d average + (1 - d) current
+/// for every parameter and floating-point buffer (batch-norm's rolling mean and variance); integer buffers
+/// (batch-norm's batch count) are copied. Records no gradient. Preconditions as copy_weights(); `d` in [0, 1]
+/// (std::invalid_argument otherwise).
+void update_weight_average(torch::nn::Module& average, const torch::nn::Module& current, double d);
+
 }  // namespace wingman::training

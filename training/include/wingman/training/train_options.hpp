@@ -4,6 +4,7 @@
 
 #include "wingman/training/augment.hpp"
 #include "wingman/training/lr_schedule.hpp"
+#include "wingman/training/weight_average.hpp"
 
 #include <wingman/detector/darknet_model.hpp>
 
@@ -34,6 +35,10 @@ struct TrainOptions {
   double decay = 0.0005;        ///< [net] decay: weight decay on convolution kernels, >= 0
   LearningRateSchedule lr;      ///< [net] learning_rate, burn_in, power, steps, scales (policy must be steps/constant)
   AugmentOptions augment;  ///< [net] hue, saturation, exposure, jitter, flip, mosaic; the rest from the command line
+  /// Exponential moving average of the weights (off by default). When on, every .weights the run writes
+  /// (<stem>_last, _<iteration>, _final) and its validation use the average; <stem>_raw_<iteration>.weights and
+  /// <stem>_raw_final.weights keep the trained weights themselves.
+  WeightAverageOptions ema;
 
   uint64_t seed = 1;              ///< seeds the initial weights, the data order and every augmentation
   int threads = 2;                ///< libtorch intra-op threads, >= 1

@@ -44,8 +44,9 @@ struct TrainSummary {
   double loss_avg = 0.0;      ///< exponential average at the end
   double images_per_s = 0.0;  ///< training images per second over this run
   double elapsed_s = 0.0;
-  std::string weights;                         ///< the last .weights written (final, or last at an interruption)
-  std::string checkpoint;                      ///< the checkpoint file
+  std::string weights;      ///< the last .weights written (final, or last at an interruption)
+  std::string raw_weights;  ///< with a weight average: <stem>_raw_final.weights, the trained weights at the end
+  std::string checkpoint;   ///< the checkpoint file
   std::optional<DetectionMetrics> validation;  ///< on the val split at the end (when it has one)
 
   std::string one_line() const;
@@ -63,7 +64,9 @@ struct TrainSummary {
 ///
 /// Files in out_dir: checkpoint.pt (weights, batch-norm statistics, momentum, iteration; written atomically),
 /// <stem>.cfg (a copy of the .cfg), <stem>_last.weights at each checkpoint, <stem>_<iteration>.weights every
-/// weights_interval, and <stem>_final.weights at the end; <stem> is the .cfg's file stem.
+/// weights_interval, and <stem>_final.weights at the end; <stem> is the .cfg's file stem. With a weight average
+/// (TrainOptions::ema) those .weights hold the average, the checkpoint holds it too, and <stem>_raw_<iteration>.weights
+/// and <stem>_raw_final.weights hold the trained weights themselves.
 class Trainer {
  public:
   /// Throws std::invalid_argument listing every invalid option; DatasetError / DarknetFormatError naming the
@@ -80,12 +83,13 @@ class Trainer {
   TrainSummary run(const std::function<void(const TrainProgress&)>& progress = {},
                    const std::atomic<bool>* stop = nullptr);
 
-  /// Writes the current weights as Darknet .weights (the detector's format).
+  /// Writes the current weights (the weight average, when the run keeps one) as Darknet .weights (the detector's
+  /// format).
   void save_weights(const std::string& path) const;
 
-  /// Evaluates the current network (inference mode, no augmentation: the detector's stretch) on `split` of the
-  /// dataset, at most `max_images` images spread over it (0 = all): every head decoded with p_thresh 0.005, NMS
-  /// 0.45, boxes in image pixels against the split's class-0 (drone) boxes.
+  /// Evaluates the current network (the weight average, when the run keeps one; inference mode, no augmentation:
+  /// the detector's stretch) on `split` of the dataset, at most `max_images` images spread over it (0 = all): every
+  /// head decoded with p_thresh 0.005, NMS 0.45, boxes in image pixels against the split's class-0 (drone) boxes.
   DetectionMetrics validate(const std::string& split, int max_images = 0) const;
 
   /// Iterations done so far (after construction: 0, or the checkpoint's with resume).
