@@ -4,6 +4,8 @@
 
 #include "wingman/tools/dataset_from_log.hpp"
 
+#include "run_verb.hpp"
+
 #include <wingman/common/config.hpp>
 #include <wingman/localizer/camera_model.hpp>
 #include <wingman/sim/drone_model.hpp>
@@ -549,44 +551,24 @@ DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
 
 DatasetVerbs::~DatasetVerbs() = default;
 
-namespace {
-
-/// Runs one `dataset` verb: its exit code, 0 when `body` returns; 2 for a bad config or argument
-/// (common::ConfigError, std::invalid_argument), 1 for any other failure, with one error line naming the verb.
-int run_verb(const char* verb, std::ostream& err, const std::function<void()>& body) {
-  try {
-    body();
-    return 0;
-  } catch (const common::ConfigError& e) {
-    err << "wingman dataset " << verb << ": error: " << e.what() << std::endl;
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    err << "wingman dataset " << verb << ": error: " << e.what() << std::endl;
-    return 2;
-  } catch (const std::exception& e) {
-    err << "wingman dataset " << verb << ": error: " << e.what() << std::endl;
-    return 1;
-  }
-}
-
-}  // namespace
-
 int DatasetVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   if (*s_->from_log) {
-    return run_verb("from-log", err, [&] {
+    return run_verb("wingman dataset from-log", err, [&] {
       s_->from_log_request.keep_negatives = !s_->skip_negatives;
       out << run_dataset_from_log(s_->from_log_request, err).one_line() << std::endl;
+      return 0;
     });
   }
   if (!*s_->synth) return -1;
-  return run_verb("synth", err, [&] {
+  return run_verb("wingman dataset synth", err, [&] {
     if (s_->print_config) {
       DatasetSynthConfig config;
       if (!s_->request.config.empty()) config = common::load_options<DatasetSynthConfig>(s_->request.config);
       out << common::print_options(config, "wingman dataset synth: effective configuration");
-      return;
+      return 0;
     }
     out << run_dataset_synth(s_->request, err).one_line() << std::endl;
+    return 0;
   });
 }
 

@@ -2,6 +2,8 @@
 // `wingman train`, `wingman val`, `wingman import-halmstad`: command lines over the training library.
 #include "wingman/tools/train_cli.hpp"
 
+#include "run_verb.hpp"
+
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/training/halmstad_import.hpp>
 #include <wingman/training/train_options.hpp>
@@ -235,7 +237,7 @@ TrainingVerbs::~TrainingVerbs() = default;
 int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   State& s = *s_;
   if (*s.val) {
-    try {
+    return run_verb("wingman val", err, [&] {
       const training::DetectionMetrics m = training::run_val(
           s.val_options,
           [&](size_t done, size_t total) {
@@ -244,29 +246,17 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
           [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
       out << (s.val_json ? m.json() + "\n" : m.report(s.val_list)) << std::flush;
       return 0;
-    } catch (const std::invalid_argument& e) {
-      err << "wingman val: error: " << e.what() << "\n";
-      return 2;
-    } catch (const std::exception& e) {
-      err << "wingman val: error: " << e.what() << "\n";
-      return 1;
-    }
+    });
   }
   if (*s.halmstad) {
     s.import.tighten = !s.no_tighten;
     s.import.negatives = !s.no_negatives;
-    try {
+    return run_verb("wingman import-halmstad", err, [&] {
       const training::HalmstadImportSummary summary = training::import_halmstad(
           s.import, [&](const std::string& line) { err << "wingman import-halmstad: " << line << "\n"; });
       out << summary.report() << "wrote " << s.import.out_dir << "/data.yaml\n" << std::flush;
       return 0;
-    } catch (const std::invalid_argument& e) {
-      err << "wingman import-halmstad: error: " << e.what() << "\n";
-      return 2;
-    } catch (const std::exception& e) {
-      err << "wingman import-halmstad: error: " << e.what() << "\n";
-      return 1;
-    }
+    });
   }
   if (*s.train) {
 #ifndef WINGMAN_WITH_TRAINING
@@ -300,7 +290,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     for (auto& [option, apply] : s.overrides)
       if (option->count() > 0) apply(o);
     restart_with_thread_settings(err);
-    try {
+    return run_verb("wingman train", err, [&] {
       training::Trainer trainer(o);
       err << fmt::format(
           "wingman train: {} training images, batch {} in {} subdivisions, {} iterations from {}; "
@@ -329,13 +319,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       std::signal(SIGTERM, SIG_DFL);
       out << summary.report() << std::flush;
       return summary.interrupted ? 130 : 0;
-    } catch (const std::invalid_argument& e) {
-      err << "wingman train: error: " << e.what() << "\n";
-      return 2;
-    } catch (const std::exception& e) {
-      err << "wingman train: error: " << e.what() << "\n";
-      return 1;
-    }
+    });
 #endif
   }
   return -1;
