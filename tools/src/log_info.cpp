@@ -5,11 +5,11 @@
 #include "lcm_fingerprint.hpp"
 
 #include <wingman/common/message_validation.hpp>
+#include <wingman/detector/preprocess.hpp>
 
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <functional>
 #include <stdexcept>
@@ -35,29 +35,6 @@ std::pair<uint64_t, std::pair<std::string, Decoder>> entry() {
     return m.utime;
   };
   return {static_cast<uint64_t>(Msg::getHash()), {Msg::getTypeName(), d}};
-}
-
-cv::Mat to_bgr(const wingman::image_t& img) {
-  cv::Mat out;
-  switch (img.pixel_format) {
-    case wingman::image_t::MJPEG:
-      out = cv::imdecode(img.data, cv::IMREAD_COLOR);
-      break;
-    case wingman::image_t::GRAY8:
-      cv::cvtColor(cv::Mat(img.height, img.width, CV_8UC1, const_cast<uint8_t*>(img.data.data()), img.stride), out,
-                   cv::COLOR_GRAY2BGR);
-      break;
-    case wingman::image_t::BGR8:
-      out = cv::Mat(img.height, img.width, CV_8UC3, const_cast<uint8_t*>(img.data.data()), img.stride).clone();
-      break;
-    case wingman::image_t::YUYV:
-      cv::cvtColor(cv::Mat(img.height, img.width, CV_8UC2, const_cast<uint8_t*>(img.data.data()), img.stride), out,
-                   cv::COLOR_YUV2BGR_YUYV);
-      break;
-    default:
-      break;
-  }
-  return out;
 }
 
 }  // namespace
@@ -104,7 +81,7 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
   if (!last_image.empty()) {
     wingman::image_t img;
     img.decode(last_image.data(), 0, static_cast<int>(last_image.size()));
-    const cv::Mat bgr = to_bgr(img);
+    const cv::Mat bgr = detector::image_to_bgr(img, nullptr);
     if (!bgr.empty()) {
       ++summary.images_with_pixels;
       if (!snapshot_png.empty() && !cv::imwrite(snapshot_png, bgr))

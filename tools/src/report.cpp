@@ -5,6 +5,7 @@
 #include "lcm_fingerprint.hpp"
 #include "log_progress.hpp"
 
+#include <wingman/detector/preprocess.hpp>
 #include <wingman/image_t.hpp>
 
 #include <fmt/format.h>
@@ -65,34 +66,6 @@ std::string base64(const std::vector<uint8_t>& in) {
     out += kAlphabet[(v >> 12) & 63];
     out += kAlphabet[(v >> 6) & 63];
     out += '=';
-  }
-  return out;
-}
-
-/// The image as BGR; empty when the format is unknown or the data is short.
-cv::Mat to_bgr(const wingman::image_t& img) {
-  cv::Mat out;
-  auto* data = const_cast<uint8_t*>(img.data.data());
-  const auto rows_fit = [&](int bytes_per_px) {
-    return img.width > 0 && img.height > 0 && img.stride >= img.width * bytes_per_px &&
-           static_cast<int64_t>(img.data.size()) >= static_cast<int64_t>(img.stride) * img.height;
-  };
-  switch (img.pixel_format) {
-    case wingman::image_t::MJPEG:
-      if (!img.data.empty()) out = cv::imdecode(img.data, cv::IMREAD_COLOR);
-      break;
-    case wingman::image_t::GRAY8:
-      if (rows_fit(1)) cv::cvtColor(cv::Mat(img.height, img.width, CV_8UC1, data, img.stride), out, cv::COLOR_GRAY2BGR);
-      break;
-    case wingman::image_t::BGR8:
-      if (rows_fit(3)) out = cv::Mat(img.height, img.width, CV_8UC3, data, img.stride).clone();
-      break;
-    case wingman::image_t::YUYV:
-      if (rows_fit(2))
-        cv::cvtColor(cv::Mat(img.height, img.width, CV_8UC2, data, img.stride), out, cv::COLOR_YUV2BGR_YUYV);
-      break;
-    default:
-      break;
   }
   return out;
 }
@@ -293,7 +266,7 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
     if (!wanted.count(i)) continue;
     wingman::image_t img;
     if (img.decode(ev->data, 0, ev->datalen) < 0) continue;
-    cv::Mat bgr = to_bgr(img);
+    cv::Mat bgr = detector::image_to_bgr(img, nullptr);
     if (bgr.empty()) continue;
     const int thick = std::max(2, bgr.cols / 320);
     const auto rect = [](const EvalResult::FrameInfo::Box& b) {

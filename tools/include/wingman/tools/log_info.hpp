@@ -24,8 +24,10 @@ struct ChannelSummary {
 struct LogSummary {
   std::vector<ChannelSummary> channels;         ///< in order of first appearance
   std::map<std::string, std::string> statuses;  ///< process -> one line from its last status_t
-  int64_t images_with_pixels = 0;               ///< image_t messages that could be turned into a picture
-  std::string report() const;                   ///< a table for people
+  /// 1 when the last valid image_t could be turned into a picture (the snapshot), else 0: only the last image is
+  /// decoded (a log holds thousands).
+  int64_t images_with_pixels = 0;
+  std::string report() const;  ///< a table for people
 };
 
 /// Reads `log_path` (throws std::runtime_error naming it when unreadable). When `snapshot_png` is
