@@ -91,13 +91,8 @@ done
 [ "$max_batches" -ge 5 ] || { echo "train_model: --max-batches $max_batches: expected at least 5 (its rate steps at 53, 77 and 90 % must increase)" >&2; exit 2; }
 case "$stage6_iou_loss" in mse|giou|diou|ciou) ;; *) echo "train_model: --stage6-iou-loss '$stage6_iou_loss': expected mse, giou, diou or ciou" >&2; exit 2 ;; esac
 case "$stage6_mix" in s5|s6) ;; *) echo "train_model: --stage6-mix '$stage6_mix': expected s5 or s6" >&2; exit 2 ;; esac
-case "$stage6_ema" in
-  ''|0.*[1-9]*) ;;
-  *) echo "train_model: --stage6-ema '$stage6_ema': expected a decay in (0, 1), e.g. 0.99" >&2; exit 2 ;;
-esac
-case "$stage6_ema" in
-  *[!0-9.]*|*.*.*) echo "train_model: --stage6-ema '$stage6_ema': expected a decay in (0, 1), e.g. 0.99" >&2; exit 2 ;;
-esac
+[ -z "$stage6_ema" ] || [[ "$stage6_ema" =~ ^0\.[0-9]*[1-9][0-9]*$ ]] ||
+  { echo "train_model: --stage6-ema '$stage6_ema': expected a decay in (0, 1), e.g. 0.99" >&2; exit 2; }
 case "$stage6_iou_normalizer" in ''|*[!0-9.]*|*.*.*|.) echo "train_model: --stage6-iou-normalizer '$stage6_iou_normalizer': expected a positive number" >&2; exit 2 ;; esac
 if [ -n "$stage6_init" ]; then
   [ -f "$stage6_init" ] || { echo "train_model: --stage6-init '$stage6_init': no such file" >&2; exit 2; }
