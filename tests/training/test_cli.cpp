@@ -65,6 +65,9 @@ TEST(WingmanVal, BadOptionsAndFilesAreNamed) {
   const auto none = wingman({"val", "--data", dir.file("data.yaml")});
   EXPECT_EQ(none.exit_code, 2);
   EXPECT_NE(none.err.find("give exactly one"), std::string::npos) << none.err;
+  // One "wingman val:" prefix: the library names itself (run_val), the verb adds its own.
+  EXPECT_EQ(none.err.rfind("wingman val: error: run_val: invalid options:", 0), 0u) << none.err;
+  EXPECT_EQ(none.err.find("wingman val:", 1), std::string::npos) << none.err;
   std::ofstream(dir.file("labels/val/b.txt")) << "0 0.5 0.5 0.1 7\n";
   const auto bad = wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred")});
   EXPECT_EQ(bad.exit_code, 1);

@@ -278,7 +278,7 @@ Trainer::Trainer(TrainOptions options) : impl_(std::make_unique<Impl>()) {
   s.o = std::move(options);
   const std::vector<std::string> problems = s.o.validate();
   if (!problems.empty()) {
-    std::string msg = "wingman train: invalid options:";
+    std::string msg = "Trainer: invalid options:";
     for (const auto& p : problems) msg += "\n  " + p;
     throw std::invalid_argument(msg);
   }

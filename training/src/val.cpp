@@ -47,7 +47,7 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
                          const std::function<void(const std::string&)>& log) {
   const std::vector<std::string> problems = o.validate();
   if (!problems.empty()) {
-    std::string msg = "wingman val: invalid options:";
+    std::string msg = "run_val: invalid options:";
     for (const auto& p : problems) msg += "\n  " + p;
     throw std::invalid_argument(msg);
   }
