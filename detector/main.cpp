@@ -73,7 +73,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   auto make_backend = [&](const detector::DarknetModel& sized) {
     std::string why;
     const auto t_backend = std::chrono::steady_clock::now();
-    // model.backend auto chooses (and, without an OpenCL GPU, measures both) at start-up; a network for another
+    // model.backend auto chooses (it measures both) at start-up; a network for another
     // frame size later takes the same kind without measuring again (seconds in which no frame would be detected).
     const bool reuse = o.backend == "auto" && !auto_kind.empty();
     auto backend = detector::make_backend(reuse ? auto_kind : o.backend, sized, o.opencl, o.opencl.max_batch, &why);

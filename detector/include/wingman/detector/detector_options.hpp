@@ -25,8 +25,9 @@ struct DetectorOptions {
   /// Darknet .weights path, or builtin:wingman-small (the shipped trained model, built in; card:
   /// models/wingman-small.md); "" = no model: images are checked and counted, nothing is detected.
   std::string weights = "builtin:wingman-small";
-  /// auto: an OpenCL GPU if there is one, else the faster of opencl and cpu here; without a usable OpenCL device
-  /// (no platform, no device, kernels that fail to build) the CPU backend, with one warning saying why.
+  /// auto: the faster of opencl and cpu here, timed at start-up (a GPU too: the kernels are shaped for CPUs);
+  /// without a usable OpenCL device (no platform, no device, kernels that fail to build) the CPU backend, with one
+  /// warning saying why.
   /// opencl: OpenCL or nothing (no usable device: exit 1 with one line). cpu: OpenCV DNN.
   /// The backend that runs, and why, is the heartbeat's detail. auto chooses once, at start-up: a network built
   /// later for another frame size (model.input_size auto) takes the same kind.
@@ -51,7 +52,7 @@ struct DetectorOptions {
       "Darknet .weights path, or builtin:wingman-small (shipped, models/wingman-small.md); \"\" = no model "
       "(images are checked and counted only)");
     v("model.backend", backend,
-      "auto (OpenCL GPU if any, else the faster of opencl/cpu here; no usable OpenCL device: cpu, with a warning), "
+      "auto (the faster of opencl/cpu here, timed at start-up; no usable OpenCL device: cpu, with a warning), "
       "opencl (no usable OpenCL device: exit 1) or cpu");
     v("model.input_size", input_size,
       "network input: auto (the cfg's longer side, the other fitted to the images' aspect, a multiple of 32), cfg "
