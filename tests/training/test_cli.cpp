@@ -144,6 +144,22 @@ TEST(WingmanTrain, TrainsWithOverridesThenResumes) {
   EXPECT_NE(refused.err.find("made with seed 1"), std::string::npos) << refused.err;
 }
 
+TEST(WingmanTrain, UnreadableCfgIsNamedOnOneLine) {
+  testing::TempDir dir;
+  write_tiny_training_set(dir);
+  std::ofstream(dir.file("bad.cfg")) << "[net]\nwidth=64\nheight=64\nchannels=3\n\n[convolutional]\nfilters=x\n";
+  const auto r = wingman({"train", "--cfg", dir.file("bad.cfg"), "--data", dir.file("data"), "--out", dir.file("out")});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(r.err.rfind("wingman train: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("bad.cfg"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("filters"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("out/progress.csv")));
+  const auto missing =
+      wingman({"train", "--cfg", dir.file("none.cfg"), "--data", dir.file("data"), "--out", dir.file("out")});
+  EXPECT_EQ(missing.exit_code, 1) << missing.err;
+  EXPECT_NE(missing.err.find("none.cfg"), std::string::npos) << missing.err;
+}
+
 TEST(WingmanTrain, GrowsANetworkOnPartialWeights) {
   testing::TempDir dir;
   write_tiny_training_set(dir);

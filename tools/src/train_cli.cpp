@@ -265,14 +265,15 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     return 1;
 #else
     training::TrainOptions o;
-    try {
-      o = training::train_options_from_model(detector::parse_darknet_cfg(s.cfg), s.cfg);
-      const std::string note = training::multi_scale_note(detector::parse_darknet_cfg(s.cfg));
+    // The .cfg gives the defaults; a cfg that does not parse is reported as every other failure of the verb.
+    const int cfg_rc = run_verb("wingman train", err, [&] {
+      const detector::DarknetModel model = detector::parse_darknet_cfg(s.cfg);
+      o = training::train_options_from_model(model, s.cfg);
+      const std::string note = training::multi_scale_note(model);
       if (!note.empty()) err << "wingman train: note: " << note << "\n";
-    } catch (const std::exception& e) {
-      err << "wingman train: error: " << e.what() << "\n";
-      return 1;
-    }
+      return 0;
+    });
+    if (cfg_rc != 0) return cfg_rc;
     o.data = s.data;
     o.out_dir = s.out_dir;
     o.init_weights = s.init_weights;
