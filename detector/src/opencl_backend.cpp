@@ -538,16 +538,30 @@ struct OpenClBackend::Impl {
       if (ti.shape.h != to.shape.h || ti.shape.w != to.shape.w || offset + ti.shape.c > to.shape.c)
         throw std::invalid_argument(layer_name(l, index) + ": routed layer " + std::to_string(r) +
                                     " does not fit the output shape");
+      // Both tensors share the output's border and padded size (h, w equal; add_tensor pads alike).
+      if (ti.hp != to.hp || ti.wp != to.wp || ti.border != to.border)
+        throw std::logic_error(layer_name(l, index) + ": routed layer " + std::to_string(r) +
+                               " has another padding than the output");
+      // Whole blocks (both counts multiples of 16): one 16-float vector per pixel; else channel by channel.
+      const bool blocks = offset % 16 == 0 && ti.shape.c % 16 == 0;
       Step s;
-      s.what = layer_name(l, index);
+      s.what = layer_name(l, index) + (blocks ? " copy: whole blocks" : " copy: channel by channel");
       s.layer = static_cast<int>(index);
-      s.kernel = cl::Kernel(misc_program, "route_copy_blocked");
+      s.kernel = cl::Kernel(misc_program, blocks ? "route_copy_blocks" : "route_copy_blocked");
       s.kernel.setArg(0, ti.buffer);
       s.kernel.setArg(1, to.buffer);
-      const int args[] = {ti.shape.c, ti.cb, to.cb, offset, to.shape.h, to.shape.w, to.hp, to.wp, to.border};
+      const int args[] = {blocks ? ti.shape.c / 16 : ti.shape.c,
+                          ti.cb,
+                          to.cb,
+                          blocks ? offset / 16 : offset,
+                          to.shape.h,
+                          to.shape.w,
+                          to.hp,
+                          to.wp,
+                          to.border};
       for (int a = 0; a < 9; ++a) s.kernel.setArg(2 + a, args[a]);
       s.global[0] = to.shape.h;
-      s.global[1] = ti.shape.c;
+      s.global[1] = blocks ? ti.shape.c / 16 : ti.shape.c;
       steps.push_back(std::move(s));
       offset += ti.shape.c;
     }

@@ -385,6 +385,34 @@ TEST(OpenClRoute, ConcatenatesChannelsAtUnalignedOffsets) {
   check_network(cfg2, "conv 3->7, conv 7->9, route -1,-2, conv 3x3 ->5 (13x11)", 1);
 }
 
+TEST(OpenClRoute, CopiesWholeBlocksAtAlignedOffsetsAndMixesBothCopies) {
+  REQUIRE_OPENCL();
+  // 16 + 32 channels: both inputs whole blocks at block offsets 0 and 1 (the vector copy); a single-input route.
+  const std::string cfg = net_section(3, 13, 11) + conv_section(16, 3, 1, true, "leaky") +
+                          conv_section(32, 3, 1, true, "leaky") + "[route]\nlayers=-1,-2\n\n" +
+                          "[route]\nlayers=-1\n\n" + conv_section(5, 3, 1, true, "leaky");
+  auto copies = [](const std::string& c) {
+    DarknetModel model = parse_darknet_cfg_string(c);
+    randomize_weights(model, 3);
+    std::vector<std::string> kinds;
+    for (const std::string& line : OpenClBackend(model, options_for_batch(1)).commands())
+      if (line.find("[route]") != std::string::npos) kinds.push_back(line.substr(line.find(" copy: ") + 7));
+    return kinds;
+  };
+  EXPECT_EQ(copies(cfg), (std::vector<std::string>{"whole blocks", "whole blocks", "whole blocks"}));
+  check_network(cfg, "conv 3->16, conv 16->32, route -1,-2 (48 ch), route -1, conv 3x3 ->5 (13x11)", 2);
+  // 7 + 16: a partial block, then a whole one at offset 7 (not a block boundary: channel by channel); then 16 + 7:
+  // a whole block at offset 0 (the vector copy) and a partial one at offset 16. Every layer feeds a later one.
+  const std::string mixed = net_section(3, 9, 12) + conv_section(16, 3, 1, true, "leaky") +
+                            conv_section(7, 3, 1, true, "leaky") + "[route]\nlayers=-1,-2\n\n" +
+                            conv_section(16, 3, 1, true, "leaky") + "[route]\nlayers=-1,1\n\n" +
+                            conv_section(4, 1, 1, false, "linear");
+  EXPECT_EQ(copies(mixed), (std::vector<std::string>{"channel by channel", "channel by channel", "whole blocks",
+                                                     "channel by channel"}));
+  check_network(mixed, "conv 3->16, conv 16->7, route -1,-2 (7+16 ch), conv ->16, route -1,1 (16+7 ch), conv 1x1 ->4",
+                2);
+}
+
 TEST(OpenClUpsample, RepeatsNearestNeighbours) {
   REQUIRE_OPENCL();
   const std::string cfg = net_section(5, 7, 9) + conv_section(7, 3, 1, true, "leaky") + "[upsample]\nstride=2\n\n" +
