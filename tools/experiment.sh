@@ -8,19 +8,22 @@
 #
 # Usage: tools/experiment.sh NAME [--quick] [--out DIR] [--detections cnn|truth]
 #   NAME           static_sweep  box width error over distance, single pass vs zoom-in (thesis Fig. 13), and the
-#                                boxes' range scale side-on and from behind (the radius calibration)
+#                                boxes' range scale side-on and from behind
+#                  calibration   the radius for the CNN's boxes (config/flights/cnn.localizer.yaml): a 30-s formation
+#                                flight with another seed than formation_2d's runs, flown with the configured radius
 #                  distance      distance error on a fast-moving leader: single, zoom-in, zoom-in filtered (Table 3)
 #                  follow_1d     the 1-D PID follow (thesis section 5.3)
 #                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
 #                  max_range     the farthest range at which the detector still finds an F450-sized drone at 1280x720
-#                  all           all of them, one after the other
+#                  all           all of them, one after the other (the calibration after the static sweep)
 #   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
 #   --out DIR      output folder (default build/experiments, or build/experiments-truth with --detections truth)
 #   --detections   cnn (default): the shipped model on rendered images; truth: boxes from the simulator's ground truth
 #                  (the bounding sphere's box, 1 px noise; no rendering): what the rest of the pipeline does with
 #                  perfect boxes (distance, follow_1d and formation_2d only)
-# Lengths (a rendered closed-loop frame takes 0.2-0.5 s here): static_sweep 3 x 952 frames, distance 4 x 10 s,
-# follow_1d 20 s, formation_2d 3 x 10 s, max_range 200 frames; about 30 min in all on the 2-core development VM.
+# Lengths (a rendered closed-loop frame takes 0.03-0.5 s here): static_sweep 3 x 952 frames, calibration 30 s,
+# distance 4 x 10 s, follow_1d 20 s, formation_2d 3 x 10 s, max_range 200 frames; 10-30 min in all on the 2-core
+# development VMs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -40,7 +43,7 @@ while [ $# -gt 0 ]; do
 done
 case "$detections" in cnn|truth) ;; *) echo "experiment: --detections '$detections': expected cnn or truth" >&2; exit 2 ;; esac
 if [ "$detections" = truth ]; then
-  case "$name" in static_sweep|max_range|all)
+  case "$name" in static_sweep|calibration|max_range|all)
     echo "experiment: $name measures the detector: it needs --detections cnn (all: run the three flights by name)" >&2
     exit 2 ;;
   esac
@@ -86,6 +89,24 @@ static_sweep() {
   grep -q "seen from behind" "$behind" || { echo "experiment: could not turn the drone in $behind" >&2; exit 1; }
   fly "$out/behind" --scenario "$behind" --localizer-config "$out/sphere.localizer.yaml"
   py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json" "$out/behind/eval.json"
+}
+
+calibration() {
+  local out="$out_root/calibration" dur=30; $quick && dur=4
+  rm -rf "$out"; mkdir -p "$out"
+  # The radius for the CNN's boxes, measured on the view the flights have: the boxes' width against the bounding
+  # sphere's depends on the view, the range and the background (the static sweep's from-behind scale, 2-20 m, made
+  # every stage-8 flight's ranges 6-8 % long), so the calibration flight is a formation flight like the ones measured,
+  # with another seed (7; formation_2d's runs use 1-3 and the README's flight 2). It flies with the configured radius
+  # (the follower's distance, and so the view, depends on it) and the summary scales that radius by the median
+  # true / estimated range of the leader's targets.
+  local cfg="$src/config/flights/cnn.localizer.yaml" radius
+  radius=$(awk '/^target:/ {t = 1} t && /radius_m:/ {print $2; exit}' "$cfg")
+  [ -n "$radius" ] || { echo "experiment: $cfg: no target.radius_m" >&2; exit 1; }
+  local scn; scn=$(scenario_variant "$out/scenario" formation_2d "s/^seed: .*/seed: 7/")
+  grep -q "^seed: 7$" "$scn" || { echo "experiment: could not set the seed in $scn" >&2; exit 1; }
+  fly "$out/run" --scenario "$scn" --duration "$dur" --localizer-config "$cfg"
+  py calibration "$out" "$radius" "$out/run/eval.json"
 }
 
 distance() {
@@ -137,8 +158,8 @@ max_range() {
 }
 
 case "$name" in
-  static_sweep|distance|follow_1d|formation_2d|max_range) "$name" ;;
-  all) static_sweep; distance; follow_1d; formation_2d; max_range ;;
+  static_sweep|calibration|distance|follow_1d|formation_2d|max_range) "$name" ;;
+  all) static_sweep; calibration; distance; follow_1d; formation_2d; max_range ;;
   *) echo "experiment: unknown experiment '$name' (see --help)" >&2; exit 2 ;;
 esac
 echo "experiment: results in $out_root" >&2

@@ -3,8 +3,8 @@
 """Summaries of tools/experiment.sh: reads the flights' eval.json (wingman eval) and writes results.json and
 results.md (a table with the thesis's figures beside ours) in the experiment's folder. Standard library only.
 
-Usage: experiment_summary.py KIND OUT_DIR EVAL_JSON...   (KIND: static_sweep, distance, follow_1d, formation_2d,
-max_range). The thesis's figures are quoted from its text (Fig. 13, Tables 3 and 4, sections 5.3 and 5.5)."""
+Usage: experiment_summary.py KIND OUT_DIR EVAL_JSON...   (KIND: static_sweep, calibration, distance, follow_1d,
+formation_2d, max_range; calibration takes the localizer's configured radius in metres before its EVAL_JSON). The thesis's figures are quoted from its text (Fig. 13, Tables 3 and 4, sections 5.3 and 5.5)."""
 import json
 import os
 import subprocess
@@ -105,9 +105,46 @@ def static_sweep(out, single, zoom, behind=None):
     if kb:
         lines += ["", f"Seen from behind (the same sweep, the drone turned 90°, single pass: the view a follower has "
                   f"of its leader): range scale {kb:.3f} (n = {kb_n}), {100 * rate(load(behind)):.1f} % of the frames "
-                  f"detected. `config/flights/cnn.localizer.yaml` takes this one (0.348 m × {kb:.3f} = "
-                  f"{0.348 * kb:.3f} m)."]
+                  f"detected (0.348 m × {kb:.3f} = {0.348 * kb:.3f} m; `config/flights/cnn.localizer.yaml` "
+                  f"takes the calibration flight's radius, `tools/experiment.sh calibration`)."]
     write(out, "static_sweep", data, lines)
+
+
+def calibration(out, radius_m, run):
+    """The radius for the detector's boxes from a formation flight flown with the localizer's radius RADIUS_M: the
+    median true / estimated range of the leader's targets times RADIUS_M (the range is proportional to the radius)."""
+    try:
+        radius = float(radius_m)
+    except ValueError:
+        sys.exit(f"experiment_summary: calibration: radius '{radius_m}': expected metres, e.g. 0.252")
+    if not radius > 0:
+        sys.exit(f"experiment_summary: calibration: radius {radius_m}: expected > 0")
+    r = load(run)
+    k, n = range_scale(os.path.join(os.path.dirname(run), "targets.csv"), 0.0, 1e9)
+    if not k:
+        sys.exit(f"experiment_summary: calibration: no targets on the leader in {run}: nothing to calibrate on")
+    ranges = range_span(os.path.join(os.path.dirname(run), "targets.csv"))
+    data = {"configured_radius_m": radius, "range_scale": k, "n": n, "radius_m": radius * k,
+            "true_range_m": ranges, "localization": r["localization"], **common_row(r)}
+    lines = ["| calibration flight | ours |", "|---|---|",
+             f"| radius flown (m) | {radius:.3f} |",
+             f"| median true / estimated range (leader's targets) | {k:.3f} (n = {n}) |",
+             f"| true range of those targets (m) | {ranges[0]:.1f}–{ranges[1]:.1f} |",
+             f"| localization RMS with the radius flown (m) | {r['localization']['rms_m']:.3f} |",
+             f"| **calibrated radius** (m) | **{radius * k:.3f}** |", "",
+             f"`config/flights/cnn.localizer.yaml` takes the calibrated radius ({radius:.3f} m × {k:.3f} = "
+             f"{radius * k:.3f} m); when it changes by more than about 2 %, fly the calibration again with it (the "
+             f"follower's distance, and so the view, follows the radius)."]
+    write(out, "calibration", data, lines)
+
+
+def range_span(csv_path):
+    """The smallest and largest true range (m) of the leader's targets with an estimated range."""
+    import csv
+    with open(csv_path) as f:
+        v = [float(row["range_m"]) for row in csv.DictReader(f)
+             if row["vehicle_id"] == "1" and float(row.get("range_est_m") or 0) > 0]
+    return [min(v), max(v)] if v else [0.0, 0.0]
 
 
 def merge_errors(a, b):
@@ -212,8 +249,9 @@ def max_range(out, run):
     write(out, "max_range", data, lines)
 
 
-# Each kind: its function and how many EVAL_JSON arguments it takes (static_sweep: the third, from behind, optional).
-KINDS = {"static_sweep": (static_sweep, (2, 3)), "distance": (distance, (4, 4)), "follow_1d": (follow_1d, (1, 1)),
+# Each kind: its function and how many arguments after OUT_DIR it takes (static_sweep: the third flight, from behind,
+# optional; calibration: the radius flown, then its flight).
+KINDS = {"static_sweep": (static_sweep, (2, 3)), "calibration": (calibration, (2, 2)), "distance": (distance, (4, 4)), "follow_1d": (follow_1d, (1, 1)),
          "formation_2d": (formation_2d, (3, 3)), "max_range": (max_range, (1, 1))}
 
 if __name__ == "__main__":

@@ -9,7 +9,19 @@
 # the cfg's third head (stride 32, for large, close drones) on stage 3 with --partial-weights and trains the whole
 # network on the same data (stage 4), then trains stage 4 longer with 2400 more synthetic 1280x720 images up to 30 m
 # added (stage 5). Stages 1-3 train the cfg without its third head (the section from "# Third head" on cut, the
-# first six anchors). The shipped weights are stage 5's final ones (OUT/stage5/wingman-small_final.weights).
+# first six anchors). Stage 5's final weights (OUT/stage5/wingman-small_final.weights) were shipped until
+# 2026-12-04; the shipped weights now are stage 5 trained on by three runs of stage 6 (the card's "weight average",
+# "stage 7" and "stage 8"; each run's averaged final weights start the next; about 2.8 h on 2 cores):
+#   tools/train_model.sh --out build/train-avg --stage6-batches 800 --stage6-init build/train-wingman-small/stage5/wingman-small_final.weights \
+#     --stage6-iou-loss ciou --stage6-iou-normalizer 1.5 --stage6-mix s5 --stage6-ema 0.99
+#   tools/train_model.sh --out build/train-s7 --stage6-batches 1200 \
+#     --stage6-init build/train-avg/stage6-ciou-1.5-s5mix-ema0.99/wingman-small_final.weights \
+#     --stage6-iou-loss ciou --stage6-iou-normalizer 1.5 --stage6-mix s5 --stage6-ema 0.99
+#   tools/train_model.sh --out build/train-s8 --stage6-batches 800 \
+#     --stage6-init build/train-s7/stage6-ciou-1.5-s5mix-ema0.99/wingman-small_final.weights \
+#     --stage6-iou-loss ciou --stage6-iou-normalizer 3 --stage6-mix s5 --stage6-ema 0.99
+# and the shipped file is the last run's trained (not averaged) weights,
+# build/train-s8/stage6-ciou-3-s5mix-ema0.99/wingman-small_raw_final.weights.
 # Resumable: run it again after an interruption and it continues from the last checkpoint (datasets are kept once
 # complete; a finished stage is not trained again).
 #
@@ -29,9 +41,9 @@
 #   --stage3-batches  stage 3 iterations (default 400, the shipped model's; 0 = stop after stage 2)
 #   --stage4-batches  stage 4 iterations (default 600; 0 = stop after stage 3)
 #   --stage5-batches  stage 5 iterations (default 1000, the shipped model's; 0 = stop after stage 4)
-#   --stage6-batches  stage 6 iterations (default 0: the shipped model has no stage 6). Stage 6 trains stage 5's
+#   --stage6-batches  stage 6 iterations (default 0: stop after stage 5). Stage 6 trains stage 5's
 #                     final weights longer with a second set of 2400 synthetic 1280x720 images (seed 41) added
-#   --stage6-init     FILE: stage 6 starts from FILE (e.g. the shipped models/wingman-small.weights) and stages 1-5
+#   --stage6-init     FILE: stage 6 starts from FILE (e.g. stage 5's final weights, or a stage-6 run's) and stages 1-5
 #                     are not trained (their datasets are still prepared: stage 6 trains on them)
 #   --stage6-iou-loss KIND: stage 6's [yolo] box loss, mse (default, the cfg's), giou, diou or ciou: stage 6 then
 #                     trains a copy of the cfg with iou_loss=KIND in every [yolo] section (OUT/cfg-KIND), into
@@ -244,7 +256,7 @@ val: halmstad/images/val
 nc: 1
 names: [drone]
 EOF
-# 6. Stage 3 (the shipped weights): stage 2's final weights fine-tuned at the shipped input size, 640x352 (the .cfg
+# 6. Stage 3: stage 2's final weights fine-tuned at the shipped input size, 640x352 (the .cfg
 # as it is: a 16:9 frame keeps 0.49 of its rows instead of the 416x416 stretch's 0.58 and 0.50 of its columns
 # instead of 0.33), at Table 2's 1e-3, 5e-4, 1e-4, 5e-5.
 if [ "$train_early" = 1 ] && [ ! -f "$out/stage3/wingman-small_final.weights" ]; then
@@ -269,7 +281,7 @@ if [ "$train_early" = 1 ] && [ ! -f "$out/stage4/wingman-small_final.weights" ];
     "${resume[@]}"
 fi
 [ "$stage5_batches" -gt 0 ] || exit 0
-# 8. Stage 5 (the shipped weights): stage 4 trained longer, with 2400 more synthetic images added, rendered as the
+# 8. Stage 5 (shipped until 2026-12-04): stage 4 trained longer, with 2400 more synthetic images added, rendered as the
 # synthetic 1280x720 test set is (the simulator's camera size, up to 30 m, antialiased) but from another seed.
 if [ ! -f "$data/synth720train/data.yaml" ]; then
   rm -rf "$data/synth720train"
@@ -299,7 +311,7 @@ if [ "$stage6_batches" -eq 0 ]; then
   [ "$data_only" = 0 ] || echo "train_model: the datasets are ready in $data"
   exit 0
 fi
-# 9. Stage 6 (not in the shipped model): stage 5 trained longer with a second set of 2400 synthetic 1280x720 images
+# 9. Stage 6 (three runs of it, the header's commands, give the shipped model): stage 5 trained longer with a second set of 2400 synthetic 1280x720 images
 # (seed 41) added: the synthetic 1280x720 target is the one the model misses (models/wingman-small.md). With
 # --stage6-mix s5, on stage 5's mix alone (the second set dilutes the training flights' small, distant leaders).
 mix6="$data/combined-s6.yaml"

@@ -17,8 +17,9 @@ mkdir -p "$work/run"
 run="$work/run/eval.json"
 val() { python3 -c "import json,sys; r=json.load(open('$1')); print(eval(sys.argv[1]))" "$2"; }
 
-for kind in static_sweep distance follow_1d formation_2d max_range; do mkdir -p "$work/$kind"; done
+for kind in static_sweep calibration distance follow_1d formation_2d max_range; do mkdir -p "$work/$kind"; done
 python3 "$summary" static_sweep "$work/static_sweep" "$run" "$run" "$run" > /dev/null
+python3 "$summary" calibration "$work/calibration" 0.25 "$run" > /dev/null
 python3 "$summary" distance "$work/distance" "$run" "$run" "$run" "$run" > /dev/null
 python3 "$summary" follow_1d "$work/follow_1d" "$run" > /dev/null
 python3 "$summary" formation_2d "$work/formation_2d" "$run" "$run" "$run" > /dev/null
@@ -45,6 +46,20 @@ grep -q "^Seen from behind .*range scale $kb (n = " "$work/static_sweep/results.
 mkdir -p "$work/static_sweep2"
 python3 "$summary" static_sweep "$work/static_sweep2" "$run" "$run" > /dev/null
 ! grep -q "Seen from behind" "$work/static_sweep2/results.md" || fail "a from-behind line without that flight"
+# Calibration: the radius flown times the median true / estimated range of the leader's targets, computed here from
+# the eval's own targets.csv.
+want=$(python3 - "$work/run/targets.csv" <<'PY'
+import csv, sys
+r = sorted(float(x["range_m"]) / float(x["range_est_m"]) for x in csv.DictReader(open(sys.argv[1]))
+           if x["vehicle_id"] == "1" and float(x["range_est_m"] or 0) > 0)
+print("%.6f %d" % (0.25 * r[len(r) // 2], len(r)))
+PY
+)
+got=$(val "$work/calibration/results.json" "'%.6f %d' % (r['radius_m'], r['n'])")
+[ "$got" = "$want" ] || fail "calibrated radius and count $got, want $want"
+grep -q "^| \*\*calibrated radius\*\* (m) | \*\*$(printf '%.3f' "${want% *}")\*\* |" "$work/calibration/results.md" || fail "calibration table: $(cat "$work/calibration/results.md")"
+if python3 "$summary" calibration "$work/calibration" abc "$run" 2> "$work/err"; then fail "radius 'abc' accepted"; fi
+grep -q "radius 'abc': expected metres" "$work/err" || fail "bad radius not named: $(cat "$work/err")"
 # Distance: the along-the-line-of-sight mean and max.
 along=$(val "$run" "'%.2f / %.2f' % (r['along_line_of_sight']['mean_m'], r['along_line_of_sight']['max_m'])")
 grep -q "^| single detection, unfiltered | 1.59 / 19.77 | $along |" "$work/distance/results.md" || fail "distance table: $(cat "$work/distance/results.md")"
