@@ -4,8 +4,10 @@
 results.md (a table with the thesis's figures beside ours) in the experiment's folder. Standard library only.
 
 Usage: experiment_summary.py KIND OUT_DIR EVAL_JSON...   (KIND: static_sweep, calibration, distance, follow_1d,
-formation_2d, max_range; calibration takes the localizer's configured radius in metres before its EVAL_JSON). The thesis's figures are quoted from its text (Fig. 13, Tables 3 and 4, sections 5.3 and 5.5)."""
+formation_2d, max_range; calibration takes the localizer's configured radius in metres before its EVAL_JSON).
+The thesis's figures are quoted from its text (Fig. 13, Tables 3 and 4, sections 5.3 and 5.5)."""
 import json
+import math
 import os
 import subprocess
 import sys
@@ -49,19 +51,22 @@ def common_row(r):
     }
 
 
+def leader_ranges(csv_path):
+    """(true range, the localizer's range) in m of the leader's targets (vehicle 1) that have a range, from a flight's
+    targets.csv (`wingman eval --csv`); None when the file cannot be read."""
+    import csv
+    try:
+        with open(csv_path) as f:
+            return [(float(row["range_m"]), float(row["range_est_m"])) for row in csv.DictReader(f)
+                    if row["vehicle_id"] == "1" and float(row.get("range_est_m") or 0) > 0]
+    except OSError:
+        return None
+
+
 def range_scale(csv_path, lo=2.0, hi=20.0):
     """Median of true range / the localizer's range over the leader's targets with true range in [lo, hi] m: the
     factor by which the detector's boxes are narrower than the bounding sphere's (see docs/localization.md)."""
-    import csv
-    ratios = []
-    try:
-        with open(csv_path) as f:
-            for row in csv.DictReader(f):
-                if row["vehicle_id"] == "1" and float(row.get("range_est_m") or 0) > 0 and lo <= float(row["range_m"]) <= hi:
-                    ratios.append(float(row["range_m"]) / float(row["range_est_m"]))
-    except OSError:
-        return None, 0
-    ratios.sort()
+    ratios = sorted(true / est for true, est in leader_ranges(csv_path) or [] if lo <= true <= hi)
     return (ratios[len(ratios) // 2] if ratios else None), len(ratios)
 
 
@@ -117,13 +122,14 @@ def calibration(out, radius_m, run):
         radius = float(radius_m)
     except ValueError:
         sys.exit(f"experiment_summary: calibration: radius '{radius_m}': expected metres, e.g. 0.252")
-    if not radius > 0:
-        sys.exit(f"experiment_summary: calibration: radius {radius_m}: expected > 0")
+    if not (radius > 0 and math.isfinite(radius)):
+        sys.exit(f"experiment_summary: calibration: radius {radius_m}: expected a finite number of metres > 0")
     r = load(run)
     k, n = range_scale(os.path.join(os.path.dirname(run), "targets.csv"), 0.0, 1e9)
     if not k:
         sys.exit(f"experiment_summary: calibration: no targets on the leader in {run}: nothing to calibrate on")
-    ranges = range_span(os.path.join(os.path.dirname(run), "targets.csv"))
+    true_ranges = [true for true, _ in leader_ranges(os.path.join(os.path.dirname(run), "targets.csv"))]
+    ranges = [min(true_ranges), max(true_ranges)]
     data = {"configured_radius_m": radius, "range_scale": k, "n": n, "radius_m": radius * k,
             "true_range_m": ranges, "localization": r["localization"], **common_row(r)}
     lines = ["| calibration flight | ours |", "|---|---|",
@@ -136,15 +142,6 @@ def calibration(out, radius_m, run):
              f"{radius * k:.3f} m); when it changes by more than about 2 %, fly the calibration again with it (the "
              f"follower's distance, and so the view, follows the radius)."]
     write(out, "calibration", data, lines)
-
-
-def range_span(csv_path):
-    """The smallest and largest true range (m) of the leader's targets with an estimated range."""
-    import csv
-    with open(csv_path) as f:
-        v = [float(row["range_m"]) for row in csv.DictReader(f)
-             if row["vehicle_id"] == "1" and float(row.get("range_est_m") or 0) > 0]
-    return [min(v), max(v)] if v else [0.0, 0.0]
 
 
 def merge_errors(a, b):
