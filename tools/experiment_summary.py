@@ -125,11 +125,12 @@ def calibration(out, radius_m, run):
     if not (radius > 0 and math.isfinite(radius)):
         sys.exit(f"experiment_summary: calibration: radius {radius_m}: expected a finite number of metres > 0")
     r = load(run)
-    k, n = range_scale(os.path.join(os.path.dirname(run), "targets.csv"), 0.0, 1e9)
-    if not k:
+    pairs = leader_ranges(os.path.join(os.path.dirname(run), "targets.csv"))
+    if not pairs:
         sys.exit(f"experiment_summary: calibration: no targets on the leader in {run}: nothing to calibrate on")
-    true_ranges = [true for true, _ in leader_ranges(os.path.join(os.path.dirname(run), "targets.csv"))]
-    ranges = [min(true_ranges), max(true_ranges)]
+    ratios = sorted(true / est for true, est in pairs)
+    k, n = ratios[len(ratios) // 2], len(ratios)
+    ranges = [min(true for true, _ in pairs), max(true for true, _ in pairs)]
     data = {"configured_radius_m": radius, "range_scale": k, "n": n, "radius_m": radius * k,
             "true_range_m": ranges, "localization": r["localization"], **common_row(r)}
     lines = ["| calibration flight | ours |", "|---|---|",
@@ -248,8 +249,8 @@ def max_range(out, run):
 
 # Each kind: its function and how many arguments after OUT_DIR it takes (static_sweep: the third flight, from behind,
 # optional; calibration: the radius flown, then its flight).
-KINDS = {"static_sweep": (static_sweep, (2, 3)), "calibration": (calibration, (2, 2)), "distance": (distance, (4, 4)), "follow_1d": (follow_1d, (1, 1)),
-         "formation_2d": (formation_2d, (3, 3)), "max_range": (max_range, (1, 1))}
+KINDS = {"static_sweep": (static_sweep, (2, 3)), "calibration": (calibration, (2, 2)), "distance": (distance, (4, 4)),
+         "follow_1d": (follow_1d, (1, 1)), "formation_2d": (formation_2d, (3, 3)), "max_range": (max_range, (1, 1))}
 
 if __name__ == "__main__":
     if (len(sys.argv) < 3 or sys.argv[1] not in KINDS or

@@ -12,7 +12,8 @@
 # first six anchors). Stage 5's final weights (OUT/stage5/wingman-small_final.weights) were shipped until
 # 2026-12-04; the shipped weights now are stage 5 trained on by three runs of stage 6 (the card's "weight average",
 # "stage 7" and "stage 8"; each run's averaged final weights start the next; about 2.8 h on 2 cores):
-#   tools/train_model.sh --out build/train-avg --stage6-batches 800 --stage6-init build/train-wingman-small/stage5/wingman-small_final.weights \
+#   tools/train_model.sh --out build/train-avg --stage6-batches 800 \
+#     --stage6-init build/train-wingman-small/stage5/wingman-small_final.weights \
 #     --stage6-iou-loss ciou --stage6-iou-normalizer 1.5 --stage6-mix s5 --stage6-ema 0.99
 #   tools/train_model.sh --out build/train-s7 --stage6-batches 1200 \
 #     --stage6-init build/train-avg/stage6-ciou-1.5-s5mix-ema0.99/wingman-small_final.weights \
@@ -281,8 +282,8 @@ if [ "$train_early" = 1 ] && [ ! -f "$out/stage4/wingman-small_final.weights" ];
     "${resume[@]}"
 fi
 [ "$stage5_batches" -gt 0 ] || exit 0
-# 8. Stage 5 (shipped until 2026-12-04): stage 4 trained longer, with 2400 more synthetic images added, rendered as the
-# synthetic 1280x720 test set is (the simulator's camera size, up to 30 m, antialiased) but from another seed.
+# 8. Stage 5 (shipped until 2026-12-04): stage 4 trained longer, with 2400 more synthetic images added, rendered
+# as the synthetic 1280x720 test set is (the simulator's camera size, up to 30 m, antialiased) but from another seed.
 if [ ! -f "$data/synth720train/data.yaml" ]; then
   rm -rf "$data/synth720train"
   sed 's/^  val_fraction: .*/  val_fraction: 0.0/' "$src/config/datasets/synth720.yaml" > "$data/synth720train.yaml"
@@ -311,9 +312,10 @@ if [ "$stage6_batches" -eq 0 ]; then
   [ "$data_only" = 0 ] || echo "train_model: the datasets are ready in $data"
   exit 0
 fi
-# 9. Stage 6 (three runs of it, the header's commands, give the shipped model): stage 5 trained longer with a second set of 2400 synthetic 1280x720 images
-# (seed 41) added: the synthetic 1280x720 target is the one the model misses (models/wingman-small.md). With
-# --stage6-mix s5, on stage 5's mix alone (the second set dilutes the training flights' small, distant leaders).
+# 9. Stage 6 (three runs of it, the header's commands, give the shipped model): stage 5 trained longer with a
+# second set of 2400 synthetic 1280x720 images (seed 41) added, for the synthetic 1280x720 target
+# (models/wingman-small.md). With --stage6-mix s5, on stage 5's mix alone (the second set dilutes the training
+# flights' small, distant leaders); the shipped model's three runs use s5.
 mix6="$data/combined-s6.yaml"
 [ "$stage6_mix" = s5 ] && mix6="$data/combined-s5.yaml"
 if [ "$stage6_mix" = s6 ] && [ ! -f "$data/synth720train2/data.yaml" ]; then
