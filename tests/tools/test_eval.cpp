@@ -438,10 +438,142 @@ TEST(Eval, BoxWidthErrorSingleAndZoomAgainstTruthBox) {
             0);
   EXPECT_EQ(r.detections_total, 8);
   EXPECT_EQ(r.detections_outside_truth, 2);
-  EXPECT_NE(r.json().find("\"detection_by_range\": [{\"lo_m\": 0, \"hi_m\": 5, \"visible\": 0, \"detected\": 0}, "
-                          "{\"lo_m\": 5, \"hi_m\": 10, \"visible\": 2, \"detected\": 2}"),
-            std::string::npos)
+  // False boxes: (300, 100) in frame 0 (5-10 m) and (111, 100) in frame 2 (20-30 m).
+  EXPECT_EQ(r.detection_by_range[1].false_boxes, 1);
+  EXPECT_EQ(r.detection_by_range[4].frames_with_false_box, 1);
+  EXPECT_NE(
+      r.json().find("\"detection_by_range\": [{\"lo_m\": 0, \"hi_m\": 5, \"visible\": 0, \"detected\": 0, "
+                    "\"false_boxes\": 0, \"frames_with_false_box\": 0}, {\"lo_m\": 5, \"hi_m\": 10, \"visible\": 2, "
+                    "\"detected\": 2, \"false_boxes\": 1, \"frames_with_false_box\": 1}"),
+      std::string::npos)
       << r.json();
+}
+
+truth_box_t truth_box(int vehicle_id, float cx, float cy, float size, bool visible, double range) {
+  truth_box_t b{};
+  b.vehicle_id = vehicle_id;
+  b.cx = cx;
+  b.cy = cy;
+  b.w = b.h = size;
+  b.visible = visible;
+  b.range = range;
+  return b;
+}
+
+TEST(Eval, BoxOnLeaderIsACentreInsideTheLeadersVisibleTruthBoxOfTheSameCamera) {
+  const std::vector<truth_box_t> truth = {truth_box(1, 200, 150, 40, true, 8), truth_box(2, 400, 150, 40, true, 9)};
+  EXPECT_TRUE(box_on_leader(box(200, 150, 10, false), 0, truth, 1));
+  EXPECT_TRUE(box_on_leader(box(220, 170, 80, false), 0, truth, 1));  // on the corner: edges included; size ignored
+  EXPECT_FALSE(box_on_leader(box(220.5f, 150, 40, false), 0, truth, 1));
+  EXPECT_FALSE(box_on_leader(box(200, 150, 10, false), 1, truth, 1));  // another camera
+  EXPECT_FALSE(box_on_leader(box(400, 150, 10, false), 0, truth, 1));  // on vehicle 2, not the leader
+  EXPECT_TRUE(box_on_leader(box(400, 150, 10, false), 0, truth, 2));
+  EXPECT_FALSE(box_on_leader(box(200, 150, 10, false), 0, {truth_box(1, 200, 150, 40, false, 8)}, 1));  // hidden
+  EXPECT_FALSE(box_on_leader(box(200, 150, 10, false), 0, {}, 1));
+}
+
+/// Ten frames; the leader's truth box is centred at (200, 150), 40 x 40 px, range 8 m (frames 0-4) and 18 m (5-9).
+/// Boxes by frame (on = centred in it, off = elsewhere): 0: on (on its right edge); 1: off; 2: on, off, off; 3: an
+/// empty detections_t; 4: off (0.5 px past the edge); 5: on; 6: off, off; 7: no detections_t; 8: the leader hidden,
+/// a box where it would be (off); 9: on, and one on vehicle 2's visible box (off, but inside a truth box). A
+/// detections_t between frames 4 and 5, with no ground truth at its utime: off.
+std::string write_false_boxes(const testing::TempDir& dir) {
+  const float on = 200, off = 400, v2 = 500;
+  const std::vector<std::vector<detection_t>> dets = {
+      {box(220, 150, 30, false)},
+      {box(off, 300, 30, false)},
+      {box(on, 150, 30, false), box(off, 300, 30, false), box(off, 20, 30, false)},
+      {},
+      {box(220.5f, 150, 30, false)},
+      {box(on, 150, 12, false)},
+      {box(off, 300, 12, false), box(off, 20, 12, false)},
+      {},
+      {box(on, 150, 12, false)},
+      {box(on, 150, 12, true), box(v2, 150, 12, false)},
+  };
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    const double range = k < 5 ? 8 : 18;
+    ground_truth_t g = truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, range, 5), vehicle(2, 3, range, 5)});
+    g.boxes = {truth_box(1, 200, 150, 40, k != 8, range), truth_box(2, v2, 150, 40, k == 9, range)};
+    g.num_boxes = 2;
+    events.push_back(make_event("GROUND_TRUTH", g, u));
+    if (k == 7) continue;
+    detections_t d{};
+    d.utime = u;
+    d.seq = k;
+    d.image_width = 640;
+    d.image_height = 480;
+    d.detections = dets[static_cast<size_t>(k)];
+    d.num_detections = static_cast<int32_t>(d.detections.size());
+    events.push_back(make_event("DETECTIONS_CAM0", d, u));
+    if (k == 4) {
+      d.utime = u + 50000;
+      d.detections = {box(on, 150, 12, false)};
+      d.num_detections = 1;
+      events.push_back(make_event("DETECTIONS_CAM0", d, d.utime));
+    }
+  }
+  const std::string path = dir.file("false_boxes.lcmlog");
+  testing::write_log(path, events);
+  return path;
+}
+
+TEST(Eval, LeaderCountsAsDetectedOnlyWithABoxOnItAndOtherBoxesAreFalse) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_false_boxes(dir);
+  o.json_path = dir.file("eval.json");
+  const EvalResult r = evaluate_log(o);
+  // Visible: frames 0-7 and 9. On the leader: 0, 2, 5, 9 (frames 1, 4 and 6 have boxes, none on it).
+  EXPECT_EQ(r.frames_leader_visible, 9);
+  EXPECT_EQ(r.frames_leader_detected, 4);
+  // False boxes in visible frames: 1 (frame 1) + 2 (2) + 1 (4) + 2 (6) + 1 (9) in five frames.
+  EXPECT_EQ(r.false_boxes_leader_visible, 7);
+  EXPECT_EQ(r.frames_leader_visible_with_false_box, 5);
+  // Over every detections_t: also frame 8's box and the one without ground truth.
+  EXPECT_EQ(r.detections_total, 13);
+  EXPECT_EQ(r.detection_frames, 10);  // frames 0-6, 8, 9 and the one between 4 and 5
+  EXPECT_EQ(r.false_boxes, 9);
+  EXPECT_EQ(r.frames_with_false_box, 7);
+  EXPECT_EQ(r.detections_outside_truth, 8);  // every false box but the one on vehicle 2
+  // By the leader's range: 8 m is in 5-10 (frames 0-4), 18 m in 15-20 (5, 6, 7, 9); the bins add up to the totals.
+  ASSERT_EQ(r.detection_by_range.size(), 6u);
+  const DetectionBin& near = r.detection_by_range[1];
+  const DetectionBin& far = r.detection_by_range[3];
+  EXPECT_EQ(near.visible, 5);
+  EXPECT_EQ(near.detected, 2);
+  EXPECT_EQ(near.false_boxes, 4);
+  EXPECT_EQ(near.frames_with_false_box, 3);
+  EXPECT_EQ(far.visible, 4);
+  EXPECT_EQ(far.detected, 2);
+  EXPECT_EQ(far.false_boxes, 3);
+  EXPECT_EQ(far.frames_with_false_box, 2);
+  int64_t visible = 0, detected = 0;
+  for (const auto& b : r.detection_by_range) visible += b.visible, detected += b.detected;
+  EXPECT_EQ(visible, r.frames_leader_visible);
+  EXPECT_EQ(detected, r.frames_leader_detected);
+  const std::string text = r.report();
+  EXPECT_NE(text.find("leader detected in 4 of 9 frames where it is visible (44.4 %"), std::string::npos) << text;
+  EXPECT_NE(text.find("7 false box(es) in 5 of those frames"), std::string::npos) << text;
+  EXPECT_NE(text.find("detected boxes: 13 in 10 frames with a detections_t; 9 not on the leader (false boxes) in 7 "
+                      "frames, 8 of them"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  leader detected at range 5-10 m         40.0 % of 5 frames (2), 4 false box(es) in 3 frames"),
+            std::string::npos)
+      << text;
+  std::ifstream js(o.json_path);
+  std::stringstream j;
+  j << js.rdbuf();
+  for (const char* field :
+       {"\"frames_leader_visible\": 9, \"frames_leader_detected\": 4, \"false_boxes_leader_visible\": 7, "
+        "\"frames_leader_visible_with_false_box\": 5,",
+        "\"detection_frames\": 10, \"false_boxes\": 9, \"frames_with_false_box\": 7}",
+        "{\"lo_m\": 15, \"hi_m\": 20, \"visible\": 4, \"detected\": 2, \"false_boxes\": 3, \"frames_with_false_box\": "
+        "2}"})
+    EXPECT_NE(j.str().find(field), std::string::npos) << field << " not in " << j.str();
 }
 
 /// An image_t of a 64 x 48 grey frame in `format`.

@@ -41,6 +41,11 @@ bool decode(const lcm::LogEvent& ev, Msg* m) {
   return common::validate_message(*m).empty();
 }
 
+/// Index of the range bin of `range` (upper edges `edges`; the last bin is open).
+size_t range_bin(const std::vector<double>& edges, double range) {
+  return static_cast<size_t>(std::upper_bound(edges.begin(), edges.end(), range) - edges.begin());
+}
+
 /// Positions of one vehicle over time, linearly interpolated.
 struct Track {
   std::vector<int64_t> utime;
@@ -88,10 +93,7 @@ struct BinnedAcc {
   std::vector<double> edges;
   std::vector<Acc> acc;
   explicit BinnedAcc(std::vector<double> e) : edges(std::move(e)), acc(edges.size() + 1) {}
-  void add(double range, double e) {
-    const size_t i = static_cast<size_t>(std::upper_bound(edges.begin(), edges.end(), range) - edges.begin());
-    acc[i].add(e);
-  }
+  void add(double range, double e) { acc[range_bin(edges, range)].add(e); }
   std::vector<RangeBin> bins() const {
     std::vector<RangeBin> out;
     for (size_t i = 0; i < acc.size(); ++i) {
@@ -155,14 +157,28 @@ std::string bins_json(const std::vector<RangeBin>& bins, bool fraction) {
 std::string detection_bins_json(const std::vector<DetectionBin>& bins) {
   std::string s = "[";
   for (const auto& b : bins) {
-    s += fmt::format("{}{{\"lo_m\": {:g}, \"hi_m\": {}, \"visible\": {}, \"detected\": {}}}", s.size() > 1 ? ", " : "",
-                     b.lo_m, std::isinf(b.hi_m) ? std::string("null") : fmt::format("{:g}", b.hi_m), b.visible,
-                     b.detected);
+    s += fmt::format(
+        "{}{{\"lo_m\": {:g}, \"hi_m\": {}, \"visible\": {}, \"detected\": {}, \"false_boxes\": {}, "
+        "\"frames_with_false_box\": {}}}",
+        s.size() > 1 ? ", " : "", b.lo_m, std::isinf(b.hi_m) ? std::string("null") : fmt::format("{:g}", b.hi_m),
+        b.visible, b.detected, b.false_boxes, b.frames_with_false_box);
   }
   return s + "]";
 }
 
+/// True when the centre of `b` lies inside `tb` (edges included); cameras and visibility are the caller's to check.
+bool centred_in(const wingman::detection_t& b, const wingman::truth_box_t& tb) {
+  return std::abs(b.cx - tb.cx) <= 0.5 * tb.w && std::abs(b.cy - tb.cy) <= 0.5 * tb.h;
+}
+
 }  // namespace
+
+bool box_on_leader(const wingman::detection_t& box, int camera_id, const std::vector<wingman::truth_box_t>& truth_boxes,
+                   int leader_id) {
+  return std::any_of(truth_boxes.begin(), truth_boxes.end(), [&](const wingman::truth_box_t& tb) {
+    return tb.vehicle_id == leader_id && tb.camera_id == camera_id && tb.visible && centred_in(box, tb);
+  });
+}
 
 std::vector<std::string> EvalOptions::validate() const {
   std::vector<std::string> p;
@@ -211,8 +227,6 @@ EvalResult evaluate_log(const EvalOptions& o) {
     std::vector<wingman::detection_t> boxes;
   };
   std::map<int, Track> truth;                                           // vehicle id -> positions
-  std::map<int64_t, bool> leader_visible;                               // truth utime -> leader box visible
-  std::map<int64_t, int> detections_at;                                 // detections utime -> number of boxes
   std::map<int64_t, std::vector<wingman::truth_box_t>> truth_boxes_at;  // truth utime -> boxes
   std::map<int64_t, int64_t> truth_event_at, image_event_at;            // utime -> first log-event timestamp, us
   std::vector<Estimate> estimates;
@@ -236,9 +250,6 @@ EvalResult evaluate_log(const EvalOptions& o) {
         t.utime.push_back(g.utime);
         t.p.emplace_back(v.p_body_in_world[0], v.p_body_in_world[1], v.p_body_in_world[2]);
       }
-      bool visible = false;
-      for (const auto& b : g.boxes) visible = visible || (b.vehicle_id == o.leader_id && b.visible);
-      leader_visible[g.utime] = visible;
       truth_boxes_at[g.utime] = g.boxes;
       truth_event_at.emplace(g.utime, ev->timestamp);
     } else if (ev->channel == o.targets_channel) {
@@ -255,7 +266,6 @@ EvalResult evaluate_log(const EvalOptions& o) {
       wingman::detections_t d;
       if (!decode(*ev, &d)) continue;
       sources.insert(d.source);
-      detections_at[d.utime] += d.num_detections;
       inference_ms.push_back(d.inference_latency_us * 1e-3);
       detections.push_back({d.utime, d.camera_id, d.image_width, d.detections});
     } else if (ev->channel == o.image_channel &&
@@ -290,11 +300,54 @@ EvalResult evaluate_log(const EvalOptions& o) {
   r.duration_s = static_cast<double>(t1 - t0) * 1e-6;
   const auto secs = [t0](int64_t u) { return static_cast<double>(u - t0) * 1e-6; };
 
-  for (const auto& [u, vis] : leader_visible) {
-    if (!vis) continue;
-    ++r.frames_leader_visible;
-    const auto it = detections_at.find(u);
-    if (it != detections_at.end() && it->second > 0) ++r.frames_leader_detected;
+  // Leader detection and false boxes, one criterion (box_on_leader) for every count. Over all detections_t: the
+  // false boxes and the frames (utimes) with one. Over the frames where the leader is visible, binned by its truth
+  // range: the frames with a box on it, the false boxes and the frames with one (a visible frame with no detections_t
+  // counts as missed).
+  std::map<int64_t, std::vector<const Detections*>> detections_at;  // utime -> its detections_t
+  for (const auto& d : detections) detections_at[d.utime].push_back(&d);
+  static const std::vector<wingman::truth_box_t> kNoTruth;
+  for (const auto& [u, ds] : detections_at) {
+    const auto boxes = truth_boxes_at.find(u);
+    const auto& truth_boxes = boxes == truth_boxes_at.end() ? kNoTruth : boxes->second;
+    int64_t false_here = 0;
+    for (const Detections* d : ds)
+      for (const auto& b : d->boxes) false_here += box_on_leader(b, d->camera_id, truth_boxes, o.leader_id) ? 0 : 1;
+    r.false_boxes += false_here;
+    if (false_here > 0) ++r.frames_with_false_box;
+  }
+  r.detection_frames = static_cast<int64_t>(detections_at.size());
+  for (size_t i = 0; i <= o.range_bins_m.size(); ++i) {
+    r.detection_by_range.push_back(
+        {i == 0 ? 0.0 : o.range_bins_m[i - 1], i < o.range_bins_m.size() ? o.range_bins_m[i] : kInf, 0, 0, 0, 0});
+  }
+  for (const auto& [u, truth_boxes] : truth_boxes_at) {
+    const auto leader_box = std::find_if(truth_boxes.begin(), truth_boxes.end(), [&](const wingman::truth_box_t& tb) {
+      return tb.vehicle_id == o.leader_id && tb.visible;
+    });
+    if (leader_box == truth_boxes.end()) continue;
+    bool on_leader = false;
+    int64_t false_here = 0;
+    if (const auto it = detections_at.find(u); it != detections_at.end()) {
+      for (const Detections* d : it->second) {
+        for (const auto& b : d->boxes) {
+          const bool on = box_on_leader(b, d->camera_id, truth_boxes, o.leader_id);
+          on_leader = on_leader || on;
+          false_here += on ? 0 : 1;
+        }
+      }
+    }
+    DetectionBin& bin = r.detection_by_range[range_bin(o.range_bins_m, leader_box->range)];
+    ++bin.visible;
+    bin.detected += on_leader ? 1 : 0;
+    bin.false_boxes += false_here;
+    bin.frames_with_false_box += false_here > 0 ? 1 : 0;
+  }
+  for (const auto& b : r.detection_by_range) {
+    r.frames_leader_visible += b.visible;
+    r.frames_leader_detected += b.detected;
+    r.false_boxes_leader_visible += b.false_boxes;
+    r.frames_leader_visible_with_false_box += b.frames_with_false_box;
   }
 
   // Localization: each world target against the nearest truth vehicle (not the follower) at its time.
@@ -381,13 +434,6 @@ EvalResult evaluate_log(const EvalOptions& o) {
   // Box widths: the detection nearest the leader's truth box centre, among those centred inside it.
   Acc width_single, width_zoom;
   BinnedAcc width_single_bins(o.range_bins_m), width_zoom_bins(o.range_bins_m);
-  for (size_t i = 0; i <= o.range_bins_m.size(); ++i) {
-    r.detection_by_range.push_back(
-        {i == 0 ? 0.0 : o.range_bins_m[i - 1], i < o.range_bins_m.size() ? o.range_bins_m[i] : kInf, 0, 0});
-  }
-  const auto inside = [](const wingman::detection_t& b, const wingman::truth_box_t& tb) {
-    return std::abs(b.cx - tb.cx) <= 0.5 * tb.w && std::abs(b.cy - tb.cy) <= 0.5 * tb.h;
-  };
   for (const auto& d : detections) {
     auto& frame = r.frames[d.utime];
     for (const auto& b : d.boxes) frame.detections.push_back({b.cx, b.cy, b.w, b.h, d.camera_id, b.zoom_refined != 0});
@@ -400,25 +446,18 @@ EvalResult evaluate_log(const EvalOptions& o) {
     for (const auto& b : d.boxes) {
       bool in_any = false;
       for (const auto& tb : boxes->second)
-        in_any = in_any || (tb.visible && tb.camera_id == d.camera_id && inside(b, tb));
+        in_any = in_any || (tb.visible && tb.camera_id == d.camera_id && centred_in(b, tb));
       if (!in_any) ++r.detections_outside_truth;
     }
     if (d.image_width <= 0) continue;
     for (const auto& tb : boxes->second) {
       if (tb.vehicle_id != o.leader_id || tb.camera_id != d.camera_id || !tb.visible) continue;
-      {
-        size_t k = 0;
-        while (k < o.range_bins_m.size() && tb.range >= o.range_bins_m[k]) ++k;
-        ++r.detection_by_range[k].visible;
-        if (std::any_of(d.boxes.begin(), d.boxes.end(), [&](const auto& b) { return inside(b, tb); }))
-          ++r.detection_by_range[k].detected;
-      }
       for (const bool zoom : {false, true}) {
         const wingman::detection_t* nearest = nullptr;
         double nearest_d = kInf;
         for (const auto& b : d.boxes) {
           if ((b.zoom_refined != 0) != zoom) continue;
-          if (std::abs(b.cx - tb.cx) > 0.5 * tb.w || std::abs(b.cy - tb.cy) > 0.5 * tb.h) continue;
+          if (!centred_in(b, tb)) continue;
           const double dist = std::hypot(b.cx - tb.cx, b.cy - tb.cy);
           if (dist < nearest_d) nearest_d = dist, nearest = &b;
         }
@@ -479,18 +518,23 @@ std::string EvalResult::report() const {
   s += fmt::format(
       "flight: {:.1f} s of ground truth ({} frames); detections from {}\n", duration_s, truth_frames,
       detection_source == "ground_truth" ? "GROUND TRUTH (simulated boxes, no detector model)" : detection_source);
-  s += fmt::format("leader detected in {} of {} frames where it is visible ({:.1f} %)\n", frames_leader_detected,
-                   frames_leader_visible,
-                   frames_leader_visible ? 100.0 * static_cast<double>(frames_leader_detected) /
-                                               static_cast<double>(frames_leader_visible)
-                                         : 0.0);
-  s += fmt::format("detected boxes: {}, of them {} centred in no visible truth box (false detections)\n",
-                   detections_total, detections_outside_truth);
+  const auto percent = [](int64_t part, int64_t whole) {
+    return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+  };
+  s += fmt::format(
+      "leader detected in {} of {} frames where it is visible ({:.1f} %; a box centred in its truth box), "
+      "{} false box(es) in {} of those frames\n",
+      frames_leader_detected, frames_leader_visible, percent(frames_leader_detected, frames_leader_visible),
+      false_boxes_leader_visible, frames_leader_visible_with_false_box);
+  s += fmt::format(
+      "detected boxes: {} in {} frames with a detections_t; {} not on the leader (false boxes) in {} frames, "
+      "{} of them centred in no visible truth box\n",
+      detections_total, detection_frames, false_boxes, frames_with_false_box, detections_outside_truth);
   for (const auto& b : detection_by_range) {
     if (b.visible == 0) continue;
-    s += fmt::format("  leader detected at range {:<12} {:6.1f} % of {} frames\n",
-                     bin_name(RangeBin{b.lo_m, b.hi_m, {}}),
-                     100.0 * static_cast<double>(b.detected) / static_cast<double>(b.visible), b.visible);
+    s += fmt::format("  leader detected at range {:<12} {:6.1f} % of {} frames ({}), {} false box(es) in {} frames\n",
+                     bin_name(RangeBin{b.lo_m, b.hi_m, {}}), percent(b.detected, b.visible), b.visible, b.detected,
+                     b.false_boxes, b.frames_with_false_box);
   }
   s += fmt::format("world targets: {} matched, {} false; {} track id(s) on the leader, {} id switch(es)\n",
                    target_estimates, false_targets, track_ids_on_leader, leader_id_switches);
@@ -531,23 +575,26 @@ std::string EvalResult::report() const {
 std::string EvalResult::json() const {
   return fmt::format(
       "{{\"detection_source\": \"{}\", \"duration_s\": {:.3f}, \"truth_frames\": {}, \"frames_leader_visible\": {}, "
-      "\"frames_leader_detected\": {}, \"target_estimates\": {}, \"false_targets\": {}, \"false_targets_per_s\": "
+      "\"frames_leader_detected\": {}, \"false_boxes_leader_visible\": {}, \"frames_leader_visible_with_false_box\": "
+      "{}, \"target_estimates\": {}, \"false_targets\": {}, \"false_targets_per_s\": "
       "{:.6f}, \"false_track_ids\": {}, \"track_ids_on_leader\": {}, \"leader_id_switches\": {}, "
       "\"localization\": {}, \"localization_x\": {}, \"localization_y\": {}, \"localization_z\": {}, "
       "\"along_line_of_sight\": {}, \"across_line_of_sight\": {}, \"localization_by_range\": {}, "
       "\"formation_horizontal\": {}, \"formation_vertical\": {}, \"latency\": {}, \"inference_latency\": {}, "
       "\"box_width_single\": {}, \"box_width_zoom\": {}, \"box_width_single_by_range\": {}, "
       "\"box_width_zoom_by_range\": {}, \"detection_by_range\": {}, \"detections_total\": {}, "
-      "\"detections_outside_truth\": {}}}",
-      detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected, target_estimates,
-      false_targets, false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches,
-      stats_json(localization), stats_json(localization_axis[0]), stats_json(localization_axis[1]),
-      stats_json(localization_axis[2]), stats_json(along_line_of_sight), stats_json(across_line_of_sight),
-      bins_json(localization_by_range, false), stats_json(formation_horizontal), stats_json(formation_vertical),
-      percentiles_json(latency_ms), percentiles_json(inference_latency_ms), fraction_json(box_width_single),
-      fraction_json(box_width_zoom), bins_json(box_width_single_by_range, true),
-      bins_json(box_width_zoom_by_range, true), detection_bins_json(detection_by_range), detections_total,
-      detections_outside_truth);
+      "\"detections_outside_truth\": {}, \"detection_frames\": {}, \"false_boxes\": {}, \"frames_with_false_box\": "
+      "{}}}",
+      detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected,
+      false_boxes_leader_visible, frames_leader_visible_with_false_box, target_estimates, false_targets,
+      false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches, stats_json(localization),
+      stats_json(localization_axis[0]), stats_json(localization_axis[1]), stats_json(localization_axis[2]),
+      stats_json(along_line_of_sight), stats_json(across_line_of_sight), bins_json(localization_by_range, false),
+      stats_json(formation_horizontal), stats_json(formation_vertical), percentiles_json(latency_ms),
+      percentiles_json(inference_latency_ms), fraction_json(box_width_single), fraction_json(box_width_zoom),
+      bins_json(box_width_single_by_range, true), bins_json(box_width_zoom_by_range, true),
+      detection_bins_json(detection_by_range), detections_total, detections_outside_truth, detection_frames,
+      false_boxes, frames_with_false_box);
 }
 
 std::string EvalResult::csv() const {

@@ -2,6 +2,9 @@
 // `wingman eval`: localization, tracking, latency and box errors of a recorded flight against the simulator's truth.
 #pragma once
 
+#include <wingman/detection_t.hpp>
+#include <wingman/truth_box_t.hpp>
+
 #include <Eigen/Core>
 
 #include <array>
@@ -68,22 +71,30 @@ struct RangeBin {
   ErrorStats error;
 };
 
-/// Detection of the leader in the frames whose truth box range lies in [lo_m, hi_m): frames with a detections_t in
-/// which the leader's truth box is visible, and of those, frames with a detection centred inside that box.
+/// Detection of the leader in the ground-truth frames where its truth box is visible and its range lies in
+/// [lo_m, hi_m) (hi_m is infinity for the last bin). A box is on the leader when box_on_leader() says so; every other
+/// box of those frames is a false box.
 struct DetectionBin {
   double lo_m = 0.0;
   double hi_m = 0.0;
-  int64_t visible = 0;
-  int64_t detected = 0;
+  int64_t visible = 0;                ///< frames in which the leader's truth box is visible
+  int64_t detected = 0;               ///< of those, frames with at least one box on the leader
+  int64_t false_boxes = 0;            ///< boxes of those frames not on the leader
+  int64_t frames_with_false_box = 0;  ///< of the visible frames, those with at least one false box
 };
 
 /// The measured errors of one flight.
 struct EvalResult {
-  std::string detection_source;        ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
-  int64_t truth_frames = 0;            ///< ground_truth_t messages
-  int64_t frames_leader_visible = 0;   ///< of those, frames in which the leader's truth box is visible
-  int64_t frames_leader_detected = 0;  ///< of those, frames with at least one detection at the same utime
-  int64_t target_estimates = 0;        ///< world-valid targets matched to a truth vehicle
+  std::string detection_source;       ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
+  int64_t truth_frames = 0;           ///< ground_truth_t messages
+  int64_t frames_leader_visible = 0;  ///< of those, frames in which the leader's truth box is visible
+  /// Of those, frames with at least one box on the leader (box_on_leader()); a box elsewhere does not count.
+  int64_t frames_leader_detected = 0;
+  /// Boxes not on the leader (false boxes) in the frames where the leader is visible, and how many of those frames
+  /// have at least one. The sums of detection_by_range's false_boxes and frames_with_false_box.
+  int64_t false_boxes_leader_visible = 0;
+  int64_t frames_leader_visible_with_false_box = 0;
+  int64_t target_estimates = 0;  ///< world-valid targets matched to a truth vehicle
   /// World-valid targets farther than match_radius_m from every truth vehicle but the follower (target samples).
   int64_t false_targets = 0;
   double false_targets_per_s = 0.0;  ///< false_targets / duration_s
@@ -111,9 +122,16 @@ struct EvalResult {
   /// leader's visible truth box at the same utime and camera (of the detections whose centre lies inside the truth
   /// box, the one with the nearest centre). Single-pass boxes (zoom_refined false) and zoom-in boxes apart.
   ErrorStats box_width_single, box_width_zoom;
-  std::vector<DetectionBin> detection_by_range;  ///< leader detection rate by truth range (range_bins_m edges)
-  int64_t detections_outside_truth = 0;          ///< detected boxes whose centre lies in no visible truth box
-  int64_t detections_total = 0;                  ///< detected boxes in all detections_t
+  /// Leader detection and false boxes by the leader's truth range (range_bins_m edges); the bins' visible and
+  /// detected add up to frames_leader_visible and frames_leader_detected.
+  std::vector<DetectionBin> detection_by_range;
+  int64_t detections_outside_truth = 0;  ///< detected boxes whose centre lies in no visible truth box
+  int64_t detections_total = 0;          ///< detected boxes in all detections_t
+  int64_t detection_frames = 0;          ///< distinct utimes with a detections_t
+  /// Boxes in all detections_t not on the leader (box_on_leader(); a box at a utime without ground truth is not on
+  /// it), whether or not the leader is visible; includes detections_outside_truth.
+  int64_t false_boxes = 0;
+  int64_t frames_with_false_box = 0;  ///< of the detection_frames, those with at least one false box
   std::vector<RangeBin> box_width_single_by_range, box_width_zoom_by_range;  ///< the same, binned by truth box range
 
   /// Time series (seconds since the first ground truth).
@@ -163,6 +181,12 @@ struct EvalResult {
   std::string json() const;    ///< one JSON object
   std::string csv() const;     ///< per-target time series with a header line
 };
+
+/// True when the detection `box` of camera `camera_id` is on the leader: its centre lies inside (edges included) the
+/// visible truth box of vehicle `leader_id` for that camera among `truth_boxes` (the ground truth of the box's utime).
+/// The one criterion behind every leader-detection and false-box count of EvalResult.
+bool box_on_leader(const wingman::detection_t& box, int camera_id, const std::vector<wingman::truth_box_t>& truth_boxes,
+                   int leader_id);
 
 /// Reads the log and computes the errors; writes json_path, csv_path and report_path when set. Throws
 /// std::invalid_argument naming the option for bad options, std::runtime_error naming the file when it cannot be
