@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // wingman-detector: camera images in, drone detections out (Algorithm 2 on an OpenCL or CPU backend).
+#include "wingman/detector/detection_message.hpp"
 #include "wingman/detector/detector_options.hpp"
 #include "wingman/detector/model_loader.hpp"
 #include "wingman/detector/preprocess.hpp"
@@ -115,7 +116,8 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     out.image_height = img.height;
     out.source = detections_t::SOURCE_CNN;
     out.inference_latency_us = static_cast<int32_t>(latency_us);
-    for (const auto& b : boxes) out.detections.push_back({b.cx, b.cy, b.w, b.h, b.confidence, 0, b.zoom_refined});
+    // Every box, drone or distractor (class_id != 0 with a multi-class model): the consumers choose.
+    for (const auto& b : boxes) out.detections.push_back(detector::to_detection(b));
     out.num_detections = static_cast<int32_t>(out.detections.size());
     rt.publish(o.output_channel, out);
     rt.status().set_last_processed_seq(img.seq);

@@ -26,10 +26,13 @@ int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
     const localizer::LocalizerOutput out = loc.on_detections(d);
     rt.status().set_last_processed_seq(d.seq);
     for (const auto& why : out.rejections) rt.status().item_dropped(o.detections_channel, why);
+    // Boxes of other classes than drone are expected, not drops: their counts since start are in the detail.
+    const std::string non_drone = loc.non_drone_boxes().summary();
     if (out.camera_frame_only) {
-      rt.status().set_state(status_t::STATE_DEGRADED, "camera frame only: no fresh own pose");
+      rt.status().set_state(status_t::STATE_DEGRADED,
+                            "camera frame only: no fresh own pose" + (non_drone.empty() ? "" : "; " + non_drone));
     } else {
-      rt.status().set_state(status_t::STATE_OK, "");
+      rt.status().set_state(status_t::STATE_OK, non_drone);
     }
     if (out.targets) rt.publish(o.output_channel, *out.targets);
   });

@@ -68,7 +68,8 @@ const WireStruct kDetection{"detection_t",
                              {"h", Wire::kF32},
                              {"confidence", Wire::kF32},
                              {"class_id", Wire::kI16},
-                             {"zoom_refined", Wire::kBool}}};
+                             {"zoom_refined", Wire::kBool},
+                             {"drone_score", Wire::kF32}}};
 const WireStruct kDetections{"detections_t",
                              {{"utime", Wire::kI64},
                               {"seq", Wire::kI64},

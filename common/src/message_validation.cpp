@@ -119,6 +119,11 @@ std::string validate_message(const wingman::detections_t& m) {
       return fmt::format("detections_t.detections[{}].w x h = {} x {}: must be positive", i, d.w, d.h);
     if (!(d.confidence >= 0 && d.confidence <= 1))
       return fmt::format("detections_t.detections[{}].confidence = {}: must be in [0, 1]", i, d.confidence);
+    if (!(d.drone_score >= 0 && d.drone_score <= 1))  // NaN fails both
+      return fmt::format("detections_t.detections[{}].drone_score = {}: must be a finite number in [0, 1]", i,
+                         d.drone_score);
+    if (d.class_id < 0)
+      return fmt::format("detections_t.detections[{}].class_id = {}: must be >= 0 (0 = drone)", i, d.class_id);
   }
   return "";
 }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <wingman/common/config.hpp>
+#include <wingman/common/detection_class.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -61,6 +62,7 @@ double box_centre_error(const wingman::detection_t& box, int32_t image_width) {
 std::optional<wingman::detection_t> most_confident_box(const wingman::detections_t& d) {
   std::optional<wingman::detection_t> best;
   for (const auto& box : d.detections) {
+    if (box.class_id != common::kDroneClassId) continue;  // a bird or airplane is never followed
     if (!(box.cx >= 0 && box.cx <= static_cast<float>(d.image_width))) continue;
     if (!best || box.confidence > best->confidence) best = box;
   }

@@ -3,6 +3,7 @@
 #include "wingman/localizer/localizer.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/detection_class.hpp>
 
 #include <stdexcept>
 
@@ -20,6 +21,16 @@ void copy33(const Eigen::Matrix3d& m, double (&out)[9]) {
 }
 
 }  // namespace
+
+std::string NonDroneCounts::summary() const {
+  if (total == 0) return "";
+  std::string by_class_text;
+  for (const auto& [class_id, n] : by_class) {
+    by_class_text +=
+        fmt::format("{}{} {}", by_class_text.empty() ? "" : ", ", common::detection_class_name(class_id), n);
+  }
+  return fmt::format("non-drone boxes not tracked: {} ({})", total, by_class_text);
+}
 
 Localizer::Localizer(const LocalizerOptions& options, CameraModel camera)
     : options_(options),
@@ -64,6 +75,11 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
   std::vector<CameraMeasurement> measurements;
   for (size_t i = 0; i < d.detections.size(); ++i) {
     const auto& det = d.detections[i];
+    if (det.class_id != common::kDroneClassId) {  // a distractor class of a multi-class model: never a target
+      ++result.non_drone.total;
+      ++result.non_drone.by_class[det.class_id];
+      continue;
+    }
     const PixelBox box{det.cx, det.cy, det.w, det.h};
     LocalizeResult r = localize_box(box, camera_, options_.sphere);
     if (!r.ok) {
@@ -73,6 +89,8 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     r.measurement.confidence = det.confidence;
     measurements.push_back(r.measurement);
   }
+  non_drone_boxes_.total += result.non_drone.total;
+  for (const auto& [class_id, n] : result.non_drone.by_class) non_drone_boxes_.by_class[class_id] += n;
 
   std::string why;
   const std::optional<PoseSample> pose = poses_.at(d.utime, &why);

@@ -65,7 +65,7 @@ TEST(ValidateDetections, RejectsCountMismatchNonFiniteAndBadConfidence) {
   d.image_width = 640;
   d.image_height = 480;
   d.detections.resize(1);
-  d.detections[0] = {320, 240, 10, 10, 0.5f, 0, false};
+  d.detections[0] = {320, 240, 10, 10, 0.5f, 0, false, 0.5f};
   d.num_detections = 2;
   EXPECT_NE(validate_message(d).find("num_detections = 2"), std::string::npos);
   d.num_detections = 1;
@@ -75,6 +75,37 @@ TEST(ValidateDetections, RejectsCountMismatchNonFiniteAndBadConfidence) {
   d.detections[0].cx = 1;
   d.detections[0].confidence = 1.5f;
   EXPECT_NE(validate_message(d).find("confidence = 1.5"), std::string::npos);
+}
+
+TEST(ValidateDetections, RejectsDroneScoreOutsideZeroToOneOrNotFiniteAndNegativeClass) {
+  wingman::detections_t d{};
+  d.utime = 1;
+  d.image_width = 640;
+  d.image_height = 480;
+  d.detections.resize(2);
+  d.detections[0] = {320, 240, 10, 10, 0.5f, 0, false, 0.5f};  // a drone: drone_score = confidence
+  d.detections[1] = {100, 100, 10, 10, 0.7f, 2, false, 0.1f};  // a bird (class 2) of a multi-class model
+  d.num_detections = 2;
+  EXPECT_EQ(validate_message(d), "");
+  // The bounds themselves are valid.
+  d.detections[1].drone_score = 0.0f;
+  EXPECT_EQ(validate_message(d), "");
+  d.detections[1].drone_score = 1.0f;
+  EXPECT_EQ(validate_message(d), "");
+  for (const float bad : {-0.01f, 1.01f, std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()}) {
+    d.detections[1].drone_score = bad;
+    const std::string why = validate_message(d);
+    EXPECT_NE(why.find("detections_t.detections[1].drone_score = "), std::string::npos) << bad << ": " << why;
+    EXPECT_NE(why.find("must be a finite number in [0, 1]"), std::string::npos) << bad << ": " << why;
+  }
+  d.detections[1].drone_score = 0.1f;
+  d.detections[1].class_id = -1;
+  EXPECT_NE(validate_message(d).find("detections_t.detections[1].class_id = -1: must be >= 0"), std::string::npos)
+      << validate_message(d);
+  // Any class >= 0 is valid: the consumers decide what a class they do not know means (the localizer: not a drone).
+  d.detections[1].class_id = 17;
+  EXPECT_EQ(validate_message(d), "");
 }
 
 TEST(ValidateOwnPose, RejectsNonUnitQuaternionAndUnknownFrame) {

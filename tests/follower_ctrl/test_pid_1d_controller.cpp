@@ -46,6 +46,19 @@ TEST(Pid1dController, MostConfidentBoxInsideTheImageIsUsed) {
   EXPECT_FALSE(most_confident_box(detections(kT0, {})).has_value());
 }
 
+TEST(Pid1dController, BoxesOfOtherClassesThanDroneAreNeverFollowed) {
+  // A multi-class model: a bird (class 2) more confident than the drone, and an airplane alone.
+  auto bird = box(300, 0.95f);
+  bird.class_id = 2;
+  bird.drone_score = 0.05f;
+  const auto b = most_confident_box(detections(kT0, {bird, box(600, 0.6f)}));
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(b->cx, 600.0f) << "the drone, not the more confident bird";
+  auto airplane = box(500, 0.9f);
+  airplane.class_id = 1;
+  EXPECT_FALSE(most_confident_box(detections(kT0, {airplane})).has_value());
+}
+
 TEST(Pid1dController, ThesisSetUpTargetRightOfCentreMovesTheFollowerTowardsWorldPlusX) {
   // The thesis's 1-D experiment: the camera looks along world +Y (body yawed 90 degrees); the image's
   // right-hand side is world +X, along which the leader moves.

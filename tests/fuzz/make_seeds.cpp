@@ -99,7 +99,13 @@ detections_t detections(int64_t utime, int64_t seq, int n) {
   d.image_width = 640;
   d.image_height = 480;
   d.source = detections_t::SOURCE_CNN;
-  for (int i = 0; i < n; ++i) d.detections.push_back({320.0f + 40.0f * i, 240.0f, 30.0f, 20.0f, 0.9f, 0, false});
+  // Drones (class 0, drone_score = confidence); the second box is a multi-class model's bird (class 2), which the
+  // localizer counts and the 1-D follower skips.
+  for (int i = 0; i < n; ++i) {
+    const bool bird = i == 1;
+    d.detections.push_back({320.0f + 40.0f * i, 240.0f, 30.0f, 20.0f, 0.9f, static_cast<int16_t>(bird ? 2 : 0), false,
+                            bird ? 0.05f : 0.9f});
+  }
   d.num_detections = n;
   return d;
 }

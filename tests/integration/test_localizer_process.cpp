@@ -75,14 +75,18 @@ wingman::own_pose_t own_pose(int64_t utime) {
 struct LocalizerRun {
   std::vector<wingman::targets_t> targets;
   wingman::status_t last_status;
+  std::vector<wingman::status_t> statuses;  ///< every heartbeat, in order (the last one is last_status)
   std::string err;
 };
 
-LocalizerRun run_localizer(const TempDir& dir, const std::vector<LogEvent>& events) {
+/// `lockstep`: a heartbeat after every handled message (--lockstep), not only at start and end.
+LocalizerRun run_localizer(const TempDir& dir, const std::vector<LogEvent>& events, bool lockstep = false) {
   wingman::testing::write_log(dir.file("in.lcmlog"), events);
-  const auto r = run({bin_path("wingman-localizer"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
-                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
-                     30s);
+  std::vector<std::string> args = {bin_path("wingman-localizer"), "--lcm-in",
+                                   "file://" + dir.file("in.lcmlog") + "?speed=0", "--lcm-out",
+                                   "file://" + dir.file("out.lcmlog") + "?mode=w"};
+  if (lockstep) args.push_back("--lockstep");
+  const auto r = run(args, 30s);
   LocalizerRun out;
   out.err = r.err;
   if (r.exit_code != 0) throw std::runtime_error("localizer failed: " + r.err);
@@ -93,6 +97,7 @@ LocalizerRun run_localizer(const TempDir& dir, const std::vector<LogEvent>& even
       out.targets.push_back(t);
     } else if (e.channel == "STATUS_LOCALIZER") {
       out.last_status.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+      out.statuses.push_back(out.last_status);
     }
   }
   return out;
@@ -179,6 +184,49 @@ TEST(LocalizerProcess, BadBoxesAndMessagesAreDroppedAndCountedNeverFatal) {
   const LocalizerRun r = run_localizer(dir, events);
   EXPECT_EQ(r.last_status.state, int{wingman::status_t::STATE_STOPPING});
   EXPECT_EQ(r.last_status.drops_total, 5) << r.last_status.last_error;
+}
+
+TEST(LocalizerProcess, BirdsAreNotTrackedButCountedInTheStatusAndABadDroneScoreIsDropped) {
+  TempDir dir;
+  std::vector<LogEvent> events;
+  int n_detections = 0;
+  for (const LogEvent& e : scripted_flight()) {
+    if (e.channel != "DETECTIONS_CAM0") {
+      events.push_back(e);
+      continue;
+    }
+    // A multi-class model's bird (class 2) beside the drone in every image, more confident than the drone.
+    wingman::detections_t d;
+    d.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+    wingman::detection_t bird = sphere_box(Eigen::Vector3d(8.0, -2.0, 1.0));
+    bird.class_id = 2;
+    bird.confidence = 0.95f;
+    bird.drone_score = 0.02f;
+    d.detections.push_back(bird);
+    d.num_detections = static_cast<int32_t>(d.detections.size());
+    events.push_back(make_event("DETECTIONS_CAM0", d, e.timestamp));
+    ++n_detections;
+  }
+  auto bad_score = sphere_box(target_in_world(kT0 + 1994000));
+  bad_score.drone_score = 1.5f;
+  events.push_back(make_event("DETECTIONS_CAM0", detections(kT0 + 1994000, 900, {bad_score}), 2100000));
+  const LocalizerRun r = run_localizer(dir, events, /*lockstep=*/true);
+  ASSERT_FALSE(r.targets.empty()) << r.err;
+  for (const auto& t : r.targets) EXPECT_LE(t.num_targets, 1) << "the bird became a track";
+  const wingman::targets_t& last = r.targets.back();
+  ASSERT_EQ(last.num_targets, 1);
+  EXPECT_EQ(last.targets[0].track_id, 1);
+  EXPECT_NEAR(last.targets[0].p_target_in_world[1], target_in_world(last.targets[0].predicted_utime).y(), 0.10);
+  // The birds are counted in the detail of the heartbeats while running (the last one says why it stopped), not
+  // as drops; the bad message is the one drop, named.
+  ASSERT_GE(r.statuses.size(), 2u);
+  const wingman::status_t& running = r.statuses[r.statuses.size() - 2];
+  EXPECT_EQ(running.state, int{wingman::status_t::STATE_OK}) << running.detail;
+  const std::string n = std::to_string(n_detections);
+  EXPECT_EQ(running.detail, "non-drone boxes not tracked: " + n + " (bird " + n + ")");
+  EXPECT_EQ(r.last_status.drops_total, 1) << r.last_status.last_error;
+  EXPECT_NE(r.last_status.last_error.find("detections_t.detections[0].drone_score = 1.5"), std::string::npos)
+      << r.last_status.last_error;
 }
 
 TEST(LocalizerProcess, WithoutOwnPosesItPublishesCameraFrameTargetsFlaggedAsSuch) {

@@ -95,7 +95,7 @@ class Bus {
     d.seq = tick_ / 10;
     d.image_width = 1280;
     d.image_height = 720;
-    d.detections.push_back({640.0f, 360.0f, 40.0f, 40.0f, 0.9f, 0, 0});
+    d.detections.push_back({640.0f, 360.0f, 40.0f, 40.0f, 0.9f, 0, 0, 0.9f});
     d.num_detections = 1;
     lcm_.publish("DETECTIONS_CAM0", &d);
   }

@@ -267,6 +267,8 @@ TEST(TruthDetections, VisibleBoxesOfThisCameraBecomeGroundTruthDetections) {
   EXPECT_EQ(d.detections[0].cx, 640);
   EXPECT_EQ(d.detections[0].w, 100);
   EXPECT_EQ(d.detections[0].confidence, 1.0f);
+  EXPECT_EQ(d.detections[0].class_id, 0);  // every simulated vehicle is a drone
+  EXPECT_EQ(d.detections[0].drone_score, 1.0f);
   EXPECT_EQ(d.detections[1].cx, 1265);  // clipped to the image: [1250, 1280]
   EXPECT_EQ(d.detections[1].w, 30);
   o.max_range_m = 50;

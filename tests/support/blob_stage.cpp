@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
         d.w = static_cast<float>(r.width);
         d.h = static_cast<float>(r.height);
         d.confidence = 1.0f;
+        d.drone_score = 1.0f;  // a drone (class 0): the same as confidence
         out.detections.push_back(d);
       }
       out.num_detections = static_cast<int32_t>(out.detections.size());

@@ -128,6 +128,7 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   d.confidence = 0.87f;
   d.class_id = 0;
   d.zoom_refined = false;
+  d.drone_score = 0.87f;  // a drone: the same as confidence
   detections.detections.push_back(d);
   detections.num_detections = static_cast<int32_t>(detections.detections.size());
   out.push_back(encode_sample("DETECTIONS_CAM0", detections));

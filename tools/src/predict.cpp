@@ -3,6 +3,7 @@
 #include "wingman/tools/predict.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/detection_class.hpp>
 #include <wingman/detector/box.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
@@ -33,6 +34,11 @@ bool is_image(const fs::path& p) {
 }
 
 }  // namespace
+
+std::string prediction_line(const detector::Box& b, double image_width, double image_height) {
+  return fmt::format("{} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f}\n", b.class_id, b.cx / image_width, b.cy / image_height,
+                     b.w / image_width, b.h / image_height, b.confidence);
+}
 
 int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& err) {
   const std::string prefix = "wingman predict: error: ";
@@ -114,7 +120,7 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
     const double W = bgr.cols, H = bgr.rows;
     // YOLO labels are normalised to the image: a box past the frame is written as its visible part.
     for (const detector::Box& b : detector::clip_to_image(boxes, static_cast<float>(W), static_cast<float>(H)))
-      f << fmt::format("0 {:.6f} {:.6f} {:.6f} {:.6f} {:.6f}\n", b.cx / W, b.cy / H, b.w / W, b.h / H, b.confidence);
+      f << prediction_line(b, W, H);
     f.close();
     if (!f) {
       err << prefix << fmt::format("{}: cannot write", txt.string()) << "\n";
@@ -128,8 +134,8 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
         const cv::Point p1(cvRound(b.cx + b.w / 2), cvRound(b.cy + b.h / 2));
         const cv::Scalar colour = b.zoom_refined ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255);
         cv::rectangle(drawn, p0, p1, colour, 2);
-        cv::putText(drawn, fmt::format("{:.2f}", b.confidence), p0 + cv::Point(0, -4), cv::FONT_HERSHEY_SIMPLEX, 0.5,
-                    colour, 1);
+        cv::putText(drawn, fmt::format("{} {:.2f}", common::detection_class_name(b.class_id), b.confidence),
+                    p0 + cv::Point(0, -4), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1);
       }
       const fs::path jpg = fs::path(options.out_dir) / (path.stem().string() + ".pred.jpg");
       if (!cv::imwrite(jpg.string(), drawn)) {

@@ -69,8 +69,9 @@ wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int
     det.w = static_cast<float>(w);
     det.h = static_cast<float>(h);
     det.confidence = 1.0f;
-    det.class_id = 0;
+    det.class_id = 0;  // every simulated vehicle is a drone
     det.zoom_refined = false;
+    det.drone_score = 1.0f;  // = confidence, as for every class-0 box
     d.detections.push_back(det);
   }
   d.num_detections = static_cast<int32_t>(d.detections.size());

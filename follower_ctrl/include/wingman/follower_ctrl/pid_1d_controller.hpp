@@ -66,8 +66,9 @@ struct Pid1dOptions {
 /// edge, 1 = right edge). e > 0: the target is right of the image centre.
 double box_centre_error(const wingman::detection_t& box, int32_t image_width);
 
-/// The most confident box of `detections` whose centre lies inside the image (0 <= cx <= image_width);
-/// nullopt when there is none. Ties go to the first.
+/// The most confident drone box (class_id 0: other classes of a multi-class model are never followed) of
+/// `detections` whose centre lies inside the image (0 <= cx <= image_width); nullopt when there is none.
+/// Ties go to the first.
 std::optional<wingman::detection_t> most_confident_box(const wingman::detections_t& detections);
 
 /// One step of the 1-D follower.

@@ -13,11 +13,23 @@
 #include <wingman/targets_t.hpp>
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace wingman::localizer {
+
+/// Boxes the localizer does not track because they are not drones (detection_t.class_id != 0: the airplanes, birds
+/// and helicopters of a multi-class model). They are expected input, not errors: not drops.
+struct NonDroneCounts {
+  int64_t total = 0;                ///< boxes with class_id != 0
+  std::map<int, int64_t> by_class;  ///< class_id -> boxes, for the classes seen
+
+  /// "" when total is 0, else one line for the status detail, e.g.
+  /// "non-drone boxes not tracked: 12 (airplane 3, bird 9)" (names: common::detection_class_name()).
+  std::string summary() const;
+};
 
 /// What one detections message gave.
 struct LocalizerOutput {
@@ -28,6 +40,8 @@ struct LocalizerOutput {
   /// the process counts each as a drop.
   std::vector<std::string> rejections;
   bool camera_frame_only = false;  ///< no own pose fresh enough at the image's exposure time
+  /// The message's boxes with class_id != 0, left out before localization (not rejections).
+  NonDroneCounts non_drone;
 };
 
 /// Turns detections into tracked targets (Algorithm: eq. 24 / tangent planes per box, then the
@@ -41,10 +55,14 @@ class Localizer {
   /// (out of order, duplicate); the caller drops and counts it.
   void on_own_pose(const wingman::own_pose_t& pose);
 
-  /// Localizes and tracks one detections message. Throws std::invalid_argument naming the field for
-  /// a message that cannot be used at all (other camera, other image size, out of order); the caller
-  /// drops and counts it.
+  /// Localizes and tracks one detections message. Only drones are localized and tracked: a box with
+  /// class_id != 0 (common::kDroneClassId) is left out and counted in LocalizerOutput::non_drone and
+  /// non_drone_boxes(). Throws std::invalid_argument naming the field for a message that cannot be used at all
+  /// (other camera, other image size, out of order); the caller drops and counts it.
   LocalizerOutput on_detections(const wingman::detections_t& detections);
+
+  /// The non-drone boxes of every message since construction that passed the camera, image size and order checks.
+  const NonDroneCounts& non_drone_boxes() const { return non_drone_boxes_; }
 
  private:
   wingman::targets_t camera_frame_targets(const wingman::detections_t& d,
@@ -57,6 +75,7 @@ class Localizer {
   Tracker tracker_;
   int64_t last_detections_utime_ = -1;
   int64_t newest_pose_utime_ = -1;
+  NonDroneCounts non_drone_boxes_;
 };
 
 }  // namespace wingman::localizer

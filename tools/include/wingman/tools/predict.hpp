@@ -2,6 +2,7 @@
 // `wingman predict`: the detector (Algorithm 2) on image files, writing YOLO-format labels and drawn images.
 #pragma once
 
+#include <wingman/detector/box.hpp>
 #include <wingman/detector/detection_pipeline.hpp>
 
 #include <ostream>
@@ -24,9 +25,16 @@ struct PredictOptions {
   detector::DetectorPipelineOptions detection;  ///< p_thresh, o_thresh, subsquare, zoom_in, policy, ...
 };
 
-/// Runs `wingman predict`: for each image writes `<out_dir>/<stem>.txt` with one line per detection,
-/// `0 cx cy w h confidence` (YOLO format: class 0, centre and size normalised by the image size), and with
-/// `draw` `<out_dir>/<stem>.pred.jpg`. Prints one line per image on `out`.
+/// One line of a `wingman predict` label file for box `b` (pixels, already clipped to the image) of an image of
+/// `image_width` x `image_height` pixels, newline included: `class cx cy w h confidence`, YOLO format (class =
+/// b.class_id: 0 drone, 1 airplane, 2 bird, 3 helicopter with a multi-class model; centre and size normalised by
+/// the image size; confidence = b.confidence, the score of that class; 6 decimals). Six fields, as training's
+/// read_yolo_predictions() reads them: the drone score (b.drone_score) has no field here.
+std::string prediction_line(const detector::Box& b, double image_width, double image_height);
+
+/// Runs `wingman predict`: for each image writes `<out_dir>/<stem>.txt` with one prediction_line() per detection
+/// of every class, and with `draw` `<out_dir>/<stem>.pred.jpg` (each box labelled with its class name and
+/// confidence). Prints one line per image on `out`.
 /// Returns 0 when every image was processed, 1 when some could not be read or the model cannot be loaded,
 /// 2 on bad options. Errors are lines on `err` ("wingman predict: error: ...").
 int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& err);
