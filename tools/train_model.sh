@@ -31,6 +31,7 @@
 #                             [--stage5-batches N] [--stage6-batches N] [--stage6-init FILE]
 #                             [--stage6-iou-loss KIND] [--stage6-iou-normalizer X] [--stage6-mix s5|s6]
 #                             [--stage6-ema DECAY]
+#                             [--distractors-batches N] [--distractors-init CFG WEIGHTS]
 #                             [--data-only]
 #   --data            where the datasets go (default build/training-data; never inside the source tree's tracked files)
 #   --out             training output: checkpoint.pt, progress.csv, *.weights; stages 2 to 5 in OUT/stage2 .. OUT/stage5
@@ -55,6 +56,16 @@
 #   --stage6-ema      DECAY: stage 6 keeps an exponential moving average of its weights (`wingman train --ema-decay`)
 #                     and exports it; its trained weights stay beside it as wingman-small_raw_*.weights. Into
 #                     OUT/stage6[-KIND[-X]][-s5mix]-emaDECAY (default: no average)
+#   --distractors-batches N: the distractor-class run (default 0: none), instead of stages 1-6: the model of
+#                     --distractors-init (default the shipped one) widened to 4 classes (drone, airplane, bird,
+#                     helicopter; `wingman model widen-classes`, with stage 8's box loss: ciou at 3) and trained N
+#                     iterations on the Halmstad clips imported with their airplane/bird/helicopter boxes as classes
+#                     (`wingman import-halmstad --distractor-classes`, every 10th frame of every clip, into
+#                     DATA/halmstad-classes), stage 1's synthetic set, the follower's-view set and the synthetic
+#                     1280x720 training set, at 5e-4 (then x0.5, x0.2, x0.5 at N/2, 8N/10, 9N/10; burn-in 30), with
+#                     the weight average (EMA 0.99) exported. Into OUT/distractors; resumable like the others
+#   --distractors-init CFG WEIGHTS: the model the distractor-class run starts from (default
+#                     models/wingman-small.cfg and models/wingman-small.weights)
 #   --data-only       prepare every dataset the stages use (import, render, fly) and train nothing
 # Needs ../shared/datasets/halmstad and a build with WINGMAN_WITH_TRAINING=ON and WINGMAN_WITH_SIM=ON; the training
 # flights need what tools/fly.sh needs (a private network namespace) and 3.3 GB of disk for one log at a time.
@@ -65,6 +76,7 @@ bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" out="$src/build/train-wingman-small" threads=2 max_batches=1500 stage2_batches=400
 stage3_batches=400 stage4_batches=600 stage5_batches=1000 stage6_batches=0 stage6_init="" data_only=0
 stage6_iou_loss=mse stage6_iou_normalizer=0.75 stage6_mix=s6 stage6_ema=""
+distractors_batches=0 distractors_cfg="$src/models/wingman-small.cfg" distractors_weights="$src/models/wingman-small.weights"
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -81,6 +93,8 @@ while [ $# -gt 0 ]; do
     --stage6-iou-normalizer) stage6_iou_normalizer="$2"; shift 2 ;;
     --stage6-mix) stage6_mix="$2"; shift 2 ;;
     --stage6-ema) stage6_ema="$2"; shift 2 ;;
+    --distractors-batches) distractors_batches="$2"; shift 2 ;;
+    --distractors-init) distractors_cfg="$2"; distractors_weights="$3"; shift 3 ;;
     --data-only) data_only=1; shift ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "train_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -112,9 +126,19 @@ if [ -n "$stage6_init" ]; then
   [ "$stage6_batches" -gt 0 ] || { echo "train_model: --stage6-init needs --stage6-batches > 0" >&2; exit 2; }
   stage6_init=$(cd "$(dirname "$stage6_init")" && pwd)/$(basename "$stage6_init")
 fi
-# Stages 1-5 train unless only the data is wanted or stage 6 starts from a given file.
+case "$distractors_batches" in ''|*[!0-9]*) echo "train_model: --distractors-batches '$distractors_batches': expected an integer >= 0" >&2; exit 2 ;; esac
+if [ "$distractors_batches" -gt 0 ] && [ "$distractors_batches" -lt 6 ]; then
+  echo "train_model: --distractors-batches $distractors_batches: expected 0 or at least 6 (its rate steps at N/2, 8N/10 and 9N/10 must increase)" >&2
+  exit 2
+fi
+for f in "$distractors_cfg" "$distractors_weights"; do
+  [ -f "$f" ] || { echo "train_model: --distractors-init: '$f': no such file" >&2; exit 2; }
+done
+distractors_cfg=$(cd "$(dirname "$distractors_cfg")" && pwd)/$(basename "$distractors_cfg")
+distractors_weights=$(cd "$(dirname "$distractors_weights")" && pwd)/$(basename "$distractors_weights")
+# Stages 1-5 train unless only the data is wanted, stage 6 starts from a given file, or the distractor-class run runs.
 train_early=1
-{ [ "$data_only" = 1 ] || [ -n "$stage6_init" ]; } && train_early=0
+{ [ "$data_only" = 1 ] || [ -n "$stage6_init" ] || [ "$distractors_batches" -gt 0 ]; } && train_early=0
 halmstad_src="$src/../shared/datasets/halmstad"
 [ -d "$halmstad_src" ] || { echo "train_model: $halmstad_src is missing (the Halmstad videos)" >&2; exit 2; }
 "$bin/wingman" train --help > /dev/null 2>&1 ||
@@ -201,6 +225,51 @@ augment=(--threads "$threads" --scales 0.5,0.2,0.5 --scale 0.25 --translate 0.1 
   --checkpoint-interval 25 --log-interval 10 --val-max-images 400)
 common=(--cfg "$out/cfg-416/wingman-small.cfg" "${augment[@]}")
 common640=(--cfg "$out/cfg-2head/wingman-small.cfg" "${augment[@]}")
+# The synthetic 1280x720 training set (stage 5 on, and the distractor-class run).
+render_synth720train() {
+  if [ ! -f "$data/synth720train/data.yaml" ]; then
+    rm -rf "$data/synth720train"
+    sed 's/^  val_fraction: .*/  val_fraction: 0.0/' "$src/config/datasets/synth720.yaml" > "$data/synth720train.yaml"
+    grep -q '^  val_fraction: 0.0$' "$data/synth720train.yaml" ||
+      { echo "train_model: config/datasets/synth720.yaml has no synth.val_fraction line to set to 0" >&2; exit 1; }
+    "$bin/wingman" dataset synth --out "$data/synth720train" --count 2400 --seed 23 --config "$data/synth720train.yaml" \
+      --meshes "$src/../shared/meshes"
+  fi
+}
+
+# The distractor-class run (--distractors-batches): the starting model widened to 4 classes, trained on the Halmstad
+# clips with their distractor boxes as classes beside the synthetic sets; then exit.
+if [ "$distractors_batches" -gt 0 ]; then
+  if [ ! -f "$data/halmstad-classes/data.yaml" ]; then
+    rm -rf "$data/halmstad-classes"
+    "$bin/wingman" import-halmstad "$halmstad_src" "$data/halmstad-classes" --distractor-classes --negative-frame-step 10
+  fi
+  render_synth720train
+  cat > "$data/combined-distractors.yaml" <<EOF
+# The distractor-class run's mix: the Halmstad train clips with airplane, bird and helicopter boxes as classes 1-3,
+# and the synthetic sets of stages 1, 2 and 5 (drones only); validation: the clip-disjoint Halmstad val clips.
+path: $data
+train: [halmstad-classes/images/train, synth/images/train, horizon/images/train, synth720train/images/train]
+val: halmstad-classes/images/val
+nc: 4
+names: [drone, airplane, bird, helicopter]
+EOF
+  outd="$out/distractors"
+  if [ ! -f "$outd/init/wingman-small.weights" ]; then
+    "$bin/wingman" model widen-classes --cfg "$distractors_cfg" --weights "$distractors_weights" --classes 4 \
+      --iou-loss ciou --iou-normalizer 3 --out-cfg "$outd/init/wingman-small.cfg" \
+      --out-weights "$outd/init/wingman-small.weights"
+  fi
+  [ -f "$outd/wingman-small_final.weights" ] && exit 0
+  u1=$((distractors_batches / 2)) u2=$((distractors_batches * 8 / 10)) u3=$((distractors_batches * 9 / 10))
+  resume=()
+  [ -f "$outd/checkpoint.pt" ] && resume=(--resume)
+  exec "$bin/wingman" train --cfg "$outd/init/wingman-small.cfg" "${augment[@]}" \
+    --data "$data/combined-distractors.yaml" --out "$outd" --weights "$outd/init/wingman-small.weights" \
+    --max-batches "$distractors_batches" --burn-in 30 --learning-rate 0.0005 --steps "$u1,$u2,$u3" \
+    --weights-interval 100 --ema-decay 0.99 "${resume[@]}"
+fi
+
 # 3. Stage 1: Table 2's rate steps, scaled to the run's length; warm-up 100 iterations.
 if [ "$train_early" = 1 ] && [ ! -f "$out/wingman-small_final.weights" ]; then
   s1=$((max_batches * 53 / 100)) s2=$((max_batches * 77 / 100)) s3=$((max_batches * 90 / 100))
@@ -284,14 +353,7 @@ fi
 [ "$stage5_batches" -gt 0 ] || exit 0
 # 8. Stage 5 (shipped until 2026-12-04): stage 4 trained longer, with 2400 more synthetic images added, rendered
 # as the synthetic 1280x720 test set is (the simulator's camera size, up to 30 m, antialiased) but from another seed.
-if [ ! -f "$data/synth720train/data.yaml" ]; then
-  rm -rf "$data/synth720train"
-  sed 's/^  val_fraction: .*/  val_fraction: 0.0/' "$src/config/datasets/synth720.yaml" > "$data/synth720train.yaml"
-  grep -q '^  val_fraction: 0.0$' "$data/synth720train.yaml" ||
-    { echo "train_model: config/datasets/synth720.yaml has no synth.val_fraction line to set to 0" >&2; exit 1; }
-  "$bin/wingman" dataset synth --out "$data/synth720train" --count 2400 --seed 23 --config "$data/synth720train.yaml" \
-    --meshes "$src/../shared/meshes"
-fi
+render_synth720train
 cat > "$data/combined-s5.yaml" <<EOF
 # Stage 5 mix: stage 3's plus 2400 synthetic 1280x720 images up to 30 m; validation: the Halmstad val clips.
 path: $data

@@ -16,8 +16,9 @@ namespace {
 /// Running sums of one group: the fused box is their weighted mean.
 struct Group {
   double weight = 0.0, cx = 0.0, cy = 0.0, w = 0.0, h = 0.0;
-  uint32_t views = 0;  ///< bit v set: the group holds a box of view v
-  Box fused;           ///< the weighted mean so far; zoom_refined when any member is
+  double drone_score = 0.0;  ///< sum of the members' drone scores
+  uint32_t views = 0;        ///< bit v set: the group holds a box of view v
+  Box fused;                 ///< the weighted mean so far; zoom_refined when any member is
 };
 
 /// Both overloads: `min_size` null (every view sees every size) or view_count minimum sizes.
@@ -57,7 +58,9 @@ void fuse(std::vector<ViewBox>& boxes, int view_count, const float* min_size, fl
     best->cy += c * vb.box.cy;
     best->w += c * vb.box.w;
     best->h += c * vb.box.h;
+    best->drone_score += vb.box.drone_score;
     best->views |= bit;
+    const int class_id = best->views == bit ? vb.box.class_id : best->fused.class_id;  // the first (most confident)
     const bool refined = best->fused.zoom_refined || vb.box.zoom_refined;
     if (best->weight > 0.0) {
       best->fused.cx = static_cast<float>(best->cx / best->weight);
@@ -68,6 +71,8 @@ void fuse(std::vector<ViewBox>& boxes, int view_count, const float* min_size, fl
       best->fused = vb.box;
     }
     best->fused.confidence = static_cast<float>(best->weight / view_count);
+    best->fused.drone_score = static_cast<float>(best->drone_score / view_count);
+    best->fused.class_id = class_id;
     best->fused.zoom_refined = refined;
   }
   fused.clear();
@@ -82,6 +87,7 @@ void fuse(std::vector<ViewBox>& boxes, int view_count, const float* min_size, fl
       holding += (g.views >> v) & 1u ? 1 : 0;
     }
     fused.back().confidence = static_cast<float>(g.weight / std::max(seeing, holding));
+    fused.back().drone_score = static_cast<float>(g.drone_score / std::max(seeing, holding));
   }
 }
 

@@ -30,17 +30,23 @@ void decode_region(const float* raw, const Shape& shape, const Layer& region, in
     for (int row = 0; row < shape.h; ++row) {
       for (int col = 0; col < shape.w; ++col) {
         const int i = row * shape.w + col;
-        float class_prob = 1.0f;
+        float class_prob = 1.0f, drone_prob = 1.0f;
+        int best = 0;
         if (region.classes > 1) {
           float max_t = base[5 * plane + i];
-          for (int c = 1; c < region.classes; ++c) max_t = std::max(max_t, base[(5 + c) * plane + i]);
+          for (int c = 1; c < region.classes; ++c)
+            if (base[(5 + c) * plane + i] > max_t) max_t = base[(5 + c) * plane + i], best = c;
           float sum = 0.0f;
           for (int c = 0; c < region.classes; ++c) sum += std::exp(base[(5 + c) * plane + i] - max_t);
           class_prob = 1.0f / sum;  // the largest softmax value
+          drone_prob = std::exp(base[5 * plane + i] - max_t) / sum;
         }
-        const float confidence = sigmoid(base[4 * plane + i]) * class_prob;
+        const float objectness = sigmoid(base[4 * plane + i]);
+        const float confidence = objectness * class_prob;
         if (confidence < p_thresh) continue;
         Box b;
+        b.class_id = best;
+        b.drone_score = objectness * drone_prob;
         b.cx = (sigmoid(base[i]) + col) * net_w / shape.w;
         b.cy = (sigmoid(base[plane + i]) + row) * net_h / shape.h;
         b.w = p_w * std::exp(base[2 * plane + i]) * net_w / shape.w;
@@ -77,10 +83,15 @@ void decode_yolo(const float* raw, const Shape& shape, const Layer& yolo, int ne
       for (int col = 0; col < shape.w; ++col) {
         const int i = row * shape.w + col;
         float max_t = base[5 * plane + i];  // sigma is increasing: max of sigma = sigma of max
-        for (int c = 1; c < yolo.classes; ++c) max_t = std::max(max_t, base[(5 + c) * plane + i]);
-        const float confidence = sigmoid(base[4 * plane + i]) * sigmoid(max_t);
+        int best = 0;                       // the first of equal maxima, as the reference's argmax
+        for (int c = 1; c < yolo.classes; ++c)
+          if (base[(5 + c) * plane + i] > max_t) max_t = base[(5 + c) * plane + i], best = c;
+        const float objectness = sigmoid(base[4 * plane + i]);
+        const float confidence = objectness * sigmoid(max_t);
         if (confidence < p_thresh) continue;
         Box b;
+        b.class_id = best;
+        b.drone_score = best == 0 ? confidence : objectness * sigmoid(base[5 * plane + i]);
         b.cx = (s * sigmoid(base[i]) - shift + col) * to_px_x;
         b.cy = (s * sigmoid(base[plane + i]) - shift + row) * to_px_y;
         b.w = a_w * std::exp(base[2 * plane + i]);

@@ -16,6 +16,30 @@ Box box(float cx, float cy, float w, float h, float confidence, bool refined = f
   return Box{cx, cy, w, h, confidence, refined};
 }
 
+TEST(FuseBoxes, ClassOfTheMostConfidentMemberAndMeanDroneScore) {
+  // View 0 calls it a bird (class 2) at 0.8 with drone score 0.1; view 1 a drone at 0.6 (drone score 0.6); a third box
+  // only view 1 found, a helicopter at 0.4 with drone score 0.05. Views 0 and 1 of 2.
+  Box bird = box(100, 50, 40, 20, 0.8f), drone = box(102, 50, 40, 20, 0.6f), heli = box(300, 200, 10, 10, 0.4f);
+  bird.class_id = 2, bird.drone_score = 0.1f;
+  drone.class_id = 0, drone.drone_score = 0.6f;
+  heli.class_id = 3, heli.drone_score = 0.05f;
+  std::vector<ViewBox> in = {{drone, 1}, {bird, 0}, {heli, 1}};
+  std::vector<Box> out;
+  fuse_boxes(in, 2, 0.3f, out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].class_id, 2);                 // the more confident member's class
+  EXPECT_NEAR(out[0].drone_score, 0.35f, 1e-6);  // (0.1 + 0.6) / 2
+  EXPECT_NEAR(out[0].confidence, 0.7f, 1e-6);    // (0.8 + 0.6) / 2
+  EXPECT_EQ(out[1].class_id, 3);
+  EXPECT_NEAR(out[1].drone_score, 0.025f, 1e-6);  // one view of two: half
+  // With per-view minimum sizes (the coarse pass): the 10 px box is below view 0's 20 px, so only view 1 sees it.
+  std::vector<ViewBox> again = {{drone, 1}, {bird, 0}, {heli, 1}};
+  fuse_boxes(again, std::vector<float>{20.0f, 0.0f}, 0.3f, out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out[1].drone_score, 0.05f, 1e-6);
+  EXPECT_NEAR(out[1].confidence, 0.4f, 1e-6);
+}
+
 TEST(FuseBoxes, HandComputedPairAndASingleViewBox) {
   // View 0: a drone at (100, 50) 40x20, 0.8, and a box elsewhere at 0.5. View 1: the drone at (104, 52) 44x20, 0.6
   // (IoU with the first: 0.71).

@@ -179,6 +179,8 @@ TEST(YoloDecode, HandComputedCellWithScaleXY) {
   EXPECT_NEAR(boxes[0].h, 169.0f * std::exp(-0.5f), 1e-3);                // 102.5037 px
   EXPECT_NEAR(boxes[0].confidence, sigmoid(2.0f) * sigmoid(0.5f), 1e-6);  // 0.8808 x 0.6225 = 0.5483
   EXPECT_NEAR(boxes[0].confidence, 0.54826f, 1e-4);
+  EXPECT_EQ(boxes[0].class_id, 1);                                          // the most probable class
+  EXPECT_NEAR(boxes[0].drone_score, sigmoid(2.0f) * sigmoid(-1.0f), 1e-6);  // objectness x P(class 0)
   boxes.clear();
   decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.55f, boxes);
   EXPECT_TRUE(boxes.empty());

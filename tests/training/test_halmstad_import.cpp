@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 namespace wingman::training {
@@ -105,6 +106,74 @@ TEST(HalmstadImport, ValSplitNeverSharesAClip) {
   testing::TempDir again;
   o.out_dir = again.path();
   EXPECT_EQ(import_halmstad(o).val_clips, s.val_clips);
+}
+
+TEST(HalmstadImport, DistractorClassesLabelTheOtherClipsWithTheSameSplit) {
+  REQUIRE_HALMSTAD(root);
+  testing::TempDir out, plain;
+  HalmstadImportOptions o;
+  o.root = root;
+  o.out_dir = out.path();
+  o.clips = {"V_DRONE_001", "V_BIRD_004", "V_HELICOPTER_002", "V_AIRPLANE_001", "V_AIRPLANE_004"};
+  o.frame_step = 100;
+  o.negative_frame_step = 100;
+  o.val_fraction = 0.5;
+  o.distractor_classes = true;
+  const HalmstadImportSummary s = import_halmstad(o);
+  EXPECT_GT(s.boxes, 0);
+  EXPECT_GT(s.distractor_boxes, 0) << s.report();
+  // The split is the one the drone-only import makes.
+  HalmstadImportOptions drone_only = o;
+  drone_only.out_dir = plain.path();
+  drone_only.distractor_classes = false;
+  const HalmstadImportSummary p = import_halmstad(drone_only);
+  EXPECT_EQ(p.val_clips, s.val_clips);
+  EXPECT_EQ(p.train_clips, s.train_clips);
+  EXPECT_EQ(p.distractor_boxes, 0);
+  // Every frame's boxes carry its clip's class: 0 drone, 1 airplane, 2 bird, 3 helicopter.
+  const std::map<std::string, int> kClass = {{"DRONE", 0}, {"AIRPLANE", 1}, {"BIRD", 2}, {"HELICOPTER", 3}};
+  size_t boxes_seen[4] = {0, 0, 0, 0};
+  for (const char* split : {"train", "val"}) {
+    const YoloDataset ds = load_yolo_dataset(out.file("data.yaml"), split);
+    ASSERT_EQ(ds.class_names, (std::vector<std::string>{"drone", "airplane", "bird", "helicopter"}));
+    for (const DatasetImage& img : ds.images) {
+      const std::string stem = fs::path(img.image_path).stem().string();
+      const std::string cls = stem.substr(2, stem.find('_', 2) - 2);
+      for (const LabeledBox& b : img.boxes) {
+        EXPECT_EQ(b.cls, kClass.at(cls)) << img.image_path;
+        ++boxes_seen[b.cls];
+      }
+    }
+  }
+  for (int c = 0; c < 4; ++c) EXPECT_GT(boxes_seen[c], 0u) << "no box of class " << c;
+  EXPECT_EQ(static_cast<int64_t>(boxes_seen[1] + boxes_seen[2] + boxes_seen[3]), s.distractor_boxes);
+}
+
+TEST(HalmstadImport, DistractorClassesNeedTheNegativesAndKnownClassNames) {
+  HalmstadImportOptions o;
+  o.root = "r";
+  o.out_dir = "o";
+  o.distractor_classes = true;
+  o.negatives = false;
+  const auto problems = o.validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("distractor_classes"), std::string::npos) << problems[0];
+  // A label whose class is none of the four: one error naming the file, the line and the value.
+  testing::TempDir dir;
+  fs::create_directories(dir.file("labels"));
+  std::ofstream(dir.file("clips.csv")) << "clip,class,drone_type,distance_bin,frames,boxes,note\n"
+                                       << "V_BIRD_900,BIRD,,CLOSE,2,2,\n";
+  std::ofstream(dir.file("labels/V_BIRD_900.csv")) << "frame,class,x,y,w,h\n0,BIRD,1,1,5,5\n1,KITE,2,2,5,5\n";
+  o.root = dir.path();
+  o.out_dir = dir.file("out");
+  o.negatives = true;
+  try {
+    import_halmstad(o);
+    FAIL() << "no exception";
+  } catch (const DatasetError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("V_BIRD_900.csv:3: field class = 'KITE'"), std::string::npos) << what;
+  }
 }
 
 TEST(HalmstadImport, UnknownClipAndMissingListAreNamed) {

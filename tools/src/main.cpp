@@ -7,6 +7,7 @@
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
+#include "wingman/tools/model_cli.hpp"
 #include "wingman/tools/predict.hpp"
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/spy.hpp"
@@ -186,6 +187,7 @@ int main(int argc, char** argv) {
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
   TrainingVerbs training(app);  // train, val, import-halmstad
+  ModelVerbs model_verbs(app);  // model widen-classes
 #ifdef WINGMAN_WITH_SIM
   DatasetVerbs dataset(app);  // dataset synth
 #endif
@@ -211,6 +213,7 @@ int main(int argc, char** argv) {
     }
     if (*s) return run_spy(spy);
     if (const int rc = training.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+    if (const int rc = model_verbs.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #ifdef WINGMAN_WITH_SIM
     if (const int rc = dataset.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #endif

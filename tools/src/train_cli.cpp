@@ -223,6 +223,8 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   h->add_option("--negative-frame-step", io.negative_frame_step,
                 "Every n-th frame of airplane/bird/helicopter clips (default 30)");
   h->add_flag("--no-negatives", s.no_negatives, "Leave out the airplane/bird/helicopter clips");
+  h->add_flag("--distractor-classes", io.distractor_classes,
+              "Label the airplane/bird/helicopter clips' boxes as classes 1, 2, 3 instead of empty negatives");
   h->add_option("--max-frames-per-clip", io.max_frames_per_clip, "At most this many frames per clip (default all)");
   h->add_option("--val-fraction", io.val_fraction, "Share of clips in val, per class and distance (default 0.2)");
   h->add_option("--seed", io.seed, "Seed of the clip split (default 1)");

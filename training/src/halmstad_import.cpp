@@ -34,16 +34,18 @@ std::vector<std::string> HalmstadImportOptions::validate() const {
     p.push_back(fmt::format("val_fraction = {}: must be in 0..1", val_fraction));
   if (jpeg_quality < 1 || jpeg_quality > 100)
     p.push_back(fmt::format("jpeg_quality = {}: must be in 1..100", jpeg_quality));
+  if (distractor_classes && !negatives)
+    p.push_back("distractor_classes is set but negatives is not: the distractor classes come from the non-drone clips");
   for (const auto& s : tightening.validate()) p.push_back(s);
   return p;
 }
 
 std::string HalmstadImportSummary::one_line() const {
   return fmt::format(
-      "{} train clips / {} images, {} val clips / {} images; {} drone boxes ({} tightened, mean area "
-      "x{:.2f}), {} negative images",
-      train_clips.size(), train_images, val_clips.size(), val_images, boxes, tightened, mean_area_ratio,
-      negative_images);
+      "{} train clips / {} images, {} val clips / {} images; {} drone boxes, {} airplane/bird/helicopter boxes ({} "
+      "of all boxes tightened, mean area x{:.2f}), {} negative images",
+      train_clips.size(), train_images, val_clips.size(), val_images, boxes, distractor_boxes, tightened,
+      mean_area_ratio, negative_images);
 }
 
 std::string HalmstadImportSummary::report() const {
@@ -105,15 +107,24 @@ std::vector<Clip> read_clips(const std::string& path) {
   return clips;
 }
 
-/// frame -> boxes (x, y, w, h in 0-based continuous pixels) of one label CSV.
-std::map<int, std::vector<cv::Rect2d>> read_boxes(const std::string& path) {
+/// The class names of the labels, in class-id order (0 = drone, then the distractors).
+const std::vector<std::string> kLabelClasses = {"DRONE", "AIRPLANE", "BIRD", "HELICOPTER"};
+
+/// One labelled box: x, y, w, h in 0-based continuous pixels, and its class id (index in kLabelClasses).
+struct LabelBox {
+  cv::Rect2d rect;
+  int cls = 0;
+};
+
+/// frame -> boxes of one label CSV.
+std::map<int, std::vector<LabelBox>> read_boxes(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw DatasetError(fmt::format("{}: cannot read the label file", path));
   std::string line;
   std::getline(in, line);
   if (line.rfind("frame,class,x,y,w,h", 0) != 0)
     throw DatasetError(fmt::format("{}:1: expected the header 'frame,class,x,y,w,h', got '{}'", path, line));
-  std::map<int, std::vector<cv::Rect2d>> boxes;
+  std::map<int, std::vector<LabelBox>> boxes;
   int line_no = 1;
   while (std::getline(in, line)) {
     ++line_no;
@@ -124,6 +135,10 @@ std::map<int, std::vector<cv::Rect2d>> read_boxes(const std::string& path) {
     const long frame = std::strtol(f[0].c_str(), &end, 10);
     if (end == f[0].c_str() || *end != '\0' || frame < 0)
       throw DatasetError(fmt::format("{}:{}: field frame = '{}': expected an integer >= 0", path, line_no, f[0]));
+    const auto cls = std::find(kLabelClasses.begin(), kLabelClasses.end(), f[1]);
+    if (cls == kLabelClasses.end())
+      throw DatasetError(
+          fmt::format("{}:{}: field class = '{}': expected DRONE, AIRPLANE, BIRD or HELICOPTER", path, line_no, f[1]));
     double v[4];
     static const char* kNames[] = {"x", "y", "w", "h"};
     for (int k = 0; k < 4; ++k) {
@@ -134,7 +149,8 @@ std::map<int, std::vector<cv::Rect2d>> read_boxes(const std::string& path) {
                                        f[2 + k], k >= 2 ? " positive" : ""));
     }
     // MATLAB's spatial coordinates put pixel centres at integers: the 0-based left edge is x - 0.5.
-    boxes[static_cast<int>(frame)].emplace_back(v[0] - 0.5, v[1] - 0.5, v[2], v[3]);
+    boxes[static_cast<int>(frame)].push_back(
+        {cv::Rect2d(v[0] - 0.5, v[1] - 0.5, v[2], v[3]), static_cast<int>(cls - kLabelClasses.begin())});
   }
   return boxes;
 }
@@ -192,13 +208,13 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
     const bool drone = clip.cls == "DRONE";
     const std::string split = is_val[ci] ? "val" : "train";
     (is_val[ci] ? summary.val_clips : summary.train_clips).push_back(clip.name);
-    std::map<int, std::vector<cv::Rect2d>> boxes;
-    if (drone) boxes = read_boxes((root / "labels" / (clip.name + ".csv")).string());
+    std::map<int, std::vector<LabelBox>> boxes;
+    if (drone || o.distractor_classes) boxes = read_boxes((root / "labels" / (clip.name + ".csv")).string());
     const std::string video = (root / "videos" / (clip.name + ".mp4")).string();
     cv::VideoCapture cap(video);
     if (!cap.isOpened()) throw DatasetError(fmt::format("{}: cannot open the video", video));
     const int step = drone ? o.frame_step : o.negative_frame_step;
-    int written = 0, clip_boxes = 0, clip_tight = 0;
+    int written = 0, clip_boxes = 0, clip_distractors = 0, clip_tight = 0;
     cv::Mat frame;
     for (int k = 0;; ++k) {
       if (o.max_frames_per_clip > 0 && written >= o.max_frames_per_clip) break;
@@ -208,10 +224,11 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
       }
       if (!cap.read(frame) || frame.empty()) break;
       std::vector<LabeledBox> labels;
-      if (drone) {
+      {
         const auto it = boxes.find(k);
         if (it != boxes.end())
-          for (const cv::Rect2d& loose : it->second) {
+          for (const LabelBox& label : it->second) {
+            const cv::Rect2d& loose = label.rect;
             cv::Rect2d b = loose;
             if (o.tighten) {
               const TightenResult t = tighten_box(frame, loose, o.tightening);
@@ -227,10 +244,10 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
             const double x1 = std::clamp(b.x + b.width, 0.0, static_cast<double>(frame.cols));
             const double y1 = std::clamp(b.y + b.height, 0.0, static_cast<double>(frame.rows));
             if (x1 - x0 < 1.0 || y1 - y0 < 1.0) continue;
-            labels.push_back({0, static_cast<float>(0.5 * (x0 + x1) / frame.cols),
+            labels.push_back({label.cls, static_cast<float>(0.5 * (x0 + x1) / frame.cols),
                               static_cast<float>(0.5 * (y0 + y1) / frame.rows),
                               static_cast<float>((x1 - x0) / frame.cols), static_cast<float>((y1 - y0) / frame.rows)});
-            ++clip_boxes;
+            ++(label.cls == 0 ? clip_boxes : clip_distractors);
           }
       }
       const std::string stem = fmt::format("{}_{:04d}", clip.name, k);
@@ -245,20 +262,26 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
     }
     if (written == 0) throw DatasetError(fmt::format("{}: no frame could be read", video));
     summary.boxes += clip_boxes;
+    summary.distractor_boxes += clip_distractors;
     summary.tightened += clip_tight;
     splits << fmt::format("{},{},{},{},{}\n", clip.name, clip.cls, clip.distance, split, written);
     if (log)
       log(fmt::format("{} ({} {}): {} -> {} images, {} boxes, {} tightened", clip.name, clip.cls, clip.distance, split,
-                      written, clip_boxes, clip_tight));
+                      written, clip_boxes + clip_distractors, clip_tight));
   }
   summary.mean_area_ratio = summary.tightened > 0 ? ratio_sum / static_cast<double>(summary.tightened) : 0.0;
   splits.close();
   if (!splits) throw DatasetError(fmt::format("{}: cannot write", (out / "splits.csv").string()));
-  write_data_yaml((out / "data.yaml").string(), {"drone"},
+  const std::vector<std::string> names = o.distractor_classes
+                                             ? std::vector<std::string>{"drone", "airplane", "bird", "helicopter"}
+                                             : std::vector<std::string>{"drone"};
+  write_data_yaml((out / "data.yaml").string(), names,
                   {"Halmstad drone detection dataset (CC0-1.0; Svanstrom et al., Data in Brief 39, 2021), imported by "
                    "wingman import-halmstad",
-                   fmt::format("frame_step {}, negative_frame_step {}, val_fraction {}, seed {}, tighten {}",
-                               o.frame_step, o.negative_frame_step, o.val_fraction, o.seed, o.tighten ? "on" : "off"),
+                   fmt::format("frame_step {}, negative_frame_step {}, val_fraction {}, seed {}, tighten {}, "
+                               "distractor_classes {}",
+                               o.frame_step, o.negative_frame_step, o.val_fraction, o.seed, o.tighten ? "on" : "off",
+                               o.distractor_classes ? "on" : "off"),
                    "split by clip: see splits.csv"});
   return summary;
 }

@@ -469,6 +469,7 @@ DetectionMetrics Trainer::validate(const std::string& split, int max_images) con
     const double sx = static_cast<double>(bgr.cols) / net_size.width,
                  sy = static_cast<double>(bgr.rows) / net_size.height;
     for (detector::Box b : s.decode(outs, 0)) {
+      if (b.class_id != 0) continue;  // drones only, as the truths below (a multi-class model's distractors are not)
       b.cx = static_cast<float>(b.cx * sx), b.w = static_cast<float>(b.w * sx);
       b.cy = static_cast<float>(b.cy * sy), b.h = static_cast<float>(b.h * sy);
       d.predictions.push_back(b);

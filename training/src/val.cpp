@@ -96,7 +96,10 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
     }
     if (pipeline) {
       // As `wingman predict` writes them: the visible part of each box (the labels' convention).
-      d.predictions = detector::clip_to_image(pipeline->detect(bgr), static_cast<float>(W), static_cast<float>(H));
+      // Boxes of class_id only: a multi-class model's distractor boxes are not drone predictions.
+      for (const detector::Box& b :
+           detector::clip_to_image(pipeline->detect(bgr), static_cast<float>(W), static_cast<float>(H)))
+        if (b.class_id == o.class_id) d.predictions.push_back(b);
     } else {
       const std::string file = (fs::path(o.predictions) / (fs::path(img.image_path).stem().string() + ".txt")).string();
       if (!fs::is_regular_file(file))

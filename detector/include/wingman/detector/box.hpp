@@ -13,8 +13,14 @@ struct Box {
   float cy = 0.0f;            ///< centre y, pixels
   float w = 0.0f;             ///< width, pixels (>= 0)
   float h = 0.0f;             ///< height, pixels (>= 0)
-  float confidence = 0.0f;    ///< objectness x class probability, 0..1
+  float confidence = 0.0f;    ///< objectness x the probability of the box's class (class_id), 0..1
   bool zoom_refined = false;  ///< true when the box comes from a zoom-in re-detection (Algorithm 2)
+  /// the most probable class of the model's [yolo]/[region] head: 0 = drone; a multi-class model's others are
+  /// distractors (models/wingman-small.md names them: 1 airplane, 2 bird, 3 helicopter)
+  int class_id = 0;
+  /// objectness x the probability of class 0 (drone), 0..1: what a drone follower ranks by; equals `confidence` when
+  /// class_id is 0 and for a single-class model
+  float drone_score = 0.0f;
 };
 
 /// Intersection over union of two boxes in the same pixel frame, 0..1 (0 when both are empty).

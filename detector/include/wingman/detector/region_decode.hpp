@@ -14,6 +14,7 @@ namespace wingman::detector {
 ///   b_x = sigma(t_x) + c_x,  b_y = sigma(t_y) + c_y          (grid cells)
 ///   b_w = p_w * exp(t_w),    b_h = p_h * exp(t_h)            (p_w, p_h: the anchor, grid cells)
 ///   confidence = sigma(t_o) * max_c softmax(t_class)_c      (= sigma(t_o) with one class)
+///   class_id = argmax_c t_class_c (the first of equal maxima), drone_score = sigma(t_o) * softmax(t_class)_0
 /// then scaled to network-input pixels: x * net_w / W, y * net_h / H (W x H: the grid).
 ///
 /// @param raw    one image's raw output, C x H x W floats with C = num * (5 + classes); channel
@@ -30,6 +31,7 @@ void decode_region(const float* raw, const Shape& shape, const Layer& region, in
 ///   b_x = (s * sigma(t_x) - (s - 1) / 2 + c_x) / W * net_w,  b_y likewise with c_y, H, net_h   (pixels)
 ///   b_w = a_w * exp(t_w),  b_h = a_h * exp(t_h)     (a = anchors[mask[k]], already network-input pixels)
 ///   confidence = sigma(t_o) * max_c sigma(t_class_c)   (independent logistic classes, no softmax)
+///   class_id = argmax_c t_class_c (the first of equal maxima), drone_score = sigma(t_o) * sigma(t_class_0)
 /// Darknet thresholds the objectness and then each class product; here the product is thresholded, as in
 /// decode_region, so both heads mean the same by p_thresh.
 ///

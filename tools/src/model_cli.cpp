@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+// `wingman model widen-classes`.
+#include "wingman/tools/model_cli.hpp"
+
+#include "run_verb.hpp"
+
+#include <wingman/detector/class_widening.hpp>
+#include <wingman/detector/darknet_cfg.hpp>
+#include <wingman/detector/darknet_weights.hpp>
+#include <wingman/detector/model_loader.hpp>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace wingman::tools {
+
+namespace fs = std::filesystem;
+
+struct ModelVerbs::State {
+  CLI::App* model = nullptr;
+  CLI::App* widen = nullptr;
+  std::string cfg = "builtin:wingman-small", weights = "builtin:wingman-small", out_cfg, out_weights, iou_loss;
+  float iou_normalizer = 0.0f;
+  int classes = 4;
+  float bias = detector::kNewClassBias;
+};
+
+ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
+  State& s = *s_;
+  s.model = app.add_subcommand("model", "Operations on a detector model's .cfg and .weights");
+  s.model->require_subcommand(1);
+  s.widen = s.model->add_subcommand(
+      "widen-classes",
+      "Grow a trained model's [yolo] heads to more classes (new classes start at zero weights and a low bias; the "
+      "model's drone boxes are unchanged), to fine-tune with distractor classes");
+  s.widen->add_option("--cfg", s.cfg, "The trained model's .cfg or builtin:wingman-small (default)");
+  s.widen->add_option("--weights", s.weights, "Its .weights or builtin:wingman-small (default)");
+  s.widen->add_option("--classes", s.classes,
+                      "Classes of the widened heads (default 4: drone, airplane, bird, "
+                      "helicopter)");
+  s.widen->add_option("--new-class-bias", s.bias, "Logit of the new classes' bias (default -4.595: probability 0.01)");
+  s.widen->add_option("--iou-loss", s.iou_loss,
+                      "Training box loss written into every [yolo] of the new .cfg: mse, giou, diou or ciou (default: "
+                      "the model's)");
+  s.widen->add_option("--iou-normalizer", s.iou_normalizer,
+                      "Weight of that box loss written into every [yolo] (default: the model's)");
+  s.widen->add_option("--out-cfg", s.out_cfg, "The widened .cfg to write")->required();
+  s.widen->add_option("--out-weights", s.out_weights, "The widened .weights to write")->required();
+}
+
+ModelVerbs::~ModelVerbs() = default;
+
+int ModelVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  State& s = *s_;
+  if (!*s.widen) return -1;
+  return run_verb("wingman model widen-classes", err, [&] {
+    const detector::DarknetModel model = detector::load_model(s.cfg, s.weights);
+    detector::DarknetModel wide = detector::widen_classes(model, s.classes, s.bias);
+    if (!s.iou_loss.empty() && s.iou_loss != "mse" && s.iou_loss != "giou" && s.iou_loss != "diou" &&
+        s.iou_loss != "ciou")
+      throw std::invalid_argument(fmt::format("--iou-loss '{}': expected mse, giou, diou or ciou", s.iou_loss));
+    if (s.iou_normalizer < 0.0f || !std::isfinite(s.iou_normalizer))
+      throw std::invalid_argument(fmt::format("--iou-normalizer {}: expected a number > 0", s.iou_normalizer));
+    for (const int h : wide.heads()) {
+      if (!s.iou_loss.empty()) wide.layers[static_cast<size_t>(h)].iou_loss = s.iou_loss;
+      if (s.iou_normalizer > 0.0f) wide.layers[static_cast<size_t>(h)].iou_normalizer = s.iou_normalizer;
+    }
+    for (const std::string& path : {s.out_cfg, s.out_weights})
+      if (const fs::path parent = fs::path(path).parent_path(); !parent.empty()) fs::create_directories(parent);
+    {
+      std::ofstream f(s.out_cfg);
+      f << "# " << s.cfg << " with its [yolo] heads widened to " << s.classes
+        << " classes by `wingman model widen-classes`\n"
+        << detector::write_darknet_cfg(wide);
+      if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write the .cfg", s.out_cfg));
+    }
+    detector::save_darknet_weights(wide, s.out_weights);
+    out << fmt::format("wrote {} and {}: {} heads at {} classes, {} weights\n", s.out_cfg, s.out_weights,
+                       wide.heads().size(), s.classes, wide.weight_count());
+    return 0;
+  });
+}
+
+}  // namespace wingman::tools
