@@ -570,10 +570,46 @@ TEST(Eval, LeaderCountsAsDetectedOnlyWithABoxOnItAndOtherBoxesAreFalse) {
   for (const char* field :
        {"\"frames_leader_visible\": 9, \"frames_leader_detected\": 4, \"false_boxes_leader_visible\": 7, "
         "\"frames_leader_visible_with_false_box\": 5,",
-        "\"detection_frames\": 10, \"false_boxes\": 9, \"frames_with_false_box\": 7}",
+        "\"detection_frames\": 10, \"false_boxes\": 9, \"frames_with_false_box\": 7, \"non_drone_boxes\": 0}",
         "{\"lo_m\": 15, \"hi_m\": 20, \"visible\": 4, \"detected\": 2, \"false_boxes\": 3, \"frames_with_false_box\": "
         "2}"})
     EXPECT_NE(j.str().find(field), std::string::npos) << field << " not in " << j.str();
+}
+
+TEST(Eval, BoxesOfOtherClassesAreNeitherDetectionsNorFalseBoxes) {
+  // Two frames with the leader visible at (200, 150): frame 0 has a bird box (class 2) centred on it and a drone box
+  // off it; frame 1 a helicopter box (class 3) on it. Only drone boxes count: nothing finds the leader.
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 2; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    ground_truth_t g = truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 8, 5)});
+    g.boxes = {truth_box(1, 200, 150, 40, true, 8)};
+    g.num_boxes = 1;
+    events.push_back(make_event("GROUND_TRUTH", g, u));
+    detections_t d{};
+    d.utime = u;
+    d.seq = k;
+    d.image_width = 640;
+    d.image_height = 480;
+    detection_t on = box(200, 150, 30, false);
+    on.class_id = static_cast<int16_t>(k == 0 ? 2 : 3);
+    d.detections = {on};
+    if (k == 0) d.detections.push_back(box(400, 300, 30, false));
+    d.num_detections = static_cast<int32_t>(d.detections.size());
+    events.push_back(make_event("DETECTIONS_CAM0", d, u));
+  }
+  EvalOptions o;
+  o.log = dir.file("classes.lcmlog");
+  testing::write_log(o.log, events);
+  const EvalResult r = evaluate_log(o);
+  EXPECT_EQ(r.frames_leader_visible, 2);
+  EXPECT_EQ(r.frames_leader_detected, 0);
+  EXPECT_EQ(r.detections_total, 1);
+  EXPECT_EQ(r.false_boxes, 1);
+  EXPECT_EQ(r.non_drone_boxes, 2);
+  EXPECT_NE(r.json().find("\"non_drone_boxes\": 2}"), std::string::npos) << r.json();
+  EXPECT_NE(r.report().find("; 2 box(es) of other classes (not drones: not counted)"), std::string::npos) << r.report();
 }
 
 /// An image_t of a 64 x 48 grey frame in `format`.

@@ -267,7 +267,15 @@ EvalResult evaluate_log(const EvalOptions& o) {
       if (!decode(*ev, &d)) continue;
       sources.insert(d.source);
       inference_ms.push_back(d.inference_latency_us * 1e-3);
-      detections.push_back({d.utime, d.camera_id, d.image_width, d.detections});
+      // Drone boxes only, as the localizer tracks them; the other classes are counted apart.
+      std::vector<wingman::detection_t> drones;
+      for (const auto& b : d.detections) {
+        if (b.class_id == 0)
+          drones.push_back(b);
+        else
+          ++r.non_drone_boxes;
+      }
+      detections.push_back({d.utime, d.camera_id, d.image_width, std::move(drones)});
     } else if (ev->channel == o.image_channel &&
                lcm_fingerprint(ev->data, ev->datalen) == static_cast<uint64_t>(wingman::image_t::getHash()) &&
                ev->datalen >= 16) {
@@ -528,8 +536,9 @@ std::string EvalResult::report() const {
       false_boxes_leader_visible, frames_leader_visible_with_false_box);
   s += fmt::format(
       "detected boxes: {} in {} frames with a detections_t; {} not on the leader (false boxes) in {} frames, "
-      "{} of them centred in no visible truth box\n",
-      detections_total, detection_frames, false_boxes, frames_with_false_box, detections_outside_truth);
+      "{} of them centred in no visible truth box; {} box(es) of other classes (not drones: not counted)\n",
+      detections_total, detection_frames, false_boxes, frames_with_false_box, detections_outside_truth,
+      non_drone_boxes);
   for (const auto& b : detection_by_range) {
     if (b.visible == 0) continue;
     s += fmt::format("  leader detected at range {:<12} {:6.1f} % of {} frames ({}), {} false box(es) in {} frames\n",
@@ -584,7 +593,7 @@ std::string EvalResult::json() const {
       "\"box_width_single\": {}, \"box_width_zoom\": {}, \"box_width_single_by_range\": {}, "
       "\"box_width_zoom_by_range\": {}, \"detection_by_range\": {}, \"detections_total\": {}, "
       "\"detections_outside_truth\": {}, \"detection_frames\": {}, \"false_boxes\": {}, \"frames_with_false_box\": "
-      "{}}}",
+      "{}, \"non_drone_boxes\": {}}}",
       detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected,
       false_boxes_leader_visible, frames_leader_visible_with_false_box, target_estimates, false_targets,
       false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches, stats_json(localization),
@@ -594,7 +603,7 @@ std::string EvalResult::json() const {
       percentiles_json(inference_latency_ms), fraction_json(box_width_single), fraction_json(box_width_zoom),
       bins_json(box_width_single_by_range, true), bins_json(box_width_zoom_by_range, true),
       detection_bins_json(detection_by_range), detections_total, detections_outside_truth, detection_frames,
-      false_boxes, frames_with_false_box);
+      false_boxes, frames_with_false_box, non_drone_boxes);
 }
 
 std::string EvalResult::csv() const {

@@ -126,8 +126,11 @@ struct EvalResult {
   /// detected add up to frames_leader_visible and frames_leader_detected.
   std::vector<DetectionBin> detection_by_range;
   int64_t detections_outside_truth = 0;  ///< detected boxes whose centre lies in no visible truth box
-  int64_t detections_total = 0;          ///< detected boxes in all detections_t
-  int64_t detection_frames = 0;          ///< distinct utimes with a detections_t
+  /// boxes of a class other than drone (class_id != 0: a multi-class model's airplane, bird, helicopter), which the
+  /// localizer does not track: left out of every other count here (none of them is a detection or a false box)
+  int64_t non_drone_boxes = 0;
+  int64_t detections_total = 0;  ///< detected boxes in all detections_t
+  int64_t detection_frames = 0;  ///< distinct utimes with a detections_t
   /// Boxes in all detections_t not on the leader (box_on_leader(); a box at a utime without ground truth is not on
   /// it), whether or not the leader is visible; includes detections_outside_truth.
   int64_t false_boxes = 0;
