@@ -59,6 +59,21 @@ TEST(Val, SavedPredictionsGiveTheHandComputedMetrics) {
   EXPECT_TRUE(m.centre.unmatched.empty());
 }
 
+TEST(Val, PredictionsOfOtherClassesAreReadAndSkipped) {
+  // A multi-class model's distractor line (class 3, a helicopter) in a dataset that names fewer classes: skipped, the
+  // metrics are those of the hand case.
+  testing::TempDir dir;
+  write_hand_case(dir);
+  std::ofstream(dir.file("pred/a.txt"), std::ios::app) << "3 0.5 0.5 0.2 0.2 0.95\n";
+  ValOptions o;
+  o.data = dir.file("data.yaml");
+  o.predictions = dir.file("pred");
+  const DetectionMetrics m = run_val(o);
+  EXPECT_EQ(m.iou.all.true_positives, 2);
+  EXPECT_EQ(m.iou.all.false_positives, 3);
+  EXPECT_NEAR(m.iou.all.ap, 2.0 / 3.0, 1e-9);
+}
+
 TEST(Val, MissingPredictionFileIsNamed) {
   testing::TempDir dir;
   write_hand_case(dir);

@@ -105,7 +105,9 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
       if (!fs::is_regular_file(file))
         throw DatasetError(fmt::format("{}: no prediction file for {} (`wingman predict` writes one per image)", file,
                                        img.image_path));
-      const int classes = std::max(static_cast<int>(ds.class_names.size()), o.class_id + 1);
+      // Any class a model can write (detection_t.class_id is an int16): a multi-class model's distractor lines are
+      // read and skipped below, whatever classes the dataset names.
+      const int classes = std::max({static_cast<int>(ds.class_names.size()), o.class_id + 1, 32768});
       for (const PredictedBox& p : read_yolo_predictions(file, classes)) {
         if (p.box.cls != o.class_id) continue;
         detector::Box b;
