@@ -7,14 +7,20 @@
 # training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size).
 # wingman val runs the detector at its default input size (model.input_size auto: the cfg's 640 columns, the rows
 # fitted to each set's aspect, 640x512 for the Halmstad frames).
+# Then the track-level metrics (wingman val --sequences, docs/training.md): every frame of the Halmstad val clips
+# through the detector and wingman-localizer's tracker with the CNN flights' localizer config
+# (config/flights/cnn.localizer.yaml): false tracks per hour of distractor video, drone clips confirmed, time to confirm
+# (a few minutes: 4 s a clip on the 2-core VM with the OpenCL backend).
 # Writes OUT/*.json (wingman val --json, one pass per set, with every truth not found), OUT/summary.md (the metrics,
-# the negative clips' false positives, and the truths not found: missed or loose, at the frame's edge) and
-# OUT/bench.txt.
+# the negative clips' false positives, the truths not found: missed or loose, at the frame's edge, and the track-level
+# table), OUT/halmstad_sequences.{txt,json} and OUT/bench.txt.
 #
-# Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench] [--val-args ARGS]
+# Usage: tools/evaluate_model.sh [--data DIR] [--cfg CFG] [--weights W] [--out DIR] [--no-bench] [--no-sequences]
+#                                [--val-args ARGS]
 #   --data     the datasets of tools/train_model.sh (default build/training-data); the 1280x720 set is made there
 #   --cfg      default builtin:wingman-small; --weights default builtin:wingman-small (the shipped model)
 #   --out      default build/model-eval
+#   --no-sequences  leave out the track-level metrics
 #   --val-args more wingman val options for every set, one word each (e.g. "--zoom-in --flip-fusion --coarse-pass":
 #              the detector's zoom-in, mirrored second pass and half-size pass); default none (the detector's
 #              defaults: a single pass)
@@ -24,7 +30,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 data="$src/build/training-data" cfg=builtin:wingman-small weights=builtin:wingman-small out="$src/build/model-eval"
-bench=true val_args=()
+bench=true sequences=true val_args=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --data) data="$2"; shift 2 ;;
@@ -32,6 +38,7 @@ while [ $# -gt 0 ]; do
     --weights) weights="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --no-bench) bench=false; shift ;;
+    --no-sequences) sequences=false; shift ;;
     --val-args) read -r -a val_args <<<"$2"; shift 2 ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "evaluate_model: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -105,11 +112,19 @@ if [ -f "$data/flights/.complete" ]; then
   flights=true
   val flights_val "$data/flights/data.yaml"
 fi
+if $sequences; then
+  # Whole clips, as a flying system meets them (the val split's clips, read from splits.csv; the videos and labels
+  # from the shared dataset).
+  echo "evaluate_model: halmstad_sequences" >&2
+  "$bin/wingman" val --sequences --data "$data/halmstad" --halmstad-root "$src/../shared/datasets/halmstad" \
+    --cfg "$cfg" --weights "$weights" --backend opencl --localizer-config "$src/config/flights/cnn.localizer.yaml" \
+    "${val_args[@]}" --json "$out/halmstad_sequences.json" > "$out/halmstad_sequences.txt"
+fi
 if $bench; then
   POCL_AFFINITY=1 "$bin/wingman" bench detector --cfg "$cfg" --weights "$weights" --sizes cfg --threads 1,2 \
     --repetitions 15 > "$out/bench.txt" 2>&1
 fi
-PYENV_VERSION=system python3 - "$out" "$flights" <<'PY'
+PYENV_VERSION=system python3 - "$out" "$flights" "$sequences" <<'PY'
 import json, os, sys
 out = sys.argv[1]
 sets = [("halmstad_val", "Halmstad val clips (all)"), ("halmstad_val_DRONE", "Halmstad val, drone clips"),
@@ -145,6 +160,25 @@ for name, label in sets:
         edge = sum(1 for x in u if x["at_edge"])
         lines.append(f"| {label} | {'IoU >= 0.5' if crit == 'iou' else 'centre in box'} | {len(u)} of {r['truths']} | "
                      f"{missed} | {len(u) - missed} | {edge} of {r[crit]['edge_truths']} |")
+if sys.argv[3] == "true":
+    r = load("halmstad_sequences")
+    step = "every frame" if r["frame_step"] == 1 else f"every {r['frame_step']}th frame"
+    within = f"{r['confirm_within_s']:g} s"
+    lines += ["", f"Track-level (Halmstad val clips, {step}, detector + wingman-localizer tracker, pinhole HFOV "
+              f"{r['hfov_deg']:.0f} deg): targets <= 1 false track per hour of distractor video, >= 95 % of drone clips "
+              f"confirmed within {within}", "",
+              f"| clips | n | video h | false tracks | per hour (95 % upper) | drone confirmed | within {within} | "
+              "median time to confirm | drone track ids |", "|---|---|---|---|---|---|---|---|---|"]
+    for g in r["groups"]:
+        row = f"| {g['name']} | {g['clips']} | {g['hours']:.4f} | {g['false_tracks']} | " \
+              f"{g['false_tracks_per_hour']:.1f} ({g['false_tracks_per_hour_upper95']:.1f}) |"
+        if g["drone"]:
+            med = g["median_time_to_confirm_s"]
+            row += f" {g['confirmed']}/{g['clips']} | {g['confirmed_within']}/{g['clips']} | " \
+                   f"{'-' if med is None else f'{med:.2f} s'} | {g['drone_tracks']} |"
+        else:
+            row += " | | | |"
+        lines.append(row)
 open(os.path.join(out, "summary.md"), "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 PY

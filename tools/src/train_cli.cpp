@@ -6,6 +6,7 @@
 
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/training/halmstad_import.hpp>
+#include <wingman/training/sequence_eval.hpp>
 #include <wingman/training/train_options.hpp>
 #include <wingman/training/val.hpp>
 #ifdef WINGMAN_WITH_TRAINING
@@ -17,6 +18,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -87,8 +89,15 @@ struct TrainingVerbs::State {
   std::vector<std::pair<CLI::Option*, std::function<void(training::TrainOptions&)>>> overrides;
 
   training::ValOptions val_options;
-  bool val_json = false;
+  CLI::Option* val_json = nullptr;  // --json [FILE]
+  std::string val_json_path;
+  CLI::Option* val_p_thresh = nullptr;
+  CLI::Option* val_predictions = nullptr;
+  CLI::Option* val_class = nullptr;
   size_t val_list = 10;
+  // val --sequences: the track-level metrics (training/sequence_eval.hpp)
+  bool val_sequences = false;
+  training::SequenceEvalOptions sequences;
 
   training::HalmstadImportOptions import;
   bool no_tighten = false, no_negatives = false;
@@ -179,14 +188,17 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--input-size", vo.input_size,
                 "Network input: auto (default: the cfg's longer side, the other fitted to each image's aspect), cfg "
                 "or WxH");
-  v->add_option("--predictions", vo.predictions, "Instead of --weights: folder of `wingman predict` <stem>.txt files");
+  s.val_predictions = v->add_option("--predictions", vo.predictions,
+                                    "Instead of --weights: folder of `wingman predict` <stem>.txt files");
   v->add_option("--conf", vo.metrics.conf_thresh,
                 "Operating confidence for precision / recall / mean IoU (default 0.2)");
   v->add_option("--iou", vo.metrics.iou_thresh, "IoU match threshold (default 0.5)");
   v->add_option("--size-edges", vo.metrics.size_edges_px, "Size-bin edges, sqrt(w h) in pixels (default 16,32,64)")
       ->delimiter(',');
   v->add_option("--pr-points", vo.metrics.pr_points, "Points of the PR curve in the JSON (default 101)");
-  v->add_option("--p-thresh", vo.detection.p_thresh, "Detector's confidence floor (default 0.005, for the curve)");
+  s.val_p_thresh = v->add_option("--p-thresh", vo.detection.p_thresh,
+                                 "Detector's confidence floor (default 0.005, for the curve; --sequences: 0.2, the "
+                                 "detector's p_thresh)");
   v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold (default 0.2)");
   v->add_flag("--subsquare", vo.detection.subsquare, "Detect in the centred h x h square of a wide image");
   v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
@@ -203,13 +215,36 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--coarse-min-size", vo.detection.coarse_min_size,
                 "--coarse-pass: drop its boxes below this sqrt(w h), image pixels (default 48)");
   v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
-  v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
+  s.val_class = v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
   v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");
   v->add_option("--edge-margin", vo.metrics.edge_margin_px,
                 "A truth within this many pixels of the image's border touches the edge (default 1)");
   v->add_option("--list", s.val_list, "List this many of the largest truths not found, per criterion (default 10)");
-  v->add_flag("--json", s.val_json,
-              "Print one JSON object (with the PR curves and every truth not found) instead of the table");
+  s.val_json = v->add_option("--json", s.val_json_path,
+                             "Alone: print one JSON object (with the PR curves and every truth not found) instead of "
+                             "the table; --json FILE: print the table and write the JSON to FILE")
+                   ->expected(0, 1);
+  training::SequenceEvalOptions& so = s.sequences;
+  v->add_flag(
+      "--sequences", s.val_sequences,
+      "Track-level metrics: run every frame of the split's Halmstad clips (--data: the folder of `wingman "
+      "import-halmstad`, its splits.csv) through the detector and wingman-localizer's tracker; false tracks per "
+      "hour, drone clips confirmed and the time to confirm (--conf, --iou, --max-images, --size-edges, "
+      "--pr-points, --list do not apply)");
+  v->add_option("--halmstad-root", so.halmstad_root,
+                "--sequences: the Halmstad dataset (videos/, labels/) (default ../shared/datasets/halmstad)");
+  v->add_option("--localizer-config", so.localizer_config,
+                "--sequences: wingman-localizer's YAML (config/localizer.yaml keys; camera.* unused) (default: its "
+                "built-in defaults)");
+  v->add_option("--hfov-deg", so.hfov_deg,
+                "--sequences: horizontal field of view of the static camera's nominal pinhole, degrees (default 24)");
+  v->add_option("--frame-step", so.frame_step, "--sequences: track every n-th frame (default 1: every frame)");
+  v->add_option("--clips", so.clips, "--sequences: only these clips of the split (comma-separated)")->delimiter(',');
+  v->add_option("--confirm-within", so.scoring.confirm_within_s,
+                "--sequences: a drone confirmed this long after its first label counts as in time, s (default 1)");
+  v->add_option("--on-target-fraction", so.scoring.on_target_fraction,
+                "--sequences: a track is on the drone when more than this share of its confirmed hits is (default "
+                "0.5)");
 
   // ---- import-halmstad ----
   s.halmstad = app.add_subcommand(
@@ -238,6 +273,40 @@ TrainingVerbs::~TrainingVerbs() = default;
 
 int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   State& s = *s_;
+  if (*s.val && s.val_sequences) {
+    return run_verb("wingman val", err, [&] {
+      training::SequenceEvalOptions so = s.sequences;
+      const training::ValOptions& vo = s.val_options;
+      if (s.val_predictions->count() > 0)
+        throw std::invalid_argument("--predictions: --sequences runs the detector on every frame; give --weights");
+      if (s.val_class->count() > 0 && vo.class_id != 0)
+        throw std::invalid_argument(
+            fmt::format("--class {}: --sequences tracks class 0 (drone), as wingman-localizer", vo.class_id));
+      so.data = vo.data;
+      so.split = vo.split;
+      so.cfg = vo.cfg;
+      if (!vo.weights.empty()) so.weights = vo.weights;
+      so.backend = vo.backend;
+      so.input_size = vo.input_size;
+      so.detection = vo.detection;  // Algorithm 2's flags as given, and the detector's p_thresh unless given
+      if (s.val_p_thresh->count() == 0) so.detection.p_thresh = detector::DetectorPipelineOptions{}.p_thresh;
+      const auto t0 = std::chrono::steady_clock::now();
+      const training::SequenceEvalResult r = training::run_sequence_eval(so, {}, [&](const std::string& line) {
+        err << "wingman val: " << line << "\n" << std::flush;
+      });
+      err << fmt::format("wingman val: {} clips in {:.0f} s\n", r.clips.size(),
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      const bool json_stdout = s.val_json->count() > 0 && s.val_json_path.empty();
+      if (!json_stdout && !s.val_json_path.empty()) {
+        std::ofstream f(s.val_json_path);
+        f << r.json() << "\n";
+        f.close();
+        if (!f) throw std::runtime_error(s.val_json_path + ": cannot write the JSON");
+      }
+      out << (json_stdout ? r.json() + "\n" : r.report()) << std::flush;
+      return 0;
+    });
+  }
   if (*s.val) {
     return run_verb("wingman val", err, [&] {
       const training::DetectionMetrics m = training::run_val(
@@ -246,7 +315,14 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
             if (done % 100 == 0 || done == total) err << fmt::format("wingman val: {}/{} images\n", done, total);
           },
           [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
-      out << (s.val_json ? m.json() + "\n" : m.report(s.val_list)) << std::flush;
+      const bool json_stdout = s.val_json->count() > 0 && s.val_json_path.empty();
+      if (!json_stdout && !s.val_json_path.empty()) {
+        std::ofstream f(s.val_json_path);
+        f << m.json() << "\n";
+        f.close();
+        if (!f) throw std::runtime_error(s.val_json_path + ": cannot write the JSON");
+      }
+      out << (json_stdout ? m.json() + "\n" : m.report(s.val_list)) << std::flush;
       return 0;
     });
   }

@@ -1,0 +1,629 @@
+// SPDX-License-Identifier: MIT
+// Track-level metrics: clips -> detector -> wingman-localizer's Localizer -> confirmed tracks -> false tracks per hour,
+// drone clips confirmed and time to confirm.
+#include "wingman/training/sequence_eval.hpp"
+
+#include "wingman/training/yolo_dataset.hpp"
+
+#include <wingman/common/config.hpp>
+#include <wingman/common/detection_class.hpp>
+#include <wingman/common/json.hpp>
+#include <wingman/detector/detection_message.hpp>
+#include <wingman/detector/input_size.hpp>
+#include <wingman/detector/model_loader.hpp>
+#include <wingman/detector/sized_detector.hpp>
+#include <wingman/localizer/sphere_localizer.hpp>
+
+#include <fmt/format.h>
+#include <opencv2/videoio.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace wingman::training {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// The classes a Halmstad label may name; DRONE is the tracked one.
+const std::vector<std::string> kHalmstadClasses = {"DRONE", "AIRPLANE", "BIRD", "HELICOPTER"};
+/// Distance bins in the order the report lists them.
+const std::vector<std::string> kDistanceBins = {"CLOSE", "MEDIUM", "DISTANT"};
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string f;
+  std::stringstream ss(line);
+  while (std::getline(ss, f, ',')) {
+    if (!f.empty() && f.back() == '\r') f.pop_back();
+    out.push_back(f);
+  }
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+bool blank(const std::string& line) { return line.empty() || line == "\r"; }
+
+/// Centre in box, inclusive, as `wingman val`'s centre criterion (detection_metrics.cpp).
+bool centre_inside(double cx, double cy, const cv::Rect2d& t) {
+  return cx >= t.x && cx <= t.x + t.width && cy >= t.y && cy <= t.y + t.height;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return -1;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// P(X <= k) for X ~ Poisson(lambda).
+double poisson_cdf(int k, double lambda) {
+  if (lambda <= 0) return 1.0;
+  double sum = 0;
+  for (int i = 0; i <= k; ++i) sum += std::exp(-lambda + i * std::log(lambda) - std::lgamma(i + 1.0));
+  return std::min(1.0, sum);
+}
+
+/// The exact one-sided 95 % upper confidence bound of a Poisson mean after observing k events: the lambda with
+/// P(X <= k; lambda) = 0.05 (k = 0: -ln 0.05 = 3.00).
+double poisson_upper95(int k) {
+  double lo = 0, hi = 10.0 + 3.0 * k;
+  while (poisson_cdf(k, hi) > 0.05) hi *= 2;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (poisson_cdf(k, mid) > 0.05 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+struct SplitClip {
+  std::string name, cls, distance_bin;
+};
+
+/// The clips of `split` in `path` (splits.csv: clip,class,distance_bin,split,images), by name.
+std::vector<SplitClip> read_splits(const std::string& path, const std::string& split) {
+  if (!fs::is_regular_file(path))
+    throw DatasetError(
+        fmt::format("{}: no splits.csv: give the folder `wingman import-halmstad` wrote (or its "
+                    "data.yaml)",
+                    path));
+  std::ifstream in(path);
+  if (!in) throw DatasetError(fmt::format("{}: cannot read the split list", path));
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = split_csv(line);
+  if (header.size() < 4 || header[0] != "clip" || header[1] != "class" || header[2] != "distance_bin" ||
+      header[3] != "split")
+    throw DatasetError(
+        fmt::format("{}:1: expected the header 'clip,class,distance_bin,split,images', got '{}'", path, line));
+  std::vector<SplitClip> clips;
+  std::set<std::string> seen;
+  int line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (blank(line)) continue;
+    const std::vector<std::string> f = split_csv(line);
+    if (f.size() < 4)
+      throw DatasetError(fmt::format("{}:{}: expected at least 4 fields, got {}", path, line_no, f.size()));
+    if (f[0].empty()) throw DatasetError(fmt::format("{}:{}: empty clip name", path, line_no));
+    if (std::find(kHalmstadClasses.begin(), kHalmstadClasses.end(), f[1]) == kHalmstadClasses.end())
+      throw DatasetError(
+          fmt::format("{}:{}: field class = '{}': expected DRONE, AIRPLANE, BIRD or HELICOPTER", path, line_no, f[1]));
+    if (!seen.insert(f[0]).second)
+      throw DatasetError(fmt::format("{}:{}: clip '{}' listed twice", path, line_no, f[0]));
+    if (f[3] == split) clips.push_back({f[0], f[1], f[2]});
+  }
+  std::sort(clips.begin(), clips.end(), [](const SplitClip& a, const SplitClip& b) { return a.name < b.name; });
+  return clips;
+}
+
+std::string fixed_or_null(double v, int decimals) {
+  return v < 0 || !std::isfinite(v) ? "null" : fmt::format("{:.{}f}", v, decimals);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------------------
+// Options
+
+std::vector<std::string> TrackScoringOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(on_target_fraction >= 0.0 && on_target_fraction < 1.0))
+    p.push_back(fmt::format("scoring.on_target_fraction = {}: must be in [0, 1)", on_target_fraction));
+  if (!(confirm_within_s > 0.0) || !std::isfinite(confirm_within_s))
+    p.push_back(fmt::format("scoring.confirm_within_s = {}: must be > 0 (seconds)", confirm_within_s));
+  return p;
+}
+
+std::vector<std::string> SequenceEvalOptions::validate() const {
+  std::vector<std::string> p;
+  if (data.empty()) p.push_back("data is empty: the folder `wingman import-halmstad` wrote (splits.csv) is required");
+  if (halmstad_root.empty()) p.push_back("halmstad_root is empty: the Halmstad dataset folder is required");
+  if (split.empty()) p.push_back("split is empty");
+  if (weights.empty()) p.push_back("weights is empty: a .weights path or builtin:wingman-small");
+  if (backend != "auto" && backend != "opencl" && backend != "cpu")
+    p.push_back(fmt::format("backend = '{}': must be auto, opencl or cpu", backend));
+  if (std::string why; !detector::InputSize::parse(input_size, &why)) p.push_back("input_size = " + why);
+  if (!(hfov_deg > 0.0 && hfov_deg < 180.0)) p.push_back(fmt::format("hfov_deg = {}: must be in (0, 180)", hfov_deg));
+  if (frame_step < 1) p.push_back(fmt::format("frame_step = {}: must be >= 1", frame_step));
+  for (const auto& s : detection.validate()) p.push_back(s);
+  for (const auto& s : scoring.validate()) p.push_back(s);
+  return p;
+}
+
+localizer::CameraModel nominal_pinhole(int width, int height, double hfov_deg) {
+  if (width < 1 || height < 1)
+    throw std::invalid_argument(fmt::format("nominal_pinhole: image size {}x{}: must be positive", width, height));
+  if (!(hfov_deg > 0.0 && hfov_deg < 180.0))
+    throw std::invalid_argument(fmt::format("nominal_pinhole: hfov_deg = {}: must be in (0, 180)", hfov_deg));
+  const double f = 0.5 * width / std::tan(0.5 * hfov_deg * kPi / 180.0);
+  // Principal point at the image centre in the calibration convention (pixel centres at integers), as
+  // wingman-localizer's built-in pinhole.
+  return localizer::CameraModel::pinhole(width, height, f, f, 0.5 * width - 0.5, 0.5 * height - 0.5,
+                                         fmt::format("nominal pinhole {}x{}, HFOV {} deg", width, height, hfov_deg));
+}
+
+// ---------------------------------------------------------------------------------------------------------------------
+// ClipTracker
+
+ClipTracker::ClipTracker(const localizer::LocalizerOptions& options, localizer::CameraModel camera, double fps)
+    : options_(options), camera_(std::move(camera)), fps_(fps) {
+  if (!(fps > 0.0) || !std::isfinite(fps))
+    throw std::invalid_argument(fmt::format("ClipTracker: fps = {}: must be > 0", fps));
+  options_.camera.scale_to_image = false;  // the camera is the frames' own
+  localizer_ = std::make_unique<localizer::Localizer>(options_, camera_);
+}
+
+ClipTracker::~ClipTracker() = default;
+
+void ClipTracker::add_frame(int frame_index, const std::vector<detector::Box>& boxes,
+                            const std::vector<cv::Rect2d>& drone_truths) {
+  if (frame_index <= last_frame_)
+    throw std::invalid_argument(fmt::format(
+        "ClipTracker: frame {} after frame {}: frames must come in increasing order", frame_index, last_frame_));
+  last_frame_ = frame_index;
+  ++frames_;
+  const int64_t utime = kClipStartUtime + std::llround(static_cast<double>(frame_index) * 1e6 / fps_);
+
+  // The camera stands still: body at the world origin, unrotated, at this frame's time.
+  wingman::own_pose_t pose{};
+  pose.utime = utime;
+  pose.frame = wingman::own_pose_t::FRAME_ENU;
+  pose.q_body_to_world[0] = 1.0;
+  localizer_->on_own_pose(pose);
+
+  // Every box as wingman-detector publishes it (detector::to_detection: unclipped, every class); the Localizer tracks
+  // class 0 (drone) only and counts the others.
+  wingman::detections_t d{};
+  d.utime = utime;
+  d.seq = frame_index;
+  d.camera_id = options_.camera.camera_id;
+  d.image_width = camera_.width();
+  d.image_height = camera_.height();
+  d.source = wingman::detections_t::SOURCE_CNN;
+  std::vector<const detector::Box*> drone;
+  for (const detector::Box& b : boxes) {
+    d.detections.push_back(detector::to_detection(b));
+    if (b.class_id == common::kDroneClassId) drone.push_back(&b);
+  }
+  d.num_detections = static_cast<int32_t>(d.detections.size());
+  drone_boxes_ += static_cast<int64_t>(drone.size());
+
+  const localizer::LocalizerOutput out = localizer_->on_detections(d);
+  other_class_boxes_ += out.non_drone.total;
+  for (const std::string& why : out.rejections)
+    if (why.rfind("detections_t.detections[", 0) == 0) ++rejected_boxes_;
+  if (!out.targets) return;
+
+  // The same localization the Localizer made of each box (deterministic: the same numbers), to find which box a
+  // track took in this frame from the camera-frame position it reports.
+  std::vector<Eigen::Vector3d> p_in_cam(drone.size(),
+                                        Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  for (size_t i = 0; i < drone.size(); ++i) {
+    const localizer::PixelBox box{drone[i]->cx, drone[i]->cy, drone[i]->w, drone[i]->h};
+    const localizer::LocalizeResult r = localizer::localize_box(box, camera_, options_.sphere);
+    if (r.ok && r.measurement.range_valid) p_in_cam[i] = r.measurement.p_target_in_cam;
+  }
+  for (const wingman::target_t& t : out.targets->targets) {
+    if (t.track_id <= 0) continue;
+    auto [it, fresh] = tracks_.try_emplace(t.track_id);
+    TrackRecord& rec = it->second;
+    if (fresh) {
+      rec.track_id = t.track_id;
+      rec.confirmed_frame = frame_index;
+    }
+    rec.last_frame = frame_index;
+    if (t.source_utime != utime) continue;  // coasting: no detection this frame
+    const Eigen::Vector3d p(t.p_target_in_cam[0], t.p_target_in_cam[1], t.p_target_in_cam[2]);
+    size_t best = drone.size();
+    double best_d = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < drone.size(); ++i) {
+      const double dist = (p_in_cam[i] - p).norm();
+      if (dist < best_d) best_d = dist, best = i;
+    }
+    ++rec.hits;
+    if (best == drone.size() || !(best_d <= 1e-6 * std::max(1.0, p.norm()))) continue;  // not found: not on target
+    const detector::Box& b = *drone[best];
+    if (std::any_of(drone_truths.begin(), drone_truths.end(),
+                    [&](const cv::Rect2d& r) { return centre_inside(b.cx, b.cy, r); }))
+      ++rec.hits_on_target;
+  }
+}
+
+std::vector<TrackRecord> ClipTracker::tracks() const {
+  std::vector<TrackRecord> v;
+  for (const auto& [id, rec] : tracks_) v.push_back(rec);
+  return v;
+}
+
+void score_clip(ClipTrackResult& clip, const TrackScoringOptions& scoring) {
+  clip.false_tracks = 0;
+  clip.drone_tracks = 0;
+  clip.drone_confirmed = false;
+  clip.time_to_confirm_s = -1;
+  int first_on_target = std::numeric_limits<int>::max();
+  for (TrackRecord& t : clip.tracks) {
+    t.on_target = t.hits > 0 && t.hits_on_target > scoring.on_target_fraction * t.hits;
+    if (!t.on_target) {
+      ++clip.false_tracks;
+    } else {
+      ++clip.drone_tracks;
+      first_on_target = std::min(first_on_target, t.confirmed_frame);
+    }
+  }
+  if (first_on_target != std::numeric_limits<int>::max() && clip.fps > 0) {
+    clip.drone_confirmed = true;
+    const int from = std::max(0, clip.first_label_frame);
+    clip.time_to_confirm_s = std::max(0.0, (first_on_target - from) / clip.fps);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------------
+// Labels, summary
+
+std::map<int, std::vector<cv::Rect2d>> read_halmstad_drone_boxes(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw DatasetError(fmt::format("{}: cannot read the label file", path));
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind("frame,class,x,y,w,h", 0) != 0)
+    throw DatasetError(fmt::format("{}:1: expected the header 'frame,class,x,y,w,h', got '{}'", path, line));
+  std::map<int, std::vector<cv::Rect2d>> boxes;
+  int line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (blank(line)) continue;
+    const std::vector<std::string> f = split_csv(line);
+    if (f.size() != 6) throw DatasetError(fmt::format("{}:{}: expected 6 fields, got {}", path, line_no, f.size()));
+    char* end = nullptr;
+    const long frame = std::strtol(f[0].c_str(), &end, 10);
+    if (end == f[0].c_str() || *end != '\0' || frame < 0 || frame > std::numeric_limits<int>::max())
+      throw DatasetError(fmt::format("{}:{}: field frame = '{}': expected an integer >= 0", path, line_no, f[0]));
+    if (std::find(kHalmstadClasses.begin(), kHalmstadClasses.end(), f[1]) == kHalmstadClasses.end())
+      throw DatasetError(
+          fmt::format("{}:{}: field class = '{}': expected DRONE, AIRPLANE, BIRD or HELICOPTER", path, line_no, f[1]));
+    double v[4];
+    static const char* kNames[] = {"x", "y", "w", "h"};
+    for (int k = 0; k < 4; ++k) {
+      end = nullptr;
+      v[k] = std::strtod(f[2 + k].c_str(), &end);
+      if (end == f[2 + k].c_str() || *end != '\0' || !std::isfinite(v[k]) || (k >= 2 && v[k] <= 0))
+        throw DatasetError(fmt::format("{}:{}: field {} = '{}': expected a{} number", path, line_no, kNames[k],
+                                       f[2 + k], k >= 2 ? " positive" : ""));
+    }
+    if (f[1] != "DRONE") continue;
+    // MATLAB's spatial coordinates put pixel centres at integers: the 0-based left edge is x - 0.5.
+    boxes[static_cast<int>(frame)].emplace_back(v[0] - 0.5, v[1] - 0.5, v[2], v[3]);
+  }
+  return boxes;
+}
+
+int SequenceEvalResult::skipped() const {
+  return static_cast<int>(
+      std::count_if(clips.begin(), clips.end(), [](const ClipTrackResult& c) { return !c.skipped.empty(); }));
+}
+
+std::vector<TrackGroupSummary> SequenceEvalResult::groups() const {
+  std::vector<TrackGroupSummary> out;
+  auto make = [&](const std::string& name, bool drone, const std::function<bool(const ClipTrackResult&)>& member) {
+    TrackGroupSummary g;
+    g.name = name;
+    g.drone = drone;
+    double seconds = 0;
+    std::vector<double> times;
+    for (const ClipTrackResult& c : clips) {
+      if (!c.skipped.empty() || !member(c)) continue;
+      ++g.clips;
+      seconds += c.duration_s;
+      g.false_tracks += c.false_tracks;
+      g.drone_tracks += c.drone_tracks;
+      if (drone && c.drone_confirmed) {
+        ++g.confirmed;
+        times.push_back(c.time_to_confirm_s);
+        if (c.time_to_confirm_s <= scoring.confirm_within_s + 1e-9) ++g.confirmed_within;
+      }
+    }
+    if (g.clips == 0) return;
+    g.hours = seconds / 3600.0;
+    g.false_per_hour = g.hours > 0 ? g.false_tracks / g.hours : 0.0;
+    g.false_per_hour_upper95 = g.hours > 0 ? poisson_upper95(g.false_tracks) / g.hours : 0.0;
+    g.median_time_to_confirm_s = median(times);
+    out.push_back(g);
+  };
+  for (const std::string& bin : kDistanceBins)
+    make("DRONE " + bin, true, [&](const ClipTrackResult& c) { return c.cls == "DRONE" && c.distance_bin == bin; });
+  // Bins other than the three known ones, if a split lists any.
+  std::set<std::string> other_bins;
+  for (const ClipTrackResult& c : clips)
+    if (c.cls == "DRONE" &&
+        std::find(kDistanceBins.begin(), kDistanceBins.end(), c.distance_bin) == kDistanceBins.end())
+      other_bins.insert(c.distance_bin);
+  for (const std::string& bin : other_bins)
+    make("DRONE " + bin, true, [&](const ClipTrackResult& c) { return c.cls == "DRONE" && c.distance_bin == bin; });
+  make("DRONE", true, [](const ClipTrackResult& c) { return c.cls == "DRONE"; });
+  for (size_t k = 1; k < kHalmstadClasses.size(); ++k)
+    make(kHalmstadClasses[k], false, [&](const ClipTrackResult& c) { return c.cls == kHalmstadClasses[k]; });
+  make("distractors", false, [](const ClipTrackResult& c) { return c.cls != "DRONE"; });
+  return out;
+}
+
+std::string SequenceEvalResult::report() const {
+  const int n_skipped = skipped();
+  std::string s = fmt::format(
+      "track-level metrics: {} clips of split '{}' ({} skipped), {} through the detector and wingman-localizer's "
+      "tracker; static camera, pinhole HFOV {:.1f} deg (fx {:.1f} px); a track is on the drone when > {:.0f} % of its "
+      "confirmed hits have their box centre in a labelled drone box\n",
+      clips.size() - static_cast<size_t>(n_skipped), split, n_skipped,
+      frame_step == 1 ? std::string("every frame") : fmt::format("every {}th frame", frame_step), hfov_deg, focal_px,
+      100.0 * scoring.on_target_fraction);
+  s += fmt::format("  {:<14} {:>5} {:>8} {:>6} {:>8} {:>9} {:>15} {:>12} {:>10} {:>10}\n", "clips", "n", "video h",
+                   "false", "false/h", "(95% up)", "drone confirmed",
+                   fmt::format("within {:g} s", scoring.confirm_within_s), "median s", "drone ids");
+  const std::vector<TrackGroupSummary> gs = groups();
+  for (const TrackGroupSummary& g : gs) {
+    std::string confirmed = "", within = "", med = "", ids = "";
+    if (g.drone) {
+      ids = fmt::format("{}", g.drone_tracks);
+      confirmed = fmt::format("{}/{} {:.0f}%", g.confirmed, g.clips, 100.0 * g.confirmed / g.clips);
+      within = fmt::format("{}/{} {:.0f}%", g.confirmed_within, g.clips, 100.0 * g.confirmed_within / g.clips);
+      med = g.median_time_to_confirm_s < 0 ? "-" : fmt::format("{:.2f}", g.median_time_to_confirm_s);
+    }
+    std::string row =
+        fmt::format("  {:<14} {:>5} {:>8.4f} {:>6} {:>8.1f} {:>9.1f} {:>15} {:>12} {:>10} {:>10}", g.name, g.clips,
+                    g.hours, g.false_tracks, g.false_per_hour, g.false_per_hour_upper95, confirmed, within, med, ids);
+    row.erase(row.find_last_not_of(' ') + 1);  // distractor rows have no drone columns
+    s += row + "\n";
+  }
+  for (const TrackGroupSummary& g : gs) {
+    if (g.name == "distractors")
+      s += fmt::format("target <= 1 false track per hour of distractor video: {:.1f} per hour ({} in {:.3f} h): {}\n",
+                       g.false_per_hour, g.false_tracks, g.hours, g.false_per_hour <= 1.0 ? "met" : "not met");
+    if (g.name == "DRONE")
+      s += fmt::format("target >= 95 % of drone clips confirmed within {:g} s: {:.1f} % ({} of {}): {}\n",
+                       scoring.confirm_within_s, 100.0 * g.confirmed_within / g.clips, g.confirmed_within, g.clips,
+                       g.confirmed_within >= 0.95 * g.clips ? "met" : "not met");
+  }
+  std::string false_list, late_list, skip_list;
+  for (const ClipTrackResult& c : clips) {
+    if (!c.skipped.empty()) {
+      skip_list += fmt::format("    {}: {}\n", c.clip, c.skipped);
+      continue;
+    }
+    for (const TrackRecord& t : c.tracks)
+      if (!t.on_target)
+        false_list += fmt::format("    {} ({}{}): track {} confirmed at {:.2f} s (frame {}), {} hits, {} on a drone\n",
+                                  c.clip, c.cls, c.cls == "DRONE" ? " " + c.distance_bin : "", t.track_id,
+                                  t.confirmed_frame / c.fps, t.confirmed_frame, t.hits, t.hits_on_target);
+    if (c.cls == "DRONE" && !(c.drone_confirmed && c.time_to_confirm_s <= scoring.confirm_within_s + 1e-9))
+      late_list += fmt::format(
+          "    {} ({}): {}; {} drone boxes detected, {} rejected by the localizer\n", c.clip, c.distance_bin,
+          c.drone_confirmed ? fmt::format("confirmed after {:.2f} s", c.time_to_confirm_s) : "never confirmed",
+          c.drone_boxes, c.rejected_boxes);
+  }
+  if (!false_list.empty()) s += "false tracks:\n" + false_list;
+  if (!late_list.empty())
+    s += fmt::format("drone clips not confirmed within {:g} s:\n", scoring.confirm_within_s) + late_list;
+  if (!skip_list.empty()) s += "skipped clips:\n" + skip_list;
+  return s;
+}
+
+std::string SequenceEvalResult::json() const {
+  std::string groups_json;
+  for (const TrackGroupSummary& g : groups()) {
+    if (!groups_json.empty()) groups_json += ", ";
+    groups_json += fmt::format(
+        "{{\"name\": {}, \"drone\": {}, \"clips\": {}, \"hours\": {:.6f}, \"false_tracks\": {}, "
+        "\"false_tracks_per_hour\": {:.4f}, \"false_tracks_per_hour_upper95\": {:.4f}",
+        common::json_string(g.name), g.drone ? "true" : "false", g.clips, g.hours, g.false_tracks, g.false_per_hour,
+        g.false_per_hour_upper95);
+    if (g.drone)
+      groups_json += fmt::format(
+          ", \"drone_tracks\": {}, \"confirmed\": {}, \"confirmed_share\": {:.4f}, \"confirmed_within\": {}, "
+          "\"confirmed_within_share\": "
+          "{:.4f}, \"median_time_to_confirm_s\": {}",
+          g.drone_tracks, g.confirmed, static_cast<double>(g.confirmed) / g.clips, g.confirmed_within,
+          static_cast<double>(g.confirmed_within) / g.clips, fixed_or_null(g.median_time_to_confirm_s, 4));
+    groups_json += "}";
+  }
+  std::string clips_json;
+  for (const ClipTrackResult& c : clips) {
+    if (!clips_json.empty()) clips_json += ",\n  ";
+    std::string tracks_json;
+    for (const TrackRecord& t : c.tracks) {
+      if (!tracks_json.empty()) tracks_json += ", ";
+      tracks_json += fmt::format(
+          "{{\"id\": {}, \"confirmed_frame\": {}, \"confirmed_s\": {:.4f}, \"last_frame\": {}, \"hits\": {}, "
+          "\"hits_on_target\": {}, \"on_target\": {}}}",
+          t.track_id, t.confirmed_frame, c.fps > 0 ? t.confirmed_frame / c.fps : 0.0, t.last_frame, t.hits,
+          t.hits_on_target, t.on_target ? "true" : "false");
+    }
+    clips_json += fmt::format(
+        "{{\"clip\": {}, \"class\": {}, \"distance_bin\": {}, \"skipped\": {}, \"fps\": {:.4f}, \"frames\": {}, "
+        "\"frames_tracked\": {}, \"duration_s\": {:.4f}, \"first_label_frame\": {}, \"drone_boxes\": {}, "
+        "\"other_class_boxes\": {}, \"rejected_boxes\": {}, \"false_tracks\": {}, \"drone_tracks\": {}, "
+        "\"drone_confirmed\": {}, "
+        "\"time_to_confirm_s\": {}, \"tracks\": [{}]}}",
+        common::json_string(c.clip), common::json_string(c.cls), common::json_string(c.distance_bin),
+        c.skipped.empty() ? "null" : common::json_string(c.skipped), c.fps, c.frames, c.frames_tracked, c.duration_s,
+        c.first_label_frame, c.drone_boxes, c.other_class_boxes, c.rejected_boxes, c.false_tracks, c.drone_tracks,
+        c.drone_confirmed ? "true" : "false", fixed_or_null(c.time_to_confirm_s, 4), tracks_json);
+  }
+  return fmt::format(
+      "{{\"split\": {}, \"hfov_deg\": {:.4f}, \"focal_px\": {:.4f}, \"frame_step\": {}, \"on_target_fraction\": {}, "
+      "\"confirm_within_s\": {}, \"skipped\": {},\n \"groups\": [{}],\n \"clips\": [\n  {}]}}",
+      common::json_string(split), hfov_deg, focal_px, frame_step, scoring.on_target_fraction, scoring.confirm_within_s,
+      skipped(), groups_json, clips_json);
+}
+
+// ---------------------------------------------------------------------------------------------------------------------
+// The run
+
+SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDetector& detect_in,
+                                     const std::function<void(const std::string&)>& log) {
+  const std::vector<std::string> problems = o.validate();
+  if (!problems.empty()) {
+    std::string msg = "run_sequence_eval: invalid options:";
+    for (const auto& p : problems) msg += "\n  " + p;
+    throw std::invalid_argument(msg);
+  }
+  // splits.csv beside the data.yaml, or in the folder.
+  const fs::path data(o.data);
+  if (!fs::exists(data))
+    throw DatasetError(
+        fmt::format("{}: no such folder or file: give the folder `wingman import-halmstad` wrote "
+                    "(splits.csv) or its data.yaml",
+                    o.data));
+  const fs::path folder = fs::is_directory(data) ? data : data.parent_path();
+  const std::string splits_path = (folder / "splits.csv").string();
+  std::vector<SplitClip> clips = read_splits(splits_path, o.split);
+  if (clips.empty()) throw DatasetError(fmt::format("{}: no clip is in split '{}'", splits_path, o.split));
+  if (!o.clips.empty()) {
+    std::vector<SplitClip> chosen;
+    for (const std::string& name : o.clips) {
+      const auto it = std::find_if(clips.begin(), clips.end(), [&](const SplitClip& c) { return c.name == name; });
+      if (it == clips.end())
+        throw DatasetError(fmt::format("{}: clip '{}' is not in split '{}'", splits_path, name, o.split));
+      chosen.push_back(*it);
+    }
+    std::sort(chosen.begin(), chosen.end(), [](const SplitClip& a, const SplitClip& b) { return a.name < b.name; });
+    chosen.erase(std::unique(chosen.begin(), chosen.end(),
+                             [](const SplitClip& a, const SplitClip& b) { return a.name == b.name; }),
+                 chosen.end());
+    clips = chosen;
+  }
+  const fs::path root(o.halmstad_root);
+  if (!fs::is_directory(root / "videos") || !fs::is_directory(root / "labels"))
+    throw DatasetError(
+        fmt::format("{}: not the Halmstad dataset folder (no videos/ and labels/ in it)", o.halmstad_root));
+
+  localizer::LocalizerOptions loc_options;
+  if (!o.localizer_config.empty()) loc_options = common::load_options<localizer::LocalizerOptions>(o.localizer_config);
+
+  // The detector, as `wingman val` builds it, unless one is given.
+  FrameDetector detect = detect_in;
+  std::shared_ptr<detector::SizedDetector> pipeline;
+  if (!detect) {
+    auto make_backend = [&](const detector::DarknetModel& sized) {
+      std::string why;
+      auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why);
+      if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
+      return backend;
+    };
+    pipeline = std::make_shared<detector::SizedDetector>(o.detection, detector::load_model(o.cfg, o.weights),
+                                                         *detector::InputSize::parse(o.input_size), make_backend);
+    detect = [pipeline](const cv::Mat& bgr) { return pipeline->detect(bgr); };
+  }
+
+  SequenceEvalResult result;
+  result.split = o.split;
+  result.hfov_deg = o.hfov_deg;
+  result.frame_step = o.frame_step;
+  result.scoring = o.scoring;
+  for (const SplitClip& sc : clips) {
+    ClipTrackResult c;
+    c.clip = sc.name, c.cls = sc.cls, c.distance_bin = sc.distance_bin;
+    // Labels first: a bad label file is an error naming it, before any frame is spent.
+    const std::string label_path = (root / "labels" / (sc.name + ".csv")).string();
+    const std::map<int, std::vector<cv::Rect2d>> truths = read_halmstad_drone_boxes(label_path);
+    c.first_label_frame = truths.empty() ? -1 : truths.begin()->first;
+
+    const std::string video = (root / "videos" / (sc.name + ".mp4")).string();
+    cv::VideoCapture cap;
+    if (fs::is_regular_file(video)) cap.open(video);
+    if (!cap.isOpened()) {
+      c.skipped = fmt::format("{}: cannot open the video", video);
+    } else {
+      c.fps = cap.get(cv::CAP_PROP_FPS);
+      if (!(c.fps > 0.0) || !std::isfinite(c.fps) || c.fps > 1000.0)
+        c.skipped = fmt::format("{}: the video gives no usable frame rate ({})", video, c.fps);
+    }
+    if (c.skipped.empty()) {
+      std::unique_ptr<ClipTracker> tracker;
+      cv::Mat frame;
+      static const std::vector<cv::Rect2d> kNone;
+      for (int k = 0;; ++k) {
+        if (k % o.frame_step != 0) {
+          if (!cap.grab()) break;
+          ++c.frames;
+          continue;
+        }
+        if (!cap.read(frame) || frame.empty()) break;
+        ++c.frames;
+        if (!tracker) {
+          const localizer::CameraModel camera = nominal_pinhole(frame.cols, frame.rows, o.hfov_deg);
+          if (result.focal_px == 0) result.focal_px = camera.fx();
+          tracker = std::make_unique<ClipTracker>(loc_options, camera, c.fps);
+        } else if (frame.cols != tracker->camera().width() || frame.rows != tracker->camera().height()) {
+          c.skipped = fmt::format("{}: frame {} is {}x{}, the first {}x{}", video, k, frame.cols, frame.rows,
+                                  tracker->camera().width(), tracker->camera().height());
+          break;
+        }
+        const auto it = truths.find(k);
+        tracker->add_frame(k, detect(frame), it == truths.end() ? kNone : it->second);
+      }
+      if (c.skipped.empty() && c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
+      if (tracker) {
+        c.frames_tracked = tracker->frames();
+        c.tracks = tracker->tracks();
+        c.drone_boxes = tracker->drone_boxes();
+        c.other_class_boxes = tracker->other_class_boxes();
+        c.rejected_boxes = tracker->rejected_boxes();
+      }
+      c.duration_s = c.fps > 0 ? c.frames / c.fps : 0.0;
+    }
+    if (c.skipped.empty()) {
+      score_clip(c, o.scoring);
+    } else {
+      c.tracks.clear();
+    }
+    if (log) {
+      if (!c.skipped.empty()) {
+        log(fmt::format("{} ({} {}): skipped: {}", c.clip, c.cls, c.distance_bin, c.skipped));
+      } else {
+        std::string drone;
+        if (c.cls == "DRONE")
+          drone = c.drone_confirmed ? fmt::format(", drone confirmed after {:.2f} s", c.time_to_confirm_s)
+                                    : ", drone not confirmed";
+        log(
+            fmt::format("{} ({} {}): {} frames, {} drone boxes ({} rejected by the localizer), {} confirmed tracks, {} "
+                        "false{}",
+                        c.clip, c.cls, c.distance_bin, c.frames, c.drone_boxes, c.rejected_boxes, c.tracks.size(),
+                        c.false_tracks, drone));
+      }
+    }
+    result.clips.push_back(std::move(c));
+  }
+  return result;
+}
+
+}  // namespace wingman::training
