@@ -90,7 +90,9 @@ TEST(ClassWidening, KeepsEveryOldChannelAndStartsNewClassesAtTheirBias) {
       EXPECT_NEAR(boxes_a[i].cx, boxes_b[i].cx, 1e-3f);
       EXPECT_NEAR(boxes_a[i].w, boxes_b[i].w, 1e-3f);
       EXPECT_NEAR(boxes_a[i].drone_score, boxes_b[i].drone_score, 1e-5f);
-      if (boxes_b[i].class_id == 0) EXPECT_NEAR(boxes_a[i].confidence, boxes_b[i].confidence, 1e-5f);
+      if (boxes_b[i].class_id == 0) {
+        EXPECT_NEAR(boxes_a[i].confidence, boxes_b[i].confidence, 1e-5f);
+      }
       EXPECT_EQ(boxes_a[i].class_id, 0);
     }
     off_a += static_cast<size_t>(s.c) * plane;
