@@ -112,7 +112,8 @@ void DetectionPipeline::run_and_decode(int count) {
     candidates_[i].clear();
     const float* raw = output_.data() + i * per_image;
     for (const Layer& h : heads_) {
-      decode_head(raw, h.input, h, net_size_.width, net_size_.height, pass_floor_, candidates_[i]);
+      decode_head(raw, h.input, h, net_size_.width, net_size_.height, pass_floor_, candidates_[i],
+                  options_.drone_first);
       raw += h.input.size();
     }
   }

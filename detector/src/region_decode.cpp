@@ -59,7 +59,7 @@ void decode_region(const float* raw, const Shape& shape, const Layer& region, in
 }
 
 void decode_yolo(const float* raw, const Shape& shape, const Layer& yolo, int net_w, int net_h, float p_thresh,
-                 std::vector<Box>& boxes) {
+                 std::vector<Box>& boxes, bool drone_first) {
   const int per_anchor = 5 + yolo.classes;
   const int num = static_cast<int>(yolo.mask.size());
   if (!(shape == yolo.input) || num < 1 || shape.c != num * per_anchor)
@@ -87,11 +87,13 @@ void decode_yolo(const float* raw, const Shape& shape, const Layer& yolo, int ne
         for (int c = 1; c < yolo.classes; ++c)
           if (base[(5 + c) * plane + i] > max_t) max_t = base[(5 + c) * plane + i], best = c;
         const float objectness = sigmoid(base[4 * plane + i]);
-        const float confidence = objectness * sigmoid(max_t);
+        float confidence = objectness * sigmoid(max_t);
+        const float drone_score = best == 0 ? confidence : objectness * sigmoid(base[5 * plane + i]);
+        if (drone_first && drone_score >= p_thresh) best = 0, confidence = drone_score;
         if (confidence < p_thresh) continue;
         Box b;
         b.class_id = best;
-        b.drone_score = best == 0 ? confidence : objectness * sigmoid(base[5 * plane + i]);
+        b.drone_score = drone_score;
         b.cx = (s * sigmoid(base[i]) - shift + col) * to_px_x;
         b.cy = (s * sigmoid(base[plane + i]) - shift + row) * to_px_y;
         b.w = a_w * std::exp(base[2 * plane + i]);
@@ -104,11 +106,11 @@ void decode_yolo(const float* raw, const Shape& shape, const Layer& yolo, int ne
 }
 
 void decode_head(const float* raw, const Shape& shape, const Layer& head, int net_w, int net_h, float p_thresh,
-                 std::vector<Box>& boxes) {
+                 std::vector<Box>& boxes, bool drone_first) {
   if (head.type == LayerType::kRegion)
     decode_region(raw, shape, head, net_w, net_h, p_thresh, boxes);
   else if (head.type == LayerType::kYolo)
-    decode_yolo(raw, shape, head, net_w, net_h, p_thresh, boxes);
+    decode_yolo(raw, shape, head, net_w, net_h, p_thresh, boxes, drone_first);
   else
     throw std::invalid_argument("decode_head: the layer is neither [region] nor [yolo]");
 }

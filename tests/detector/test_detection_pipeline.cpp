@@ -181,6 +181,20 @@ TEST(YoloDecode, HandComputedCellWithScaleXY) {
   EXPECT_NEAR(boxes[0].confidence, 0.54826f, 1e-4);
   EXPECT_EQ(boxes[0].class_id, 1);                                          // the most probable class
   EXPECT_NEAR(boxes[0].drone_score, sigmoid(2.0f) * sigmoid(-1.0f), 1e-6);  // objectness x P(class 0)
+  // drone_first: the drone score 0.8808 x 0.2689 = 0.2369 reaches 0.2, so the box is a drone with that confidence;
+  // at 0.3 it does not, and the box stays class 1.
+  std::vector<Box> drone_first;
+  decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.2f, drone_first, true);
+  ASSERT_EQ(drone_first.size(), 1u);
+  EXPECT_EQ(drone_first[0].class_id, 0);
+  EXPECT_NEAR(drone_first[0].confidence, sigmoid(2.0f) * sigmoid(-1.0f), 1e-6);
+  EXPECT_NEAR(drone_first[0].drone_score, drone_first[0].confidence, 1e-7);
+  EXPECT_FLOAT_EQ(drone_first[0].cx, boxes[0].cx);
+  drone_first.clear();
+  decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.3f, drone_first, true);
+  ASSERT_EQ(drone_first.size(), 1u);
+  EXPECT_EQ(drone_first[0].class_id, 1);
+  EXPECT_NEAR(drone_first[0].confidence, 0.54826f, 1e-4);
   boxes.clear();
   decode_yolo(raw.data(), yolo.input, yolo, 416, 320, 0.55f, boxes);
   EXPECT_TRUE(boxes.empty());

@@ -112,6 +112,9 @@ int main(int argc, char** argv) {
   pr->add_option("--o-thresh", predict.detection.o_thresh, "Non-max suppression IoU threshold (default 0.2)");
   pr->add_flag("--subsquare", predict.detection.subsquare, "Detect in the centred h x h square of a wide image");
   pr->add_flag("--zoom-in", predict.detection.zoom_in, "Re-detect in full-resolution crops around detections");
+  pr->add_flag("--drone-first", predict.detection.drone_first,
+               "Multi-class models: a box whose drone score reaches the threshold is a drone even if another class "
+               "scores higher");
   pr->add_flag("--flip-fusion", predict.detection.flip_fusion,
                "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
   pr->add_option("--fusion-iou", predict.detection.fusion_iou,

@@ -202,6 +202,9 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold (default 0.2)");
   v->add_flag("--subsquare", vo.detection.subsquare, "Detect in the centred h x h square of a wide image");
   v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
+  v->add_flag("--drone-first", vo.detection.drone_first,
+              "Multi-class models: a box whose drone score reaches the threshold is a drone even if another class "
+              "scores higher");
   v->add_option("--zoom-max-fraction", vo.detection.zoom_max_fraction,
                 "Zoom in only on boxes at most this fraction of the crop's width and height (default 0.25)");
   v->add_flag("--flip-fusion", vo.detection.flip_fusion,

@@ -34,8 +34,11 @@ struct DetectorPipelineOptions {
   bool coarse_pass = false;
   double coarse_scale = 0.5;      ///< coarse_pass: network input sides times this (multiples of 32), (0, 1)
   double coarse_min_size = 48.0;  ///< coarse_pass: its boxes below this sqrt(w h), image pixels, are dropped, >= 0
-  std::string policy = "all";     ///< which detections to return: "all" or "most_confident"
-  int max_detections = 10;        ///< at most this many boxes per image (and zoom-in crops), >= 1
+  /// multi-class models ([yolo] heads): a box whose drone score (objectness x P(drone)) reaches p_thresh is a drone
+  /// box even when another class scores higher (decode_yolo); false: each box is its most probable class
+  bool drone_first = false;
+  std::string policy = "all";  ///< which detections to return: "all" or "most_confident"
+  int max_detections = 10;     ///< at most this many boxes per image (and zoom-in crops), >= 1
 
   template <class V>
   void visit(V& v) {
@@ -54,6 +57,8 @@ struct DetectorPipelineOptions {
     v("detection.coarse_scale", coarse_scale, "coarse_pass: network input sides times this, multiples of 32 (0..1)");
     v("detection.coarse_min_size", coarse_min_size,
       "coarse_pass: its boxes smaller than this sqrt(w h), image pixels, are dropped (>= 0)");
+    v("detection.drone_first", drone_first,
+      "multi-class models: a box whose drone score reaches p_thresh is a drone even if another class scores higher");
     v("detection.policy", policy, "all or most_confident");
     v("detection.max_detections", max_detections, "at most this many boxes per image (>= 1)");
   }

@@ -33,7 +33,9 @@ void decode_region(const float* raw, const Shape& shape, const Layer& region, in
 ///   confidence = sigma(t_o) * max_c sigma(t_class_c)   (independent logistic classes, no softmax)
 ///   class_id = argmax_c t_class_c (the first of equal maxima), drone_score = sigma(t_o) * sigma(t_class_0)
 /// Darknet thresholds the objectness and then each class product; here the product is thresholded, as in
-/// decode_region, so both heads mean the same by p_thresh.
+/// decode_region, so both heads mean the same by p_thresh. With `drone_first`, a cell whose drone score is
+/// >= p_thresh is a drone box (class_id 0, confidence = drone_score) even when another class scores higher: a
+/// multi-class model's drone that also looks like a bird is still reported as a drone.
 ///
 /// @param raw    one image's raw head input, C x H x W floats with C = mask.size() * (5 + classes); channel
 ///               k * (5 + classes) + j holds t_x, t_y, t_w, t_h, t_o, t_class... (j = 0..4+classes) of
@@ -43,10 +45,10 @@ void decode_region(const float* raw, const Shape& shape, const Layer& region, in
 /// @param yolo   the [yolo] layer (anchors, mask, classes, scale_x_y).
 /// Does not allocate if `boxes` has capacity for H * W * mask.size() more boxes.
 void decode_yolo(const float* raw, const Shape& shape, const Layer& yolo, int net_w, int net_h, float p_thresh,
-                 std::vector<Box>& boxes);
+                 std::vector<Box>& boxes, bool drone_first = false);
 
-/// decode_region or decode_yolo, after `head`'s type (std::invalid_argument for any other layer).
+/// decode_region or decode_yolo (with `drone_first`), after `head`'s type (std::invalid_argument for any other layer).
 void decode_head(const float* raw, const Shape& shape, const Layer& head, int net_w, int net_h, float p_thresh,
-                 std::vector<Box>& boxes);
+                 std::vector<Box>& boxes, bool drone_first = false);
 
 }  // namespace wingman::detector
