@@ -2,6 +2,8 @@
 // Halmstad dataset -> YOLO layout: frame sampling, box conversion and tightening, split by clip.
 #include "wingman/training/halmstad_import.hpp"
 
+#include "wingman/training/halmstad_labels.hpp"
+
 #include "wingman/training/seeded_random.hpp"
 #include "wingman/training/yolo_dataset.hpp"
 
@@ -70,24 +72,12 @@ struct Clip {
   int frames = 0;
 };
 
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string f;
-  std::stringstream ss(line);
-  while (std::getline(ss, f, ',')) {
-    if (!f.empty() && f.back() == '\r') f.pop_back();
-    out.push_back(f);
-  }
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
 std::vector<Clip> read_clips(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw DatasetError(fmt::format("{}: cannot read the clip list", path));
   std::string line;
   std::getline(in, line);
-  const std::vector<std::string> header = split_csv(line);
+  const std::vector<std::string> header = split_csv_line(line);
   if (header.size() < 5 || header[0] != "clip" || header[1] != "class" || header[3] != "distance_bin" ||
       header[4] != "frames")
     throw DatasetError(
@@ -97,7 +87,7 @@ std::vector<Clip> read_clips(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_no;
     if (line.empty() || line == "\r") continue;
-    const std::vector<std::string> f = split_csv(line);
+    const std::vector<std::string> f = split_csv_line(line);
     if (f.size() < 5)
       throw DatasetError(fmt::format("{}:{}: expected at least 5 fields, got {}", path, line_no, f.size()));
     Clip c{f[0], f[1], f[3], std::atoi(f[4].c_str())};
@@ -105,54 +95,6 @@ std::vector<Clip> read_clips(const std::string& path) {
     clips.push_back(c);
   }
   return clips;
-}
-
-/// The class names of the labels, in class-id order (0 = drone, then the distractors).
-const std::vector<std::string> kLabelClasses = {"DRONE", "AIRPLANE", "BIRD", "HELICOPTER"};
-
-/// One labelled box: x, y, w, h in 0-based continuous pixels, and its class id (index in kLabelClasses).
-struct LabelBox {
-  cv::Rect2d rect;
-  int cls = 0;
-};
-
-/// frame -> boxes of one label CSV.
-std::map<int, std::vector<LabelBox>> read_boxes(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw DatasetError(fmt::format("{}: cannot read the label file", path));
-  std::string line;
-  std::getline(in, line);
-  if (line.rfind("frame,class,x,y,w,h", 0) != 0)
-    throw DatasetError(fmt::format("{}:1: expected the header 'frame,class,x,y,w,h', got '{}'", path, line));
-  std::map<int, std::vector<LabelBox>> boxes;
-  int line_no = 1;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line == "\r") continue;
-    const std::vector<std::string> f = split_csv(line);
-    if (f.size() != 6) throw DatasetError(fmt::format("{}:{}: expected 6 fields, got {}", path, line_no, f.size()));
-    char* end = nullptr;
-    const long frame = std::strtol(f[0].c_str(), &end, 10);
-    if (end == f[0].c_str() || *end != '\0' || frame < 0)
-      throw DatasetError(fmt::format("{}:{}: field frame = '{}': expected an integer >= 0", path, line_no, f[0]));
-    const auto cls = std::find(kLabelClasses.begin(), kLabelClasses.end(), f[1]);
-    if (cls == kLabelClasses.end())
-      throw DatasetError(
-          fmt::format("{}:{}: field class = '{}': expected DRONE, AIRPLANE, BIRD or HELICOPTER", path, line_no, f[1]));
-    double v[4];
-    static const char* kNames[] = {"x", "y", "w", "h"};
-    for (int k = 0; k < 4; ++k) {
-      end = nullptr;
-      v[k] = std::strtod(f[2 + k].c_str(), &end);
-      if (end == f[2 + k].c_str() || *end != '\0' || !std::isfinite(v[k]) || (k >= 2 && v[k] <= 0))
-        throw DatasetError(fmt::format("{}:{}: field {} = '{}': expected a{} number", path, line_no, kNames[k],
-                                       f[2 + k], k >= 2 ? " positive" : ""));
-    }
-    // MATLAB's spatial coordinates put pixel centres at integers: the 0-based left edge is x - 0.5.
-    boxes[static_cast<int>(frame)].push_back(
-        {cv::Rect2d(v[0] - 0.5, v[1] - 0.5, v[2], v[3]), static_cast<int>(cls - kLabelClasses.begin())});
-  }
-  return boxes;
 }
 
 }  // namespace
@@ -208,8 +150,8 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
     const bool drone = clip.cls == "DRONE";
     const std::string split = is_val[ci] ? "val" : "train";
     (is_val[ci] ? summary.val_clips : summary.train_clips).push_back(clip.name);
-    std::map<int, std::vector<LabelBox>> boxes;
-    if (drone || o.distractor_classes) boxes = read_boxes((root / "labels" / (clip.name + ".csv")).string());
+    std::map<int, std::vector<HalmstadLabelBox>> boxes;
+    if (drone || o.distractor_classes) boxes = read_halmstad_labels((root / "labels" / (clip.name + ".csv")).string());
     const std::string video = (root / "videos" / (clip.name + ".mp4")).string();
     cv::VideoCapture cap(video);
     if (!cap.isOpened()) throw DatasetError(fmt::format("{}: cannot open the video", video));
@@ -227,7 +169,7 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
       {
         const auto it = boxes.find(k);
         if (it != boxes.end())
-          for (const LabelBox& label : it->second) {
+          for (const HalmstadLabelBox& label : it->second) {
             const cv::Rect2d& loose = label.rect;
             cv::Rect2d b = loose;
             if (o.tighten) {

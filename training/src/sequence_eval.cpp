@@ -3,6 +3,8 @@
 // drone clips confirmed and time to confirm.
 #include "wingman/training/sequence_eval.hpp"
 
+#include "wingman/training/halmstad_labels.hpp"
+
 #include "wingman/training/yolo_dataset.hpp"
 
 #include <wingman/common/config.hpp>
@@ -36,21 +38,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 /// The classes a Halmstad label may name; DRONE is the tracked one.
-const std::vector<std::string> kHalmstadClasses = {"DRONE", "AIRPLANE", "BIRD", "HELICOPTER"};
+const std::vector<std::string>& kHalmstadClasses = halmstad_label_classes();
 /// Distance bins in the order the report lists them.
 const std::vector<std::string> kDistanceBins = {"CLOSE", "MEDIUM", "DISTANT"};
-
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string f;
-  std::stringstream ss(line);
-  while (std::getline(ss, f, ',')) {
-    if (!f.empty() && f.back() == '\r') f.pop_back();
-    out.push_back(f);
-  }
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
 
 bool blank(const std::string& line) { return line.empty() || line == "\r"; }
 
@@ -101,7 +91,7 @@ std::vector<SplitClip> read_splits(const std::string& path, const std::string& s
   if (!in) throw DatasetError(fmt::format("{}: cannot read the split list", path));
   std::string line;
   std::getline(in, line);
-  const std::vector<std::string> header = split_csv(line);
+  const std::vector<std::string> header = split_csv_line(line);
   if (header.size() < 4 || header[0] != "clip" || header[1] != "class" || header[2] != "distance_bin" ||
       header[3] != "split")
     throw DatasetError(
@@ -112,7 +102,7 @@ std::vector<SplitClip> read_splits(const std::string& path, const std::string& s
   while (std::getline(in, line)) {
     ++line_no;
     if (blank(line)) continue;
-    const std::vector<std::string> f = split_csv(line);
+    const std::vector<std::string> f = split_csv_line(line);
     if (f.size() < 4)
       throw DatasetError(fmt::format("{}:{}: expected at least 4 fields, got {}", path, line_no, f.size()));
     if (f[0].empty()) throw DatasetError(fmt::format("{}:{}: empty clip name", path, line_no));
@@ -292,39 +282,10 @@ void score_clip(ClipTrackResult& clip, const TrackScoringOptions& scoring) {
 // Labels, summary
 
 std::map<int, std::vector<cv::Rect2d>> read_halmstad_drone_boxes(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw DatasetError(fmt::format("{}: cannot read the label file", path));
-  std::string line;
-  std::getline(in, line);
-  if (line.rfind("frame,class,x,y,w,h", 0) != 0)
-    throw DatasetError(fmt::format("{}:1: expected the header 'frame,class,x,y,w,h', got '{}'", path, line));
   std::map<int, std::vector<cv::Rect2d>> boxes;
-  int line_no = 1;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (blank(line)) continue;
-    const std::vector<std::string> f = split_csv(line);
-    if (f.size() != 6) throw DatasetError(fmt::format("{}:{}: expected 6 fields, got {}", path, line_no, f.size()));
-    char* end = nullptr;
-    const long frame = std::strtol(f[0].c_str(), &end, 10);
-    if (end == f[0].c_str() || *end != '\0' || frame < 0 || frame > std::numeric_limits<int>::max())
-      throw DatasetError(fmt::format("{}:{}: field frame = '{}': expected an integer >= 0", path, line_no, f[0]));
-    if (std::find(kHalmstadClasses.begin(), kHalmstadClasses.end(), f[1]) == kHalmstadClasses.end())
-      throw DatasetError(
-          fmt::format("{}:{}: field class = '{}': expected DRONE, AIRPLANE, BIRD or HELICOPTER", path, line_no, f[1]));
-    double v[4];
-    static const char* kNames[] = {"x", "y", "w", "h"};
-    for (int k = 0; k < 4; ++k) {
-      end = nullptr;
-      v[k] = std::strtod(f[2 + k].c_str(), &end);
-      if (end == f[2 + k].c_str() || *end != '\0' || !std::isfinite(v[k]) || (k >= 2 && v[k] <= 0))
-        throw DatasetError(fmt::format("{}:{}: field {} = '{}': expected a{} number", path, line_no, kNames[k],
-                                       f[2 + k], k >= 2 ? " positive" : ""));
-    }
-    if (f[1] != "DRONE") continue;
-    // MATLAB's spatial coordinates put pixel centres at integers: the 0-based left edge is x - 0.5.
-    boxes[static_cast<int>(frame)].emplace_back(v[0] - 0.5, v[1] - 0.5, v[2], v[3]);
-  }
+  for (const auto& [frame, labels] : read_halmstad_labels(path))
+    for (const HalmstadLabelBox& label : labels)
+      if (label.cls == 0) boxes[frame].push_back(label.rect);
   return boxes;
 }
 
