@@ -74,6 +74,36 @@ TEST(WingmanVal, BadOptionsAndFilesAreNamed) {
   EXPECT_NE(bad.err.find("labels/val/b.txt:1: field h = 7"), std::string::npos) << bad.err;
 }
 
+TEST(WingmanModel, WidenClassesWritesAFourClassModelOfTheShippedOne) {
+  testing::TempDir dir;
+  const auto r = wingman({"model", "widen-classes", "--iou-loss", "ciou", "--iou-normalizer", "3", "--out-cfg",
+                          dir.file("wide/wide.cfg"), "--out-weights", dir.file("wide/wide.weights")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 heads at 4 classes"), std::string::npos) << r.out;
+  detector::DarknetModel wide = detector::parse_darknet_cfg(dir.file("wide/wide.cfg"));
+  detector::load_darknet_weights(wide, dir.file("wide/wide.weights"));  // the right length for the cfg
+  for (const int h : wide.heads()) {
+    EXPECT_EQ(wide.layers[static_cast<size_t>(h)].classes, 4);
+    EXPECT_EQ(wide.layers[static_cast<size_t>(h)].iou_loss, "ciou");
+    EXPECT_FLOAT_EQ(wide.layers[static_cast<size_t>(h)].iou_normalizer, 3.0f);
+    EXPECT_EQ(wide.layers[static_cast<size_t>(h - 1)].filters, 27);
+  }
+  // Bad input: one line naming what is wrong, exit 2 for a bad option, 1 for an unreadable file.
+  const auto bad_loss = wingman({"model", "widen-classes", "--iou-loss", "l1", "--out-cfg", dir.file("a.cfg"),
+                                 "--out-weights", dir.file("a.weights")});
+  EXPECT_EQ(bad_loss.exit_code, 2);
+  EXPECT_NE(bad_loss.err.find("wingman model widen-classes: error: --iou-loss 'l1'"), std::string::npos)
+      << bad_loss.err;
+  const auto missing = wingman({"model", "widen-classes", "--weights", dir.file("absent.weights"), "--out-cfg",
+                                dir.file("b.cfg"), "--out-weights", dir.file("b.weights")});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.err.find("absent.weights"), std::string::npos) << missing.err;
+  const auto fewer = wingman({"model", "widen-classes", "--classes", "0", "--out-cfg", dir.file("c.cfg"),
+                              "--out-weights", dir.file("c.weights")});
+  EXPECT_EQ(fewer.exit_code, 2);
+  EXPECT_NE(fewer.err.find("classes = 0"), std::string::npos) << fewer.err;
+}
+
 TEST(WingmanImportHalmstad, MissingDatasetIsNamed) {
   testing::TempDir dir;
   const auto r = wingman({"import-halmstad", dir.path(), dir.file("out")});

@@ -65,7 +65,8 @@ int ModelVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
         s.iou_loss != "ciou")
       throw std::invalid_argument(fmt::format("--iou-loss '{}': expected mse, giou, diou or ciou", s.iou_loss));
     if (s.iou_normalizer < 0.0f || !std::isfinite(s.iou_normalizer))
-      throw std::invalid_argument(fmt::format("--iou-normalizer {}: expected a number > 0", s.iou_normalizer));
+      throw std::invalid_argument(
+          fmt::format("--iou-normalizer {}: expected a number > 0 (or 0: the model's)", s.iou_normalizer));
     for (const int h : wide.heads()) {
       if (!s.iou_loss.empty()) wide.layers[static_cast<size_t>(h)].iou_loss = s.iou_loss;
       if (s.iou_normalizer > 0.0f) wide.layers[static_cast<size_t>(h)].iou_normalizer = s.iou_normalizer;
