@@ -153,7 +153,7 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
     std::map<int, std::vector<HalmstadLabelBox>> boxes;
     if (drone || o.distractor_classes) boxes = read_halmstad_labels((root / "labels" / (clip.name + ".csv")).string());
     const std::string video = (root / "videos" / (clip.name + ".mp4")).string();
-    cv::VideoCapture cap(video);
+    cv::VideoCapture cap(video, cv::CAP_FFMPEG);  // MP4 clips: FFmpeg, no fallback to other backends
     if (!cap.isOpened()) throw DatasetError(fmt::format("{}: cannot open the video", video));
     const int step = drone ? o.frame_step : o.negative_frame_step;
     int written = 0, clip_boxes = 0, clip_distractors = 0, clip_tight = 0;

@@ -520,7 +520,9 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
 
     const std::string video = (root / "videos" / (sc.name + ".mp4")).string();
     cv::VideoCapture cap;
-    if (fs::is_regular_file(video)) cap.open(video);
+    // FFmpeg only: the Halmstad clips are MP4 files it reads; OpenCV's fallback to GStreamer on an unreadable file
+    // adds nothing here (and leaks in GStreamer's device probing, libusb).
+    if (fs::is_regular_file(video)) cap.open(video, cv::CAP_FFMPEG);
     if (!cap.isOpened()) {
       c.skipped = fmt::format("{}: cannot open the video", video);
     } else {
