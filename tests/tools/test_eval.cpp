@@ -367,6 +367,18 @@ detection_t box(float cx, float cy, float w, bool zoom) {
   return d;
 }
 
+/// A detections_t of CAM0 at `u` with `boxes`, for a width x height image.
+detections_t detections_msg(int64_t u, int seq, std::vector<detection_t> boxes, int width = 640, int height = 480) {
+  detections_t d{};
+  d.utime = u;
+  d.seq = seq;
+  d.image_width = width;
+  d.image_height = height;
+  d.detections = std::move(boxes);
+  d.num_detections = static_cast<int32_t>(d.detections.size());
+  return d;
+}
+
 /// Leader truth box centred at (100, 100), 20 x 20 px, range 8 m (frames 0, 1) and 25 m (frames 2, 3), 640 px wide
 /// images. Detections (w in px): frame 0: single 26 (error 6) and one far outside the box; frame 1: single 18 at
 /// cx 105 (2), zoom 21 (1); frame 2: zoom 19.5 (0.5) and a single centred outside the box; frame 3: singles 30 at
@@ -390,14 +402,8 @@ std::string write_box_widths(const testing::TempDir& dir) {
     b.range = k < 2 ? 8 : 25;
     g.boxes = {b};
     g.num_boxes = 1;
-    detections_t d{};
-    d.utime = u;
-    d.seq = k;
-    d.image_width = 640;
-    d.image_height = 480;
-    d.detections = dets[static_cast<size_t>(k)];
-    d.num_detections = static_cast<int32_t>(d.detections.size());
-    events.push_back(make_event("DETECTIONS_CAM0", d, u));  // before its ground truth: order must not matter
+    events.push_back(make_event("DETECTIONS_CAM0", detections_msg(u, k, dets[static_cast<size_t>(k)]),
+                                u));  // before its ground truth: order must not matter
     events.push_back(make_event("GROUND_TRUTH", g, u));
   }
   const std::string path = dir.file("widths.lcmlog");
@@ -500,20 +506,10 @@ std::string write_false_boxes(const testing::TempDir& dir) {
     g.num_boxes = 2;
     events.push_back(make_event("GROUND_TRUTH", g, u));
     if (k == 7) continue;
-    detections_t d{};
-    d.utime = u;
-    d.seq = k;
-    d.image_width = 640;
-    d.image_height = 480;
-    d.detections = dets[static_cast<size_t>(k)];
-    d.num_detections = static_cast<int32_t>(d.detections.size());
-    events.push_back(make_event("DETECTIONS_CAM0", d, u));
-    if (k == 4) {
-      d.utime = u + 50000;
-      d.detections = {box(on, 150, 12, false)};
-      d.num_detections = 1;
-      events.push_back(make_event("DETECTIONS_CAM0", d, d.utime));
-    }
+    events.push_back(make_event("DETECTIONS_CAM0", detections_msg(u, k, dets[static_cast<size_t>(k)]), u));
+    if (k == 4)
+      events.push_back(
+          make_event("DETECTIONS_CAM0", detections_msg(u + 50000, k, {box(on, 150, 12, false)}), u + 50000));
   }
   const std::string path = dir.file("false_boxes.lcmlog");
   testing::write_log(path, events);
@@ -587,17 +583,11 @@ TEST(Eval, BoxesOfOtherClassesAreNeitherDetectionsNorFalseBoxes) {
     g.boxes = {truth_box(1, 200, 150, 40, true, 8)};
     g.num_boxes = 1;
     events.push_back(make_event("GROUND_TRUTH", g, u));
-    detections_t d{};
-    d.utime = u;
-    d.seq = k;
-    d.image_width = 640;
-    d.image_height = 480;
     detection_t on = box(200, 150, 30, false);
     on.class_id = static_cast<int16_t>(k == 0 ? 2 : 3);
-    d.detections = {on};
-    if (k == 0) d.detections.push_back(box(400, 300, 30, false));
-    d.num_detections = static_cast<int32_t>(d.detections.size());
-    events.push_back(make_event("DETECTIONS_CAM0", d, u));
+    std::vector<detection_t> boxes = {on};
+    if (k == 0) boxes.push_back(box(400, 300, 30, false));
+    events.push_back(make_event("DETECTIONS_CAM0", detections_msg(u, k, boxes), u));
   }
   EvalOptions o;
   o.log = dir.file("classes.lcmlog");
@@ -657,14 +647,8 @@ TEST(Report, DrawsFramesOfEveryPixelFormatAndEveryChart) {
     g.boxes = {b};
     g.num_boxes = 1;
     events.push_back(make_event("GROUND_TRUTH", g, u));
-    detections_t d{};
-    d.utime = u;
-    d.seq = k;
-    d.image_width = 64;
-    d.image_height = 48;
-    d.detections = {box(32, 24, 11, k % 2 == 1)};
-    d.num_detections = 1;
-    events.push_back(make_event("DETECTIONS_CAM0", d, u + 1000));
+    events.push_back(
+        make_event("DETECTIONS_CAM0", detections_msg(u, k, {box(32, 24, 11, k % 2 == 1)}, 64, 48), u + 1000));
     events.push_back(make_event("TARGETS", targets_msg(u, {world_target(7, 0.2 * k + 0.1, 10, 5, u)}), u + 2000));
   }
   const std::string log = dir.file("images.lcmlog");
