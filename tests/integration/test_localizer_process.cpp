@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // wingman-localizer as a process, file to file: a scripted flight gives tracked world positions;
 // bad and out-of-order inputs are dropped and counted; without own poses it publishes camera-frame targets.
+#include "sphere_scene.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -25,51 +26,15 @@ using wingman::testing::run;
 using wingman::testing::TempDir;
 
 constexpr int64_t kT0 = 1700000000000000;
-constexpr double kF = 640, kCx = 640, kCy = 360, kRadius = 0.348;  // built-in pinhole, default radius
+// The process's built-in pinhole looking east (default extrinsics, identity body pose), the default radius.
+const wingman::localizer::testing::SphereScene kScene{};
+using wingman::localizer::testing::detections;
+using wingman::localizer::testing::own_pose;
 
 /// Target truth: 10 m east, 1 m north, 0.5 m up of the observer, flying north at 1 m/s.
 Eigen::Vector3d target_in_world(int64_t utime) {
   const double t = (utime - kT0) * 1e-6;
   return {10.0, 1.0 + 1.0 * t, 0.5};
-}
-
-/// The exact box of a sphere seen by the built-in pinhole camera, which looks east (the default
-/// extrinsics with an identity body pose): camera x = -north, y = -up, z = east.
-wingman::detection_t sphere_box(const Eigen::Vector3d& p_world) {
-  const double X = -p_world.y(), Y = -p_world.z(), Z = p_world.x();
-  auto edges = [](double a, double z) {  // tangent lines from the origin to a circle (a, z) of radius r
-    const double centre = std::atan2(a, z), half = std::asin(kRadius / std::hypot(a, z));
-    return std::make_pair(std::tan(centre - half), std::tan(centre + half));
-  };
-  const auto [xl, xr] = edges(X, Z);
-  const auto [yt, yb] = edges(Y, Z);
-  wingman::detection_t d{};
-  d.cx = static_cast<float>(kCx + kF * 0.5 * (xl + xr));
-  d.cy = static_cast<float>(kCy + kF * 0.5 * (yt + yb));
-  d.w = static_cast<float>(kF * (xr - xl));
-  d.h = static_cast<float>(kF * (yb - yt));
-  d.confidence = 0.9f;
-  return d;
-}
-
-wingman::detections_t detections(int64_t utime, int64_t seq, std::vector<wingman::detection_t> boxes, int camera = 0) {
-  wingman::detections_t m{};
-  m.utime = utime;
-  m.seq = seq;
-  m.camera_id = camera;
-  m.image_width = 1280;
-  m.image_height = 720;
-  m.detections = std::move(boxes);
-  m.num_detections = static_cast<int32_t>(m.detections.size());
-  return m;
-}
-
-wingman::own_pose_t own_pose(int64_t utime) {
-  wingman::own_pose_t p{};
-  p.utime = utime;
-  p.frame = wingman::own_pose_t::FRAME_ENU;
-  p.q_body_to_world[0] = 1.0;
-  return p;
 }
 
 struct LocalizerRun {
@@ -111,8 +76,8 @@ std::vector<LogEvent> scripted_flight() {
     events.push_back(make_event("OWN_POSE", own_pose(kT0 + t), t));
     if (t % 33333 < 10000 && t >= 20000) {
       const int64_t exposure = kT0 + t - 15000;  // the detector reports 15 ms after exposure
-      events.push_back(
-          make_event("DETECTIONS_CAM0", detections(exposure, seq++, {sphere_box(target_in_world(exposure))}), t));
+      events.push_back(make_event("DETECTIONS_CAM0",
+                                  detections(exposure, seq++, {kScene.sphere_box(target_in_world(exposure))}), t));
     }
   }
   return events;
@@ -138,10 +103,10 @@ TEST(LocalizerProcess, ScriptedFlightGivesOneConfirmedTrackAtTheTruePositionPred
   EXPECT_EQ(r.last_status.drops_total, 0) << r.last_status.last_error;
 }
 
-TEST(LocalizerProcess, OneTargetsMessagePerDetectionsEmptyUntilConfirmedWithTheSourceFlagCopied) {
-  TempDir dir;
+/// scripted_flight() with every detections_t passed through `edit`; `count` (may be null) gets how many there are.
+template <class Edit>
+std::vector<LogEvent> scripted_flight_with(Edit edit, int* count) {
   std::vector<LogEvent> events;
-  int n_detections = 0;
   for (const LogEvent& e : scripted_flight()) {
     if (e.channel != "DETECTIONS_CAM0") {
       events.push_back(e);
@@ -149,10 +114,18 @@ TEST(LocalizerProcess, OneTargetsMessagePerDetectionsEmptyUntilConfirmedWithTheS
     }
     wingman::detections_t d;
     d.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
-    d.source = wingman::detections_t::SOURCE_GROUND_TRUTH;
+    edit(d);
     events.push_back(make_event("DETECTIONS_CAM0", d, e.timestamp));
-    ++n_detections;
+    if (count != nullptr) ++*count;
   }
+  return events;
+}
+
+TEST(LocalizerProcess, OneTargetsMessagePerDetectionsEmptyUntilConfirmedWithTheSourceFlagCopied) {
+  TempDir dir;
+  int n_detections = 0;
+  const std::vector<LogEvent> events = scripted_flight_with(
+      [](wingman::detections_t& d) { d.source = wingman::detections_t::SOURCE_GROUND_TRUTH; }, &n_detections);
   const LocalizerRun r = run_localizer(dir, events);
   ASSERT_EQ(static_cast<int>(r.targets.size()), n_detections) << r.err;
   // tracker.birth_hits = 3: the first two images give empty targets_t, the third a confirmed track.
@@ -170,9 +143,9 @@ TEST(LocalizerProcess, BadBoxesAndMessagesAreDroppedAndCountedNeverFatal) {
   TempDir dir;
   std::vector<LogEvent> events = scripted_flight();
   const int64_t t = kT0 + 500000;
-  auto nan_box = sphere_box(target_in_world(t));
+  auto nan_box = kScene.sphere_box(target_in_world(t));
   nan_box.cx = std::numeric_limits<float>::quiet_NaN();
-  auto outside = sphere_box(target_in_world(t));
+  auto outside = kScene.sphere_box(target_in_world(t));
   outside.cx = 5000;
   events.push_back(
       make_event("DETECTIONS_CAM0", detections(kT0 + 1994000, 900, {nan_box}), 2100000));  // invalid message
@@ -188,26 +161,19 @@ TEST(LocalizerProcess, BadBoxesAndMessagesAreDroppedAndCountedNeverFatal) {
 
 TEST(LocalizerProcess, BirdsAreNotTrackedButCountedInTheStatusAndABadDroneScoreIsDropped) {
   TempDir dir;
-  std::vector<LogEvent> events;
+  // A multi-class model's bird (class 2) beside the drone in every image, more confident than the drone.
+  wingman::detection_t bird = kScene.sphere_box(Eigen::Vector3d(8.0, -2.0, 1.0));
+  bird.class_id = 2;
+  bird.confidence = 0.95f;
+  bird.drone_score = 0.02f;
   int n_detections = 0;
-  for (const LogEvent& e : scripted_flight()) {
-    if (e.channel != "DETECTIONS_CAM0") {
-      events.push_back(e);
-      continue;
-    }
-    // A multi-class model's bird (class 2) beside the drone in every image, more confident than the drone.
-    wingman::detections_t d;
-    d.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
-    wingman::detection_t bird = sphere_box(Eigen::Vector3d(8.0, -2.0, 1.0));
-    bird.class_id = 2;
-    bird.confidence = 0.95f;
-    bird.drone_score = 0.02f;
-    d.detections.push_back(bird);
-    d.num_detections = static_cast<int32_t>(d.detections.size());
-    events.push_back(make_event("DETECTIONS_CAM0", d, e.timestamp));
-    ++n_detections;
-  }
-  auto bad_score = sphere_box(target_in_world(kT0 + 1994000));
+  std::vector<LogEvent> events = scripted_flight_with(
+      [&bird](wingman::detections_t& d) {
+        d.detections.push_back(bird);
+        d.num_detections = static_cast<int32_t>(d.detections.size());
+      },
+      &n_detections);
+  auto bad_score = kScene.sphere_box(target_in_world(kT0 + 1994000));
   bad_score.drone_score = 1.5f;
   events.push_back(make_event("DETECTIONS_CAM0", detections(kT0 + 1994000, 900, {bad_score}), 2100000));
   const LocalizerRun r = run_localizer(dir, events, /*lockstep=*/true);
@@ -233,7 +199,7 @@ TEST(LocalizerProcess, WithoutOwnPosesItPublishesCameraFrameTargetsFlaggedAsSuch
   TempDir dir;
   std::vector<LogEvent> events;
   const Eigen::Vector3d p(10.0, 1.0, 0.5);
-  events.push_back(make_event("DETECTIONS_CAM0", detections(kT0, 0, {sphere_box(p)}), 0));
+  events.push_back(make_event("DETECTIONS_CAM0", detections(kT0, 0, {kScene.sphere_box(p)}), 0));
   const LocalizerRun r = run_localizer(dir, events);
   ASSERT_EQ(r.targets.size(), 1u);
   ASSERT_EQ(r.targets[0].num_targets, 1);

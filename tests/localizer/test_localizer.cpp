@@ -3,6 +3,8 @@
 // classes are left out and counted per class, never rejected.
 #include "wingman/localizer/localizer.hpp"
 
+#include "sphere_scene.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -21,48 +23,12 @@ using wingman::localizer::LocalizerOutput;
 using wingman::localizer::NonDroneCounts;
 
 constexpr int64_t kT0 = 1700000000000000;
-constexpr double kF = 640, kCx = 639.5, kCy = 359.5, kRadius = 0.348;  // the built-in pinhole, the default radius
+// A pinhole with its principal point at the image centre, looking east; the default radius.
+const wingman::localizer::testing::SphereScene kScene{640, 639.5, 359.5, 0.348};
+using wingman::localizer::testing::detections;
+using wingman::localizer::testing::own_pose;
 
-CameraModel camera() { return CameraModel::pinhole(1280, 720, kF, kF, kCx, kCy); }
-
-/// The exact box of the default-radius sphere at `p_world` (ENU) seen by the built-in camera with the default
-/// extrinsics and an identity body pose: the camera looks east (camera x = -north, y = -up, z = east).
-wingman::detection_t sphere_box(const Eigen::Vector3d& p_world, int16_t class_id = 0) {
-  const double X = -p_world.y(), Y = -p_world.z(), Z = p_world.x();
-  auto edges = [](double a, double z) {  // tangent lines from the origin to a circle (a, z) of radius kRadius
-    const double centre = std::atan2(a, z), half = std::asin(kRadius / std::hypot(a, z));
-    return std::make_pair(std::tan(centre - half), std::tan(centre + half));
-  };
-  const auto [xl, xr] = edges(X, Z);
-  const auto [yt, yb] = edges(Y, Z);
-  wingman::detection_t d{};
-  d.cx = static_cast<float>(kCx + kF * 0.5 * (xl + xr));
-  d.cy = static_cast<float>(kCy + kF * 0.5 * (yt + yb));
-  d.w = static_cast<float>(kF * (xr - xl));
-  d.h = static_cast<float>(kF * (yb - yt));
-  d.confidence = 0.9f;
-  d.class_id = class_id;
-  d.drone_score = class_id == 0 ? 0.9f : 0.05f;
-  return d;
-}
-
-wingman::detections_t detections(int64_t utime, std::vector<wingman::detection_t> boxes) {
-  wingman::detections_t m{};
-  m.utime = utime;
-  m.image_width = 1280;
-  m.image_height = 720;
-  m.detections = std::move(boxes);
-  m.num_detections = static_cast<int32_t>(m.detections.size());
-  return m;
-}
-
-wingman::own_pose_t own_pose(int64_t utime) {
-  wingman::own_pose_t p{};
-  p.utime = utime;
-  p.frame = wingman::own_pose_t::FRAME_ENU;
-  p.q_body_to_world[0] = 1.0;
-  return p;
-}
+CameraModel camera() { return CameraModel::pinhole(1280, 720, kScene.f, kScene.f, kScene.cx, kScene.cy); }
 
 constexpr int16_t kAirplane = 1, kBird = 2;
 
@@ -73,8 +39,9 @@ TEST(Localizer, BoxesOfOtherClassesAreNotTrackedAndAreCountedPerClassNotRejected
   for (int k = 0; k < 6; ++k) {
     const int64_t t = kT0 + 33333 * k;
     loc.on_own_pose(own_pose(t));
-    out = loc.on_detections(
-        detections(t, {sphere_box(p_bird, kBird), sphere_box(p_drone), sphere_box(p_airplane, kAirplane)}));
+    out = loc.on_detections(detections(
+        t, 0,
+        {kScene.sphere_box(p_bird, kBird), kScene.sphere_box(p_drone), kScene.sphere_box(p_airplane, kAirplane)}));
     EXPECT_TRUE(out.rejections.empty()) << out.rejections.front();
     EXPECT_EQ(out.non_drone.total, 2);
     EXPECT_EQ(out.non_drone.by_class, (std::map<int, int64_t>{{kAirplane, 1}, {kBird, 1}}));
@@ -94,14 +61,14 @@ TEST(Localizer, BoxesOfOtherClassesAreNotTrackedAndAreCountedPerClassNotRejected
 TEST(Localizer, OnlyNonDroneBoxesGiveNoTargetEvenInTheCameraFrame) {
   Localizer loc(LocalizerOptions{}, camera());
   // No own pose: camera-frame targets would be published for drones (publish_camera_frame_only), none for a bird.
-  const LocalizerOutput no_pose = loc.on_detections(detections(kT0, {sphere_box({10.0, 0.0, 0.0}, kBird)}));
+  const LocalizerOutput no_pose = loc.on_detections(detections(kT0, 0, {kScene.sphere_box({10.0, 0.0, 0.0}, kBird)}));
   ASSERT_TRUE(no_pose.targets.has_value());
   EXPECT_EQ(no_pose.targets->num_targets, 0);
   EXPECT_EQ(no_pose.non_drone.total, 1);
   for (int k = 1; k <= 6; ++k) {
     const int64_t t = kT0 + 33333 * k;
     loc.on_own_pose(own_pose(t));
-    const LocalizerOutput out = loc.on_detections(detections(t, {sphere_box({10.0, 0.0, 0.0}, kBird)}));
+    const LocalizerOutput out = loc.on_detections(detections(t, 0, {kScene.sphere_box({10.0, 0.0, 0.0}, kBird)}));
     EXPECT_TRUE(out.rejections.empty());
     ASSERT_TRUE(out.targets.has_value());  // output.publish_empty: one targets_t per detections_t
     EXPECT_EQ(out.targets->num_targets, 0) << "frame " << k;
@@ -112,14 +79,14 @@ TEST(Localizer, OnlyNonDroneBoxesGiveNoTargetEvenInTheCameraFrame) {
 TEST(Localizer, ANonDroneBoxIsCountedBeforeItsGeometryIsLookedAt) {
   Localizer loc(LocalizerOptions{}, camera());
   loc.on_own_pose(own_pose(kT0));
-  wingman::detection_t outside = sphere_box({10.0, 0.0, 0.0}, 7);  // a class the model card does not name
-  outside.cx = 5000.0f;                                            // outside the image: a drone here is rejected
-  const LocalizerOutput out = loc.on_detections(detections(kT0, {outside}));
+  wingman::detection_t outside = kScene.sphere_box({10.0, 0.0, 0.0}, 7);  // a class the model card does not name
+  outside.cx = 5000.0f;                                                   // outside the image: a drone here is rejected
+  const LocalizerOutput out = loc.on_detections(detections(kT0, 0, {outside}));
   EXPECT_TRUE(out.rejections.empty()) << out.rejections.front();
   EXPECT_EQ(loc.non_drone_boxes().summary(), "non-drone boxes not tracked: 1 (class 7 1)");
   // The same box as a drone is a rejection, not a count.
   outside.class_id = 0;
-  const LocalizerOutput drone = loc.on_detections(detections(kT0 + 33333, {outside}));
+  const LocalizerOutput drone = loc.on_detections(detections(kT0 + 33333, 0, {outside}));
   EXPECT_EQ(drone.rejections.size(), 1u);
   EXPECT_EQ(drone.non_drone.total, 0);
 }
