@@ -41,7 +41,22 @@ for p in "${packages[@]}"; do
   fi
 done
 
+# The MAVLink codec's cross-check (tests/mavlink): node and npm from Debian, unless another install provides them,
+# and the npm packages it checks against (node-mavlink, pinned by tests/mavlink/node/package-lock.json). Without them
+# ctest mavlink.NodeCrosscheck skips; a failing `npm ci` (no registry) is reported, not fatal.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  missing+=(nodejs npm)
+fi
+npm_project="$(cd "$(dirname "$0")/.." && pwd)/tests/mavlink/node"
+install_npm_packages() {
+  if [ -d "$npm_project/node_modules/node-mavlink" ] || ! command -v npm >/dev/null 2>&1; then return 0; fi
+  echo "install_deps: npm ci in $npm_project (node-mavlink, for the MAVLink codec's cross-check)" >&2
+  (cd "$npm_project" && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "install_deps: npm ci failed: ctest mavlink.NodeCrosscheck will skip" >&2
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
+  install_npm_packages
   exit 0
 fi
 
@@ -55,3 +70,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+install_npm_packages

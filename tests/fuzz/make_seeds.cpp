@@ -9,6 +9,8 @@
 #include <wingman/detector/darknet_weights.hpp>
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
+#include <wingman/mavlink/enums.hpp>
+#include <wingman/mavlink/frame.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/setpoint_t.hpp>
 #include <wingman/status_t.hpp>
@@ -207,6 +209,44 @@ Bytes jpeg_bomb() {
   return encode(m);
 }
 
+/// MAVLink frames as an autopilot sends them (wingman-mavlink's input), v2 and one v1.
+Bytes mavlink_frames() {
+  using namespace wingman::mavlink;
+  Bytes out;
+  auto add = [&](const std::vector<uint8_t>& f) { out.insert(out.end(), f.begin(), f.end()); };
+  Heartbeat hb;
+  hb.custom_mode = px4_custom_mode(6);
+  hb.type = 2;
+  hb.autopilot = 12;
+  hb.base_mode = 129;
+  add(encode(hb, Sender{1, 1, 0}));
+  AttitudeQuaternion att;
+  att.time_boot_ms = 1000;
+  att.q1 = 0.7071f;
+  att.q4 = 0.7071f;
+  add(encode(att, Sender{1, 1, 1}));
+  LocalPositionNed lp;
+  lp.time_boot_ms = 1000;
+  lp.x = 1.5f;
+  lp.z = -3.0f;
+  add(encode(lp, Sender{1, 1, 2}));
+  Odometry odo;
+  odo.time_usec = 1000000;
+  odo.pose_covariance[0] = 0.01f;
+  odo.frame_id = 1;
+  odo.child_frame_id = 12;
+  add(encode(odo, Sender{1, 1, 3}));
+  Timesync ts;
+  ts.tc1 = 5000000000;
+  ts.ts1 = 1700000000000000000;
+  add(encode(ts, Sender{1, 1, 4}));
+  CommandAck ack;
+  ack.command = 511;
+  add(encode(ack, Sender{1, 1, 5}));
+  add(encode(hb, Sender{1, 1, 6}, Version::kV1));
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -271,5 +311,15 @@ int main(int argc, char** argv) {
             record(0, text("0 0.5 0.5 0.25 0.25\n"))}));
   save(yolo, "data_yaml_train",
        cat({record(2, text("train: [images/train]\nnames: {0: drone}\n")), record(0, text("0 0.4 0.6 0.2 0.3\n"))}));
+
+  const fs::path mav = root / "mavlink_parser";
+  const Bytes frames = mavlink_frames();
+  save(mav, "autopilot_stream", record(0, frames));
+  save(mav, "datagrams",
+       cat({record(0, Bytes(frames.begin(), frames.begin() + 40)), record(3, {}),
+            record(1, Bytes(frames.begin() + 21, frames.end())), record(3, {})}));
+  Bytes damaged = frames;
+  damaged[15] ^= 0x10;
+  save(mav, "bad_crc_then_frames", record(0, damaged));
   return 0;
 }
