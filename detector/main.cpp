@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
@@ -149,10 +150,12 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     const int64_t rejected = rt.status().input_drops(o.input_channel) - drops_accounted - (handler_threw ? 1 : 0);
     handler_threw = false;
     const int64_t missing = std::max<int64_t>(0, gaps.observe(img.seq) - rejected);
-    for (int64_t i = 0; i < missing; ++i) {
-      rt.status().item_dropped(o.input_channel, fmt::format("channel {}: {} frame(s) missing before seq {} (lost "
-                                                            "upstream: at the camera or on the bus)",
-                                                            o.input_channel, missing, img.seq));
+    // One step whatever the gap (a hostile seq jump of 2^62 once hung this loop, issue 33).
+    if (missing > 0) {
+      rt.status().items_dropped(o.input_channel, missing,
+                                fmt::format("channel {}: {} frame(s) missing before seq {} (lost "
+                                            "upstream: at the camera or on the bus)",
+                                            o.input_channel, missing, img.seq));
     }
   };
   auto accounted = [&] { drops_accounted = rt.status().input_drops(o.input_channel); };
@@ -230,7 +233,8 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     for (const Done& d : taken.results) {
       if (!d.error.empty()) {
         rt.status().item_dropped(o.input_channel, std::string("channel ") + o.input_channel + ": " + d.error);
-        ++drops_accounted;  // this drop is not a message the runtime rejected: keep it out of the next gap
+        // This drop is not a message the runtime rejected: keep it out of the next gap (the counts saturate).
+        if (drops_accounted < std::numeric_limits<int64_t>::max()) ++drops_accounted;
         continue;
       }
       publish_detections(d.meta, d.result.boxes, d.result.latency_us);

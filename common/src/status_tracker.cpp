@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace wingman::common {
 namespace {
@@ -13,6 +14,12 @@ namespace {
 // reference (std::pair, std::map::find) fails to link in unoptimised builds.
 constexpr int8_t kIn = wingman::channel_stats_t::DIRECTION_IN;
 constexpr int8_t kOut = wingman::channel_stats_t::DIRECTION_OUT;
+
+// a + b for b >= 0, saturated at INT64_MAX (drop counts from hostile sequence gaps can be that large).
+int64_t saturating_add(int64_t a, int64_t b) {
+  int64_t sum = 0;
+  return __builtin_add_overflow(a, b, &sum) ? std::numeric_limits<int64_t>::max() : sum;
+}
 }  // namespace
 
 StatusTracker::StatusTracker(std::string process, int32_t pid, size_t latency_window)
@@ -55,10 +62,11 @@ void StatusTracker::input_dropped(const std::string& ch, const std::string& reas
   last_error_ = reason;
 }
 
-void StatusTracker::item_dropped(const std::string& ch, const std::string& reason) {
+void StatusTracker::items_dropped(const std::string& ch, int64_t count, const std::string& reason) {
   Channel& c = channel(ch, kIn);
-  ++c.drops;
-  ++drops_total_;
+  const int64_t n = std::max<int64_t>(0, count);
+  c.drops = saturating_add(c.drops, n);
+  drops_total_ = saturating_add(drops_total_, n);
   last_error_ = reason;
 }
 

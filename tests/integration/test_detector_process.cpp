@@ -12,6 +12,7 @@
 #include <wingman/image_t.hpp>
 #include <wingman/status_t.hpp>
 
+#include <chrono>
 #include <fstream>
 #include <iostream>
 
@@ -143,6 +144,37 @@ TEST(DetectorProcess, MissingWeightsFileIsAOneLineErrorNamingIt) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("wingman-detector: error:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("/nonexistent/x.weights"), std::string::npos) << r.err;
+}
+
+// Issue 33, finding 1: a frame whose seq jumps 2^62 ahead used to make the detector loop once per "missing" frame
+// (it never ended and ignored SIGTERM). The gap is one count now: the run ends at once and reports it.
+TEST(DetectorProcess, ASequenceJumpOfTwoToTheSixtySecondIsCountedAtOnceNotLoopedOver) {
+  TempDir dir;
+  std::vector<LogEvent> events;
+  for (const int64_t seq : {int64_t{0}, int64_t{1} << 62}) {
+    wingman::image_t img{};
+    img.utime = 1700000000000000 + (seq == 0 ? 0 : 33333);
+    img.seq = seq;
+    img.width = 320;
+    img.height = 240;
+    img.stride = 3 * 320;
+    img.pixel_format = wingman::image_t::BGR8;
+    img.data.assign(static_cast<size_t>(img.stride) * 240, 40);
+    img.size = static_cast<int32_t>(img.data.size());
+    events.push_back(wingman::testing::make_event("IMAGE_CAM0", img, img.utime));
+  }
+  const std::string in = dir.file("seq_jump_in.lcmlog");
+  wingman::testing::write_log(in, events);
+  const auto t0 = std::chrono::steady_clock::now();
+  const DetectorRun r = run_detector(dir, in, write_random_weights(dir), "cpu", "jump");  // throws on a timeout
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "detector over a 2^62 seq jump: " << seconds << " s\n";
+  ASSERT_EQ(r.detections.size(), 2u);
+  EXPECT_EQ(r.detections[1].seq, int64_t{1} << 62);
+  EXPECT_EQ(r.status.drops_total, (int64_t{1} << 62) - 1) << r.status.last_error;
+  EXPECT_NE(r.status.last_error.find("4611686018427387903 frame(s) missing before seq 4611686018427387904"),
+            std::string::npos)
+      << r.status.last_error;
 }
 
 }  // namespace

@@ -44,7 +44,10 @@ class StatusTracker {
   void input_dropped(const std::string& channel, const std::string& reason);
   /// Part of a handled input could not be used (e.g. one box of a detections message); counts a drop
   /// on `channel` without counting another message. `reason` names the field.
-  void item_dropped(const std::string& channel, const std::string& reason);
+  void item_dropped(const std::string& channel, const std::string& reason) { items_dropped(channel, 1, reason); }
+  /// `count` (>= 0) such drops at once, in O(1) (e.g. frames missing from a sequence gap); the counters saturate
+  /// at INT64_MAX instead of overflowing.
+  void items_dropped(const std::string& channel, int64_t count, const std::string& reason);
   /// A message was published. `utime`: its utime field.
   void output(const std::string& channel, int64_t utime);
   /// The source lost `count` frames before they reached `channel` (e.g. a V4L2 sequence gap).
