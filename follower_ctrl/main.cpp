@@ -4,6 +4,8 @@
 
 #include <wingman/common/runtime.hpp>
 
+#include <spdlog/spdlog.h>
+
 namespace {
 
 using namespace wingman;
@@ -15,6 +17,7 @@ int run(common::Runtime& rt, const follower_ctrl::FollowerOptions& o) {
   // Publishes what an input gave, counts the parts it could not use, and reports the state.
   auto handle = [&](const std::string& channel, const follower_ctrl::FollowerOutput& out) {
     for (const auto& why : out.rejections) rt.status().item_dropped(channel, why);
+    for (const auto& note : out.notes) spdlog::warn("{}", note);  // a time resync
     if (out.setpoint) rt.publish(o.output_channel, *out.setpoint);
     rt.status().set_state(follower.status().flying ? status_t::STATE_OK : status_t::STATE_DEGRADED,
                           follower.status().detail);

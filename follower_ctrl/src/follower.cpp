@@ -22,7 +22,10 @@ const FollowerOptions& checked(const FollowerOptions& o) {
   return o;
 }
 
-double seconds(int64_t us) { return static_cast<double>(us) * 1e-6; }
+// now - stamp in seconds, for messages: exact enough and defined for hostile times (no int64_t overflow).
+double seconds_between(int64_t stamp, int64_t now) {
+  return static_cast<double>(static_cast<long double>(now) - static_cast<long double>(stamp)) * 1e-6;
+}
 
 const char* source_name(int8_t source) {
   return source == wingman::detections_t::SOURCE_GROUND_TRUTH ? "ground-truth boxes" : "CNN boxes";
@@ -38,15 +41,42 @@ Follower::Follower(const FollowerOptions& options)
     : options_(checked(options)),
       mode_(options.controller_mode()),
       timeout_us_(options.hold_timeout_us()),
+      max_ahead_us_(options.time.max_ahead_us()),
+      clock_(options.time),
+      own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)),
+      driving_input_(mode_ == ControllerMode::kFormation
+                         ? clock_.add_input("targets_t.utime", "targets_t", false)
+                         : clock_.add_input("detections_t.utime", "detections_t", false)),
       select_policy_(*parse_select_policy(options.formation.select)),
       formation_(options.formation, options.limits, options.camera_mount.rotation()),
       pid_1d_(options.pid_1d, options.limits, options.camera_mount.rotation()),
       localizer_timeout_us_(options.localizer_heartbeat_timeout_us()) {}
 
-void Follower::saw_message_time(int64_t utime) {
-  if (!newest_utime_ || utime > *newest_utime_) newest_utime_ = utime;
+void Follower::saw_message_time() {
   // A heartbeat that came before any message time is dated by the first one.
-  if (localizer_armed_ && !localizer_seen_utime_) localizer_seen_utime_ = *newest_utime_;
+  if (localizer_armed_ && !localizer_seen_utime_) localizer_seen_utime_ = clock_.now();
+}
+
+void Follower::admit(int input, int64_t utime, FollowerOutput& out) {
+  const common::TimeAdmission a = clock_.admit(input, utime);
+  if (!a.accepted()) throw std::invalid_argument(a.problem);
+  if (a.resynced()) {
+    forget_time_state();
+    out.notes.push_back(a.problem);
+  }
+}
+
+void Follower::forget_time_state() {
+  own_.reset();
+  first_pose_utime_.reset();
+  last_driving_utime_.reset();
+  followed_track_id_ = 0;
+  last_target_.reset();
+  last_box_utime_.reset();
+  formation_.reset();
+  pid_1d_.reset();
+  // The localizer's last sign of life is dated anew by the re-anchored clock (its state is kept).
+  if (localizer_seen_utime_) localizer_seen_utime_ = clock_.now();
 }
 
 void Follower::on_localizer_status(const wingman::status_t& status) {
@@ -54,7 +84,7 @@ void Follower::on_localizer_status(const wingman::status_t& status) {
   localizer_armed_ = true;
   localizer_state_ = status.state;
   localizer_detail_ = status.detail;
-  if (newest_utime_) localizer_seen_utime_ = *newest_utime_;
+  if (clock_.now()) localizer_seen_utime_ = clock_.now();
 }
 
 std::string Follower::localizer_problem(int64_t utime) const {
@@ -63,33 +93,32 @@ std::string Follower::localizer_problem(int64_t utime) const {
     return fmt::format("localizer '{}' reports {}{}", options_.localizer_instance,
                        localizer_state_ == wingman::status_t::STATE_STOPPING ? "STOPPING" : "ERROR",
                        localizer_detail_.empty() ? "" : " (" + localizer_detail_ + ")");
-  if (localizer_seen_utime_ && utime - *localizer_seen_utime_ > localizer_timeout_us_)
+  if (localizer_seen_utime_ && !common::is_fresh(utime, *localizer_seen_utime_, localizer_timeout_us_, max_ahead_us_))
     return fmt::format(
         "no heartbeat from localizer '{}' for {:.3f} s of message time "
         "(localizer.heartbeat_timeout_s = {})",
-        options_.localizer_instance, seconds(utime - *localizer_seen_utime_), options_.localizer_heartbeat_timeout_s);
+        options_.localizer_instance, seconds_between(*localizer_seen_utime_, utime),
+        options_.localizer_heartbeat_timeout_s);
   return "";
 }
 
 FollowerOutput Follower::on_own_pose(const wingman::own_pose_t& pose) {
-  if (own_ && pose.utime <= own_->utime)
-    throw std::invalid_argument(fmt::format("own_pose_t.utime = {}: not after the previous own pose ({}): {}",
-                                            pose.utime, own_->utime,
-                                            pose.utime == own_->utime ? "duplicate" : "out of order"));
+  FollowerOutput out;
+  admit(own_pose_input_, pose.utime, out);
   own_ = own_state_from_message(pose);
-  saw_message_time(pose.utime);
+  saw_message_time();
   if (!first_pose_utime_) {
     first_pose_utime_ = pose.utime;
     start_height_m_ = own_->p_body_in_world.z();
   }
-  FollowerOutput out;
   const int64_t since = last_driving_utime_.value_or(*first_pose_utime_);
-  if (pose.utime - since > timeout_us_) {
+  // A driving input dated after this pose by more than time.max_ahead_s is no sign of life either.
+  if (!common::is_fresh(pose.utime, since, timeout_us_, max_ahead_us_)) {
     const bool formation = mode_ == ControllerMode::kFormation;
     out.setpoint = hold(pose.utime, fmt::format("no {} on {} for {:.3f} s of own-pose time (hold.timeout_s = {})",
                                                 formation ? "targets_t" : "detections_t",
                                                 formation ? options_.targets_channel : options_.detections_channel,
-                                                seconds(pose.utime - since), options_.hold_timeout_s));
+                                                seconds_between(since, pose.utime), options_.hold_timeout_s));
   } else if (const std::string why = localizer_problem(pose.utime); !why.empty()) {
     out.setpoint = hold(pose.utime, why);
   }
@@ -106,9 +135,10 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
                       "or SOURCE_GROUND_TRUTH (1)",
                       i, msg.targets[i].detection_source));
   }
-  accept_driving_input("targets_t.utime", msg.utime);
-  saw_message_time(msg.utime);
   FollowerOutput out;
+  admit(driving_input_, msg.utime, out);
+  last_driving_utime_ = msg.utime;
+  saw_message_time();
   if (const std::string why = own_pose_problem(msg.utime); !why.empty()) {
     out.setpoint = hold(msg.utime, why);
     return out;
@@ -132,15 +162,15 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
     last_source_ = chosen->detection_source;
     target = chosen->predicted_to(msg.utime);
     detail = fmt::format("following track {} on {}", followed_track_id_, source_name(target.detection_source));
-  } else if (last_target_ && msg.utime - last_target_->source_utime <= timeout_us_) {
+  } else if (last_target_ && common::is_fresh(msg.utime, last_target_->source_utime, timeout_us_)) {
     target = last_target_->predicted_to(msg.utime);
     detail = fmt::format("coasting on track {}: no usable update, newest image {:.3f} s old", followed_track_id_,
-                         seconds(msg.utime - last_target_->source_utime));
+                         seconds_between(last_target_->source_utime, msg.utime));
   } else {
     const std::string why =
         last_target_
             ? fmt::format("target lost: track {} not seen for {:.3f} s (hold.timeout_s = {})", followed_track_id_,
-                          seconds(msg.utime - last_target_->source_utime), options_.hold_timeout_s)
+                          seconds_between(last_target_->source_utime, msg.utime), options_.hold_timeout_s)
             : std::string("no usable target yet (world-frame targets with an image within hold.timeout_s)");
     out.setpoint = hold(msg.utime, why);  // the lost track is remembered: a later hold still names it
     return out;
@@ -159,10 +189,11 @@ FollowerOutput Follower::on_detections(const wingman::detections_t& msg) {
   if (!known_source(msg.source))
     throw std::invalid_argument(
         fmt::format("detections_t.source = {}: must be SOURCE_CNN (0) or SOURCE_GROUND_TRUTH (1)", msg.source));
-  accept_driving_input("detections_t.utime", msg.utime);
-  saw_message_time(msg.utime);
-  last_source_ = msg.source;
   FollowerOutput out;
+  admit(driving_input_, msg.utime, out);
+  last_driving_utime_ = msg.utime;
+  saw_message_time();
+  last_source_ = msg.source;
   for (size_t i = 0; i < msg.detections.size(); ++i) {
     const float cx = msg.detections[i].cx;
     if (!(cx >= 0 && cx <= static_cast<float>(msg.image_width)))
@@ -176,11 +207,11 @@ FollowerOutput Follower::on_detections(const wingman::detections_t& msg) {
   const OwnState own = own_->predicted_to(msg.utime);
   const std::optional<wingman::detection_t> box = most_confident_box(msg);
   if (box) last_box_utime_ = msg.utime;
-  if (!last_box_utime_ || msg.utime - *last_box_utime_ > timeout_us_) {
-    out.setpoint =
-        hold(msg.utime, last_box_utime_ ? fmt::format("target lost: no box for {:.3f} s (hold.timeout_s = {})",
-                                                      seconds(msg.utime - *last_box_utime_), options_.hold_timeout_s)
-                                        : std::string("no box yet"));
+  if (!last_box_utime_ || !common::is_fresh(msg.utime, *last_box_utime_, timeout_us_)) {
+    out.setpoint = hold(
+        msg.utime, last_box_utime_ ? fmt::format("target lost: no box for {:.3f} s (hold.timeout_s = {})",
+                                                 seconds_between(*last_box_utime_, msg.utime), options_.hold_timeout_s)
+                                   : std::string("no box yet"));
     return out;
   }
   const std::optional<Eigen::Vector3d> axis = pid_1d_.axis_in_world(own);
@@ -194,23 +225,21 @@ FollowerOutput Follower::on_detections(const wingman::detections_t& msg) {
   const Pid1dCommand cmd = pid_1d_.update(error, *axis, own, msg.utime, start_height_m_);
   const std::string detail =
       error ? fmt::format("following the most confident box (e = {:+.3f}) on {}", *error, source_name(msg.source))
-            : fmt::format("no box for {:.3f} s: 0 along the axis, height held", seconds(msg.utime - *last_box_utime_));
+            : fmt::format("no box for {:.3f} s: 0 along the axis, height held",
+                          seconds_between(*last_box_utime_, msg.utime));
   out.setpoint = fly(msg.utime, cmd.command, 0, msg.source, detail);
   return out;
 }
 
-void Follower::accept_driving_input(const char* field, int64_t utime) {
-  if (last_driving_utime_ && utime < *last_driving_utime_)
-    throw std::invalid_argument(
-        fmt::format("{} = {}: before the previous input ({}): out of order", field, utime, *last_driving_utime_));
-  last_driving_utime_ = utime;
-}
-
 std::string Follower::own_pose_problem(int64_t utime) const {
   if (!own_) return "no own pose yet";
-  if (utime - own_->utime > timeout_us_)
+  if (!common::is_fresh(utime, own_->utime, timeout_us_, max_ahead_us_)) {
+    if (own_->utime > utime)  // a negative age is stale, not fresh
+      return fmt::format("own pose from the future: newest is {:.3f} s after the input (time.max_ahead_s = {})",
+                         seconds_between(utime, own_->utime), options_.time.max_ahead_s);
     return fmt::format("own pose stale: newest is {:.3f} s older than the input (hold.timeout_s = {})",
-                       seconds(utime - own_->utime), options_.hold_timeout_s);
+                       seconds_between(own_->utime, utime), options_.hold_timeout_s);
+  }
   return "";
 }
 

@@ -28,7 +28,8 @@ std::vector<std::string> FollowerOptions::validate() const {
     p.push_back(problem("hold.timeout_s", hold_timeout_s, "must be a finite number > 0"));
   if (!(localizer_heartbeat_timeout_s > 0) || !std::isfinite(localizer_heartbeat_timeout_s))
     p.push_back(problem("localizer.heartbeat_timeout_s", localizer_heartbeat_timeout_s, "must be a finite number > 0"));
-  for (const auto& part : {limits.validate(), camera_mount.validate(), formation.validate(), pid_1d.validate()})
+  for (const auto& part :
+       {time.validate(), limits.validate(), camera_mount.validate(), formation.validate(), pid_1d.validate()})
     p.insert(p.end(), part.begin(), part.end());
   if (formation.avoid_climb_mps > limits.max_vertical_speed_mps)
     p.push_back(

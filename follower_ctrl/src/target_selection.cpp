@@ -4,6 +4,8 @@
 
 #include "wingman/follower_ctrl/world_frame.hpp"
 
+#include <wingman/common/time_sanity.hpp>
+
 #include <tuple>
 
 namespace wingman::follower_ctrl {
@@ -25,9 +27,12 @@ std::vector<TargetState> usable_targets(const wingman::targets_t& msg, int64_t m
   const bool ned = msg.frame == wingman::own_pose_t::FRAME_NED;
   std::vector<TargetState> out;
   for (const auto& t : msg.targets) {
-    // A source_utime so far from utime that the difference overflows (a fuzzed message) is not usable either.
-    int64_t age_us = 0;
-    if (!t.world_valid || __builtin_sub_overflow(msg.utime, t.source_utime, &age_us) || age_us > max_age_us) continue;
+    // The image must be at most max_age_us old and not dated after the message (a negative age is stale, not
+    // fresh: such a target was coasted forever, issue 33); a difference that overflows is not usable either. The
+    // state's time (predicted_utime) must lie within max_age_us of the message either way: the prediction to
+    // msg.utime is then bounded.
+    if (!t.world_valid || !common::is_fresh(msg.utime, t.source_utime, max_age_us)) continue;
+    if (t.predicted_utime > 0 && !common::is_fresh(msg.utime, t.predicted_utime, max_age_us, max_age_us)) continue;
     TargetState s;
     s.track_id = t.track_id;
     s.p_target_in_world = Eigen::Vector3d(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);

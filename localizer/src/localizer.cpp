@@ -32,12 +32,15 @@ std::string NonDroneCounts::summary() const {
   return fmt::format("non-drone boxes not tracked: {} ({})", total, by_class_text);
 }
 
-Localizer::Localizer(const LocalizerOptions& options, CameraModel camera)
+Localizer::Localizer(const LocalizerOptions& options, CameraModel camera, const common::TimeSanityOptions& time)
     : options_(options),
       camera_(std::move(camera)),
       extrinsics_(Extrinsics::from_options(options.extrinsics)),
       poses_(options.pose),
-      tracker_(options.tracker) {}
+      tracker_(options.tracker),
+      clock_(time),
+      own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)),
+      detections_input_(clock_.add_input("detections_t.utime", "detections_t", true)) {}
 
 void Localizer::on_own_pose(const wingman::own_pose_t& m) {
   PoseSample s;
@@ -48,6 +51,12 @@ void Localizer::on_own_pose(const wingman::own_pose_t& m) {
           .normalized();
   s.v_body_in_world = Eigen::Vector3d(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
   if (m.frame == wingman::own_pose_t::FRAME_NED) s = pose_ned_frd_to_enu_flu(s);  // world ENU, body FLU inside
+  const common::TimeAdmission admission = clock_.admit(own_pose_input_, m.utime);
+  if (!admission.accepted()) throw std::invalid_argument(admission.problem);
+  if (admission.resynced()) {  // the buffered poses belong to the old times: forget them
+    poses_ = PoseBuffer(options_.pose);
+    newest_pose_utime_ = -1;
+  }
   std::string why;
   if (!poses_.add(s, &why)) throw std::invalid_argument("own_pose_t.utime = " + std::to_string(m.utime) + ": " + why);
   newest_pose_utime_ = std::max(newest_pose_utime_, m.utime);
@@ -65,11 +74,9 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     }
     camera_ = camera_.scaled_to(d.image_width, d.image_height);
   }
-  if (d.utime <= last_detections_utime_) {
-    throw std::invalid_argument(fmt::format("detections_t.utime = {}: not after the previous one ({}): out of order",
-                                            d.utime, last_detections_utime_));
-  }
-  last_detections_utime_ = d.utime;
+  const common::TimeAdmission admission = clock_.admit(detections_input_, d.utime);
+  if (!admission.accepted()) throw std::invalid_argument(admission.problem);
+  if (admission.resynced()) tracker_ = Tracker(options_.tracker);  // its tracks live in the old times
 
   LocalizerOutput result;
   std::vector<CameraMeasurement> measurements;

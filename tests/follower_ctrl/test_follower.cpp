@@ -289,7 +289,7 @@ TEST(Follower, UnusableInputsThrowNamingTheFieldAndBadBoxesAreReported) {
     f.on_targets(targets(kT0 + 15 * kMs, {}));
     ADD_FAILURE() << "out-of-order targets accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("targets_t.utime = 1700000000015000: before the previous input"),
+    EXPECT_NE(std::string(e.what()).find("targets_t.utime = 1700000000015000: before the previous targets_t"),
               std::string::npos)
         << e.what();
   }

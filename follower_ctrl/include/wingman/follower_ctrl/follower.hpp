@@ -9,6 +9,7 @@
 #include "wingman/follower_ctrl/target_selection.hpp"
 #include "wingman/follower_ctrl/world_frame.hpp"
 
+#include <wingman/common/time_sanity.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/setpoint_t.hpp>
@@ -35,6 +36,8 @@ struct FollowerOutput {
   std::optional<wingman::setpoint_t> setpoint;
   /// Parts of the input that could not be used, one line each naming the field (counted as drops).
   std::vector<std::string> rejections;
+  /// Lines for the log that are not drops: a time resync (the input re-anchored the follower's clock).
+  std::vector<std::string> notes;
 };
 
 /// The follower process's logic. Time is message time only (utimes); the same inputs in the same
@@ -63,6 +66,15 @@ struct FollowerOutput {
 /// Then each targets_t gives a MODE_HOLD, and so does each own pose. The next heartbeat in another
 /// state ends it; the follower resumes with the next usable target. Before the first heartbeat the
 /// watchdog is not armed (no targets come without a localizer, and the targets timeout holds).
+/// Time sanity (common::StageClock, options.time): own poses and driving inputs are admitted by one clock of
+/// message time. A message dated more than time.max_ahead_s after the newest accepted one is dropped (thrown as
+/// std::invalid_argument naming the field), never adopted as "now"; own poses must be strictly after the previous
+/// own pose, driving inputs at or after the previous one. Ages are checked both ways: an own pose dated more than
+/// time.max_ahead_s after the input, a last driving input after the own pose, a target's image (source_utime) or
+/// box after the input are stale, not fresh. When one input's messages have all been refused for
+/// time.resync_after_s of their own time (a bad first message latched the order), the clock re-anchors on them and
+/// the follower forgets its time-keyed state as at start-up (own pose, targets, PID memory; FollowerOutput::notes
+/// says so): it holds until fresh data comes, and recovers within time.resync_after_s after any single bad message.
 /// Every hold forgets the PID memory and the previous command; a track switch forgets the PID memory.
 /// setpoint_t.detection_source is copied from the data behind the setpoint (the followed target, the
 /// detections message; for a hold the newest known); target_track_id is the followed track (0 for pid_1d and holds).
@@ -72,7 +84,8 @@ class Follower {
   explicit Follower(const FollowerOptions& options);
 
   /// An own pose (ENU or NED). Throws std::invalid_argument naming the field when its utime is not
-  /// after the previous own pose's (duplicate or out of order); the caller drops and counts it.
+  /// after the previous own pose's (duplicate or out of order) or too far ahead (time.max_ahead_s); the caller
+  /// drops and counts it.
   FollowerOutput on_own_pose(const wingman::own_pose_t& pose);
   /// A targets_t (mode formation). Throws std::invalid_argument naming the field for a message before
   /// the previous one, or a target with an unknown detection_source; throws std::logic_error in mode pid_1d.
@@ -94,15 +107,23 @@ class Follower {
   std::string own_pose_problem(int64_t utime) const;
   /// "" when the localizer watchdog lets the follower fly at message time `utime`, else why not.
   std::string localizer_problem(int64_t utime) const;
-  /// Advances the newest message time (own poses and driving inputs) to `utime`.
-  void saw_message_time(int64_t utime);
-  void accept_driving_input(const char* field, int64_t utime);
+  /// Admits a message of `input` (the clock's id) at `utime`: throws std::invalid_argument with the problem when
+  /// it is refused; on a resync forgets the time-keyed state and adds the note to `out`.
+  void admit(int input, int64_t utime, FollowerOutput& out);
+  /// Dates a heartbeat that came before any message time by the clock's first time.
+  void saw_message_time();
+  /// Forgets everything learnt from message times (a resync): as at start-up, but for the localizer's state.
+  void forget_time_state();
   wingman::setpoint_t fly(int64_t utime, const VelocityCommand& command, int32_t track_id, int8_t source,
                           const std::string& what);
 
   FollowerOptions options_;
   ControllerMode mode_;
   int64_t timeout_us_;
+  int64_t max_ahead_us_;  ///< time.max_ahead_s: the tolerance of cross-input ages
+  common::StageClock clock_;
+  int own_pose_input_;
+  int driving_input_;
   SelectPolicy select_policy_;
   FormationController formation_;
   Pid1dController pid_1d_;
@@ -115,7 +136,6 @@ class Follower {
   std::optional<TargetState> last_target_;  ///< formation: the last usable state of the followed track
   std::optional<int64_t> last_box_utime_;   ///< pid_1d: utime of the last detections with a usable box
   int64_t localizer_timeout_us_;
-  std::optional<int64_t> newest_utime_;          ///< newest own-pose or driving-input utime
   bool localizer_armed_ = false;                 ///< a localizer heartbeat has arrived
   std::optional<int64_t> localizer_seen_utime_;  ///< message time of the newest heartbeat (unset: none yet)
   int8_t localizer_state_ = wingman::status_t::STATE_STARTING;

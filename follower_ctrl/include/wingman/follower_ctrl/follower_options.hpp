@@ -7,6 +7,8 @@
 #include "wingman/follower_ctrl/pid_1d_controller.hpp"
 #include "wingman/follower_ctrl/velocity_limits.hpp"
 
+#include <wingman/common/time_sanity.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -42,6 +44,8 @@ struct FollowerOptions {
   /// targets utimes, > 0) -> MODE_HOLD. Heartbeats come every second of wall time: this must exceed the
   /// localizer's status period times the simulator's sync.speed when it runs faster than real time.
   double localizer_heartbeat_timeout_s = 3.0;
+  /// Time sanity of the inputs (own poses and driving inputs): future-dated messages dropped, the resync bound.
+  common::TimeSanityOptions time;
   LimitsOptions limits;
   CameraMountOptions camera_mount;
   FormationOptions formation;
@@ -60,6 +64,7 @@ struct FollowerOptions {
       "mode formation: hold unless this localizer instance's heartbeat (STATUS_<NAME>) is alive; \"\" = no watchdog");
     v("localizer.heartbeat_timeout_s", localizer_heartbeat_timeout_s,
       "no localizer heartbeat for longer than this (own-pose/targets time, s), or STOPPING/ERROR -> MODE_HOLD");
+    time.visit(v);
     limits.visit(v);
     camera_mount.visit(v);
     formation.visit(v);

@@ -37,8 +37,9 @@ enum class SelectPolicy {
 std::optional<SelectPolicy> parse_select_policy(const std::string& name);
 
 /// The targets of `msg` a controller may follow, converted to ENU (msg.frame NED is swapped): those
-/// with world_valid, and whose newest image is at most `max_age_us` older than msg.utime
-/// (msg.utime - source_utime <= max_age_us; message time). Order kept.
+/// with world_valid, whose newest image is at most `max_age_us` older than msg.utime and not after it
+/// (0 <= msg.utime - source_utime <= max_age_us; message time), and whose state time (predicted_utime, when set) is
+/// within max_age_us of msg.utime. Order kept.
 std::vector<TargetState> usable_targets(const wingman::targets_t& msg, int64_t max_age_us);
 
 /// The target to follow among `usable`: the one with `followed_track_id` while it is there (0: none

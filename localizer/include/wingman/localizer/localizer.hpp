@@ -8,6 +8,7 @@
 #include "wingman/localizer/pose_buffer.hpp"
 #include "wingman/localizer/tracker.hpp"
 
+#include <wingman/common/time_sanity.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/targets_t.hpp>
@@ -48,11 +49,16 @@ struct LocalizerOutput {
 /// frames, then the tracker). Uses message utimes only: the same inputs give the same outputs.
 class Localizer {
  public:
-  /// `camera` must match the detections' image size (checked per message).
-  Localizer(const LocalizerOptions& options, CameraModel camera);
+  /// `camera` must match the detections' image size (checked per message). `time`: the time sanity of the two
+  /// inputs (common::StageClock): an own pose or detections_t dated more than time.max_ahead_s after the newest
+  /// message time accepted is dropped; when one input's messages have all been refused for time.resync_after_s of
+  /// their own time (a bad first message latched the order), the clock re-anchors on them: an own-pose resync
+  /// empties the pose buffer, a detections resync restarts the tracker (new tracks, as after a restart).
+  /// Throws std::invalid_argument for invalid options.
+  Localizer(const LocalizerOptions& options, CameraModel camera, const common::TimeSanityOptions& time = {});
 
   /// Adds an own pose. Throws std::invalid_argument naming the field when it cannot be used
-  /// (out of order, duplicate); the caller drops and counts it.
+  /// (out of order, duplicate, dated too far ahead); the caller drops and counts it.
   void on_own_pose(const wingman::own_pose_t& pose);
 
   /// Localizes and tracks one detections message. Only drones are localized and tracked: a box with
@@ -73,7 +79,9 @@ class Localizer {
   Extrinsics extrinsics_;
   PoseBuffer poses_;
   Tracker tracker_;
-  int64_t last_detections_utime_ = -1;
+  common::StageClock clock_;  ///< admits own poses and detections by message time
+  int own_pose_input_;
+  int detections_input_;
   int64_t newest_pose_utime_ = -1;
   NonDroneCounts non_drone_boxes_;
 };
