@@ -46,6 +46,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   if (o.weights.empty()) return run_without_model(rt, o, limits);
 
   detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
+  const std::string model_id = detector::weights_model_id(o.weights);  // detections_t.model_id
   const detector::InputSize input_size = *detector::InputSize::parse(o.input_size);  // validated with the options
   // model.backend = opencl: no usable OpenCL device, or a kernel that fails to build, throws here (exit 1, one line).
   // The first network is built at start-up (the cfg's size, or model.input_size's WxH); with input_size auto,
@@ -117,6 +118,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     out.image_height = img.height;
     out.source = detections_t::SOURCE_CNN;
     out.inference_latency_us = static_cast<int32_t>(latency_us);
+    out.model_id = model_id;
     // Every box, drone or distractor (class_id != 0 with a multi-class model): the consumers choose.
     for (const auto& b : boxes) out.detections.push_back(detector::to_detection(b));
     out.num_detections = static_cast<int32_t>(out.detections.size());

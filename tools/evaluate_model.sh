@@ -8,8 +8,8 @@
 # wingman val runs the detector at its default input size (model.input_size auto: the cfg's 640 columns, the rows
 # fitted to each set's aspect, 640x512 for the Halmstad frames).
 # Then the track-level metrics (wingman val --sequences, docs/training.md): every frame of the Halmstad val clips
-# through the detector and wingman-localizer's tracker with the CNN flights' localizer config
-# (config/flights/cnn.localizer.yaml): false tracks per hour of distractor video, drone clips confirmed, time to confirm
+# through the detector and wingman-localizer's tracker with the localizer's defaults (as installed: the shipped box
+# relation): false tracks per hour of distractor video, drone clips confirmed, time to confirm
 # (a few minutes: 4 s a clip on the 2-core VM with the OpenCL backend).
 # Writes OUT/*.json (wingman val --json, one pass per set, with every truth not found), OUT/summary.md (the metrics,
 # the negative clips' false positives, the truths not found: missed or loose, at the frame's edge, and the track-level
@@ -117,7 +117,7 @@ if $sequences; then
   # from the shared dataset).
   echo "evaluate_model: halmstad_sequences" >&2
   "$bin/wingman" val --sequences --data "$data/halmstad" --halmstad-root "$src/../shared/datasets/halmstad" \
-    --cfg "$cfg" --weights "$weights" --backend opencl --localizer-config "$src/config/flights/cnn.localizer.yaml" \
+    --cfg "$cfg" --weights "$weights" --backend opencl \
     "${val_args[@]}" --json "$out/halmstad_sequences.json" > "$out/halmstad_sequences.txt"
 fi
 if $bench; then

@@ -9,8 +9,8 @@
 # Usage: tools/experiment.sh NAME [--quick] [--out DIR] [--detections cnn|truth]
 #   NAME           static_sweep  box width error over distance, single pass vs zoom-in (thesis Fig. 13), and the
 #                                boxes' range scale side-on and from behind
-#                  calibration   the radius for the CNN's boxes (config/flights/cnn.localizer.yaml): a 30-s formation
-#                                flight with another seed than formation_2d's runs, flown with the configured radius
+#                  calibration   a check of the range the CNN's boxes give (the shipped box relation, the leader's true
+#                                bounding radius): a 30-s formation flight with another seed than formation_2d's runs
 #                  distance      distance error on a fast-moving leader: single, zoom-in, zoom-in filtered (Table 3)
 #                  follow_1d     the 1-D PID follow (thesis section 5.3)
 #                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
@@ -78,12 +78,14 @@ static_sweep() {
   rm -rf "$out"; mkdir -p "$out"
   # The thesis: a hovering drone seen from the side from 0.5 to 30 m; 8 frames per 0.25 m step.
   local scn; scn=$(scenario_variant "$out/scenario" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/")
-  # The bounding sphere's own radius (the default quad's), so that the sweep measures the boxes' range scale.
-  printf 'target: {radius_m: 0.348}\n' > "$out/sphere.localizer.yaml"
+  # The bounding sphere's own radius (the default quad's) and ratio 1 (no box relation), so that the sweep measures
+  # the boxes' raw range scale.
+  printf 'target: {radius_m: 0.348, box_relation: sphere}\n' > "$out/sphere.localizer.yaml"
   fly "$out/single" --scenario "$scn" --localizer-config "$out/sphere.localizer.yaml"
   fly "$out/zoom" --scenario "$scn" --zoom-in --localizer-config "$out/sphere.localizer.yaml"
   # The same sweep with the drone turned 90 degrees, seen from behind as a follower sees its leader (single pass): the
-  # boxes' width, and so the range scale, depends on the view; config/flights/cnn.localizer.yaml takes this one.
+  # boxes' width, and so the range scale, depends on the view (models/wingman-small.boxes.yaml tabulates it by the
+  # box's aspect).
   local behind; behind=$(scenario_variant "$out/scenario-behind" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/" \
     "s/yaw_deg: 0 *# seen from the side/yaw_deg: 90               # seen from behind/")
   grep -q "seen from behind" "$behind" || { echo "experiment: could not turn the drone in $behind" >&2; exit 1; }
@@ -94,30 +96,22 @@ static_sweep() {
 calibration() {
   local out="$out_root/calibration" dur=30; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
-  # The radius for the CNN's boxes, measured on the view the flights have: the boxes' width against the bounding
-  # sphere's depends on the view, the range and the background (the static sweep's from-behind scale, 2-20 m, made
-  # every stage-8 flight's ranges 6-8 % long), so the calibration flight is a formation flight like the ones measured,
-  # with another seed (7; formation_2d's runs use 1-3 and the README's flight 2). It flies with the configured radius
-  # (the follower's distance, and so the view, depends on it) and the summary scales that radius by the median
-  # true / estimated range of the leader's targets.
-  local cfg="$src/config/flights/cnn.localizer.yaml" radius
-  radius=$(awk '/^target:/ {t = 1} t && /radius_m:/ {print $2; exit}' "$cfg")
-  [ -n "$radius" ] || { echo "experiment: $cfg: no target.radius_m" >&2; exit 1; }
+  # The range the installed localizer gives on CNN boxes: the leader's true bounding radius (the default, 0.348 m,
+  # the simulator's default quad) and the shipped box relation, on a formation flight like the ones measured, with
+  # another seed (7; formation_2d's runs use 1-3 and the README's flight 2). The summary reports the median true /
+  # estimated range of the leader's targets (1: the relation holds on this view) and the radius it would imply.
   local scn; scn=$(scenario_variant "$out/scenario" formation_2d "s/^seed: .*/seed: 7/")
   grep -q "^seed: 7$" "$scn" || { echo "experiment: could not set the seed in $scn" >&2; exit 1; }
-  fly "$out/run" --scenario "$scn" --duration "$dur" --localizer-config "$cfg"
-  py calibration "$out" "$radius" "$out/run/eval.json"
+  fly "$out/run" --scenario "$scn" --duration "$dur"
+  py calibration "$out" 0.348 "$out/run/eval.json"
 }
 
 distance() {
   local out="$out_root/distance" dur=10; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
-  # CNN boxes: the radius calibrated for them; ground-truth sphere boxes: the true radius (the default).
-  local calibration=/dev/null
-  [ "$detections" = cnn ] && calibration="$src/config/flights/cnn.localizer.yaml"
-  { cat "$calibration"; printf 'tracker: {mode: sliding_window, window_size: 1}\n'; } > "$out/raw.localizer.yaml"
-  { cat "$calibration"; printf 'tracker: {mode: sliding_window, window_size: 5}\n'; } > "$out/window5.localizer.yaml"
+  printf 'tracker: {mode: sliding_window, window_size: 1}\n' > "$out/raw.localizer.yaml"
+  printf 'tracker: {mode: sliding_window, window_size: 5}\n' > "$out/window5.localizer.yaml"
   fly "$out/single" --scenario fast_target --duration "$dur" --localizer-config "$out/raw.localizer.yaml"
   fly "$out/zoom" --scenario fast_target --duration "$dur" --zoom-in --localizer-config "$out/raw.localizer.yaml"
   fly "$out/zoom_window5" --scenario fast_target --duration "$dur" --zoom-in \

@@ -110,14 +110,15 @@ def static_sweep(out, single, zoom, behind=None):
     if kb:
         lines += ["", f"Seen from behind (the same sweep, the drone turned 90°, single pass: the view a follower has "
                   f"of its leader): range scale {kb:.3f} (n = {kb_n}), {100 * rate(load(behind)):.1f} % of the frames "
-                  f"detected (0.348 m × {kb:.3f} = {0.348 * kb:.3f} m; `config/flights/cnn.localizer.yaml` "
-                  f"takes the calibration flight's radius, `tools/experiment.sh calibration`)."]
+                  f"detected (the raw boxes, ratio 1: `models/wingman-small.boxes.yaml` holds the measured ratios by "
+                  f"box size and aspect, `wingman model box-relation`)."]
     write(out, "static_sweep", data, lines)
 
 
 def calibration(out, radius_m, run):
-    """The radius for the detector's boxes from a formation flight flown with the localizer's radius RADIUS_M: the
-    median true / estimated range of the leader's targets times RADIUS_M (the range is proportional to the radius)."""
+    """A check of the range on a formation flight flown with the localizer's radius RADIUS_M (the leader's true
+    bounding radius) and the shipped box relation: the median true / estimated range of the leader's targets (1: the
+    relation holds on this view), and the radius that would make it 1 (the range is proportional to the radius)."""
     try:
         radius = float(radius_m)
     except ValueError:
@@ -138,10 +139,10 @@ def calibration(out, radius_m, run):
              f"| median true / estimated range (leader's targets) | {k:.3f} (n = {n}) |",
              f"| true range of those targets (m) | {ranges[0]:.1f}–{ranges[1]:.1f} |",
              f"| localization RMS with the radius flown (m) | {r['localization']['rms_m']:.3f} |",
-             f"| **calibrated radius** (m) | **{radius * k:.3f}** |", "",
-             f"`config/flights/cnn.localizer.yaml` takes the calibrated radius ({radius:.3f} m × {k:.3f} = "
-             f"{radius * k:.3f} m); when it changes by more than about 2 %, fly the calibration again with it (the "
-             f"follower's distance, and so the view, follows the radius)."]
+             f"| radius that would make it 1 (m) | {radius * k:.3f} |", "",
+             f"The localizer flies with the leader's true bounding radius ({radius:.3f} m) and the shipped box relation "
+             f"(`models/wingman-small.boxes.yaml`, measured on renders of other airframes, views and ranges); nothing is "
+             f"fitted to this flight. A scale far from 1 means the relation does not hold on this view."]
     write(out, "calibration", data, lines)
 
 

@@ -23,9 +23,8 @@
 #   --zoom-in        the detector re-detects each box in a full-resolution crop (Algorithm 2's zoom-in)
 #   --flip-fusion    the detector also detects in the mirrored frame and fuses both passes' boxes (docs/detector.md)
 #   --coarse-pass    the detector also detects at half the network input and fuses its large boxes (close drones)
-#   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any; else with
-#                    cnn detections config/flights/cnn.localizer.yaml, the range calibrated to the shipped model's
-#                    boxes; else the defaults)
+#   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any, else the
+#                    defaults: the leader's bounding radius, and the shipped model's box relation for cnn boxes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -74,10 +73,6 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   exec tools/netns_run.sh "$0" "${again[@]}"
 fi
 [ -z "$localizer_config" ] || [ -r "$localizer_config" ] || { echo "fly: --localizer-config $localizer_config: cannot read it" >&2; exit 2; }
-if [ -z "$localizer_config" ] && [ ! -r "$src/config/flights/$name.localizer.yaml" ] && [ "$detections" = cnn ] &&
-   [ -r "$src/config/flights/cnn.localizer.yaml" ]; then
-  localizer_config="$src/config/flights/cnn.localizer.yaml"
-fi
 
 mkdir -p "$out"
 out=$(realpath "$out")

@@ -81,7 +81,10 @@ def decode_status(data):
 
 
 def decode_detections(data):
-    utime, seq, camera_id, _w, _h, _source, latency_us, n = struct.unpack_from(">qqiiibii", data, 8)
+    r = Reader(data)
+    utime, seq, camera_id, _w, _h, _source, latency_us = r.get("qqiiibi")
+    _model_id = r.string()
+    n = r.get("i")
     return {"utime": utime, "seq": seq, "camera_id": camera_id, "inference_us": latency_us, "n": n}
 
 

@@ -8,9 +8,12 @@
 #include "wingman/detector/opencl_backend.hpp"
 
 #include <fmt/format.h>
+#include <openssl/evp.h>
 
 #include <algorithm>
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <vector>
 
@@ -88,6 +91,29 @@ void load_weights(DarknetModel& model, const std::string& weights) {
   } else {
     load_darknet_weights(model, weights);
   }
+}
+
+std::string weights_model_id(const std::string& weights) {
+  if (weights.empty()) return "";
+  std::vector<char> bytes;
+  const std::string name = builtin_name(weights);
+  if (name == "wingman-small") {
+    bytes = builtin_small_weights();
+  } else if (!name.empty()) {
+    throw std::runtime_error("model.weights = '" + weights + "': no such built-in model; expected " +
+                             known_names(builtin_weights_names()) + " or a .weights path");
+  } else {
+    std::ifstream in(weights, std::ios::binary);
+    if (!in) throw std::runtime_error(weights + ": cannot read the weights file");
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int digest_size = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &digest_size, EVP_sha256(), nullptr) != 1 || digest_size < 8)
+    throw std::runtime_error(weights + ": SHA-256 of the weights failed (OpenSSL)");
+  std::string id = "sha256:";
+  for (int i = 0; i < 8; ++i) id += fmt::format("{:02x}", digest[i]);
+  return id;
 }
 
 DarknetModel load_model(const std::string& cfg, const std::string& weights) {

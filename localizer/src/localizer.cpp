@@ -34,6 +34,7 @@ std::string NonDroneCounts::summary() const {
 
 Localizer::Localizer(const LocalizerOptions& options, CameraModel camera, const common::TimeSanityOptions& time)
     : options_(options),
+      cnn_relation_(BoxRelation::load(options.sphere.box_relation)),
       camera_(std::move(camera)),
       extrinsics_(Extrinsics::from_options(options.extrinsics)),
       poses_(options.pose),
@@ -74,6 +75,10 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     }
     camera_ = camera_.scaled_to(d.image_width, d.image_height);
   }
+  const bool ground_truth = d.source == wingman::detections_t::SOURCE_GROUND_TRUTH;
+  if (!ground_truth) {
+    if (const std::string bad = cnn_relation_.check_model(d.model_id); !bad.empty()) throw std::invalid_argument(bad);
+  }
   const common::TimeAdmission admission = clock_.admit(detections_input_, d.utime);
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);
   if (admission.resynced()) tracker_ = Tracker(options_.tracker);  // its tracks live in the old times
@@ -88,7 +93,8 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
       continue;
     }
     const PixelBox box{det.cx, det.cy, det.w, det.h};
-    LocalizeResult r = localize_box(box, camera_, options_.sphere);
+    const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d.image_width);
+    LocalizeResult r = localize_box(box, camera_, options_.sphere, scale);
     if (!r.ok) {
       result.rejections.push_back(fmt::format("detections_t.detections[{}]: {}", i, r.reason));
       continue;
@@ -134,6 +140,8 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     copy33(t.cov_v, m.velocity_covariance);
     m.world_valid = true;
     m.range = t.range;
+    m.radius_m = options_.sphere.radius_m;  // the configured size (not estimated online)
+    m.radius_sigma_m = 0.0;
     m.confidence = static_cast<float>(t.confidence);
     m.age_s = static_cast<float>(t.age_s);
     m.source_utime = t.source_utime;

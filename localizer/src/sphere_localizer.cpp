@@ -29,6 +29,7 @@
 #include <Eigen/Dense>
 #include <wingman/common/config.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -38,6 +39,11 @@ std::vector<std::string> SphereLocalizerOptions::validate() const {
   using common::problem;
   std::vector<std::string> p;
   if (!(std::isfinite(radius_m) && radius_m > 0)) p.push_back(problem("target.radius_m", radius_m, "must be > 0"));
+  try {
+    (void)BoxRelation::load(box_relation);
+  } catch (const BoxRelationError& e) {
+    p.push_back(problem("target.box_relation", box_relation, e.what()));
+  }
   if (range_method != "exact" && range_method != "thesis" && range_method != "thesis_eq33")
     p.push_back(problem("range.method", range_method, "must be exact, thesis or thesis_eq33"));
   if (!(std::isfinite(min_range_m) && min_range_m > radius_m))
@@ -109,21 +115,35 @@ struct Solution {
   Eigen::Vector3d bearing = Eigen::Vector3d::UnitZ();
 };
 
-/// Exact solve from edge-plane normals (uncut edges only) and the box-centre ray. radius in metres.
+/// The distance of each edge's plane from the sphere's centre, metres: radius x the box relation's width ratio for
+/// the left and right edges, x its height ratio for the top and bottom ones (a model's box is the box of a
+/// concentric sphere that much larger or smaller; BoxScale).
+using EdgeRadii = std::array<double, 4>;
+
+EdgeRadii edge_radii(double radius, const BoxScale& scale) {
+  return {radius * scale.width_ratio, radius * scale.width_ratio, radius * scale.height_ratio,
+          radius * scale.height_ratio};
+}
+
+/// Exact solve from edge-plane normals (uncut edges only) and the box-centre ray; radii per edge in metres.
 Solution solve_planes(const std::array<Eigen::Vector3d, 4>& normals, const std::array<bool, 4>& whole,
-                      const Eigen::Vector3d& centre_ray, double radius) {
+                      const Eigen::Vector3d& centre_ray, const EdgeRadii& radii) {
   Solution out;
   out.bearing = centre_ray;
   Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 4, 3> N(0, 3);
   int count = 0;
   for (int i = 0; i < 4; ++i) count += whole[i] ? 1 : 0;
   N.resize(count, 3);
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1> d(count);
   int row = 0;
-  for (int i = 0; i < 4; ++i)
-    if (whole[i]) N.row(row++) = normals[i].transpose();
+  for (int i = 0; i < 4; ++i) {
+    if (!whole[i]) continue;
+    d(row) = radii[i];
+    N.row(row++) = normals[i].transpose();
+  }
   if (count >= 3) {
     const Eigen::Matrix3d NtN = N.transpose() * N;
-    const Eigen::Vector3d Ntr = radius * N.colwise().sum().transpose();  // N^T (r 1)
+    const Eigen::Vector3d Ntr = N.transpose() * d;  // N^T (r_i)
     out.p_in_cam = NtN.ldlt().solve(Ntr);
   } else if (count == 2 && ((whole[kLeft] && whole[kRight]) || (whole[kTop] && whole[kBottom]))) {
     // The centre lies on the line {c : n_a . c = r, n_b . c = r}; take its point closest to the centre ray.
@@ -131,7 +151,7 @@ Solution solve_planes(const std::array<Eigen::Vector3d, 4>& normals, const std::
     const Eigen::Vector3d m = na.cross(nb).normalized();
     Eigen::Matrix2d G;
     G << 1, na.dot(nb), na.dot(nb), 1;
-    const Eigen::Vector2d w = G.ldlt().solve(Eigen::Vector2d(radius, radius));
+    const Eigen::Vector2d w = G.ldlt().solve(Eigen::Vector2d(d(0), d(1)));
     const Eigen::Vector3d c0 = w(0) * na + w(1) * nb;  // the line's point closest to the camera
     // min over (t, k) of |c0 + t m - k b|^2.
     const double mb = m.dot(centre_ray);
@@ -142,7 +162,8 @@ Solution solve_planes(const std::array<Eigen::Vector3d, 4>& normals, const std::
   } else {
     return out;  // bearing only
   }
-  if (!(out.p_in_cam.allFinite() && out.p_in_cam.z() > 0 && out.p_in_cam.norm() > radius)) {
+  if (!(out.p_in_cam.allFinite() && out.p_in_cam.z() > 0 &&
+        out.p_in_cam.norm() > *std::max_element(radii.begin(), radii.end()))) {
     out.ok = false;
     out.reason = "no sphere in front of the camera fits the box edges";
     return out;
@@ -160,8 +181,8 @@ struct ExactState {
   int iterations = 0;
 };
 
-Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole, double radius,
-                     ExactState& state) {
+Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole,
+                     const EdgeRadii& radii, ExactState& state) {
   const Eigen::Vector2d centre = edges.centre();
   state.centre_ray = camera.unproject(centre);
   state.s = {centre.y(), centre.y(), centre.x(), centre.x()};
@@ -170,11 +191,14 @@ Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::a
   for (state.iterations = 1; state.iterations <= 30; ++state.iterations) {
     for (int i = 0; i < 4; ++i)
       if (whole[i]) state.normals[i] = edge_normal(camera, i, edges.e[i], state.s[i], state.centre_ray);
-    solution = solve_planes(state.normals, whole, state.centre_ray, radius);
+    solution = solve_planes(state.normals, whole, state.centre_ray, radii);
     if (!distorted || !solution.ok || !solution.range_valid) break;
     // New tangency coordinates: where the silhouette of the sphere at the current centre is extremal (the point
     // the measured edge should touch). Taken from the forward model, which depends on c only; using the plane's
     // own tangency point c - r n instead can oscillate and diverge near the rim of a fisheye.
+    // The silhouette of the sphere of the mean edge radius (the ratios differ by tens of percent at most, and the
+    // tangency coordinate moves little with the radius).
+    const double radius = 0.25 * (radii[0] + radii[1] + radii[2] + radii[3]);
     const SphereImageBox image = project_sphere(camera, solution.p_in_cam, radius, 1e-3);
     if (!image.valid) {
       solution.ok = false;
@@ -197,18 +221,20 @@ Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::a
 
 /// The thesis's method: eq. 24 direction of the box centre, eq. 27-32 (or eq. 33) distance from the rays
 /// through the midpoints of the left and right edges (top and bottom if the width is cut).
-Solution solve_thesis(const CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole, double radius,
-                      bool eq33, int& edges_used) {
+Solution solve_thesis(const CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole,
+                      const EdgeRadii& radii, bool eq33, int& edges_used) {
   Solution out;
   const Eigen::Vector2d centre = edges.centre();
   out.bearing = thesis_direction(camera.undistort_to_normalized(centre));  // eq. 24
   Eigen::Vector3d a, b;
+  double radius = radii[kLeft];
   if (whole[kLeft] && whole[kRight]) {
     a = camera.unproject({edges.e[kLeft], centre.y()});
     b = camera.unproject({edges.e[kRight], centre.y()});
   } else if (whole[kTop] && whole[kBottom]) {
     a = camera.unproject({centre.x(), edges.e[kTop]});
     b = camera.unproject({centre.x(), edges.e[kBottom]});
+    radius = radii[kTop];
   } else {
     edges_used = 0;
     return out;  // bearing only
@@ -242,7 +268,8 @@ std::string check_box(const PixelBox& box, const CameraModel& camera) {
 
 }  // namespace
 
-LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, const SphereLocalizerOptions& options) {
+LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, const SphereLocalizerOptions& options,
+                            const BoxScale& scale) {
   LocalizeResult result;
   if (std::string bad = check_box(box, camera); !bad.empty()) {
     result.reason = std::move(bad);
@@ -257,7 +284,7 @@ LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, cons
       {left - kBoxToCameraPixel, right - kBoxToCameraPixel, top - kBoxToCameraPixel, bottom - kBoxToCameraPixel}};
 
   const RangeMethod method = options.method();
-  const double r = options.radius_m;
+  const EdgeRadii r = edge_radii(options.radius_m, scale);
   Solution solution;
   ExactState state;
   if (method == RangeMethod::kExact) {
@@ -315,14 +342,19 @@ LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, cons
     J.col(i) =
         (perturbed_position(i, kJacobianStepPx) - perturbed_position(i, -kJacobianStepPx)) / (2 * kJacobianStepPx);
   const double se2 = options.edge_noise_px * options.edge_noise_px;
-  const double rel_u = options.edge_noise_rel * (edges.e[kRight] - edges.e[kLeft]);
-  const double rel_v = options.edge_noise_rel * (edges.e[kBottom] - edges.e[kTop]);
+  const double edge_rel = std::hypot(options.edge_noise_rel, scale.edge_noise_rel);
+  const double rel_u = edge_rel * (edges.e[kRight] - edges.e[kLeft]);
+  const double rel_v = edge_rel * (edges.e[kBottom] - edges.e[kTop]);
   const double sc2 = options.centre_noise_px * options.centre_noise_px;
   Eigen::Matrix4d S =
       Eigen::Vector4d(se2 + rel_u * rel_u, se2 + rel_u * rel_u, se2 + rel_v * rel_v, se2 + rel_v * rel_v).asDiagonal();
   S.block<2, 2>(0, 0).array() += sc2;
   S.block<2, 2>(2, 2).array() += sc2;
   out.cov_p_in_cam = J * S * J.transpose();
+  // The box relation's spread: a relative error of the whole scale, along the line of sight (p is proportional to the
+  // edge radii).
+  out.cov_p_in_cam += scale.range_sigma_rel * scale.range_sigma_rel * out.p_target_in_cam *
+                      out.p_target_in_cam.transpose();
   out.cov_p_in_cam = 0.5 * (out.cov_p_in_cam + out.cov_p_in_cam.transpose()).eval();
   result.ok = true;
   return result;

@@ -41,10 +41,12 @@ struct SphereScene {
   }
 };
 
-/// A detections_t of a 1280 x 720 image.
+/// A detections_t of a 1280 x 720 image. The boxes are the exact sphere boxes: SOURCE_GROUND_TRUTH (the
+/// localizer takes them as the sphere's, whatever target.box_relation says).
 inline wingman::detections_t detections(int64_t utime, int64_t seq, std::vector<wingman::detection_t> boxes,
                                         int camera = 0) {
   wingman::detections_t m{};
+  m.source = wingman::detections_t::SOURCE_GROUND_TRUTH;
   m.utime = utime;
   m.seq = seq;
   m.camera_id = camera;

@@ -94,3 +94,39 @@ TEST(Localizer, ANonDroneBoxIsCountedBeforeItsGeometryIsLookedAt) {
 TEST(NonDroneCounts, SummaryIsEmptyWithoutNonDroneBoxes) { EXPECT_EQ(NonDroneCounts{}.summary(), ""); }
 
 }  // namespace
+
+TEST(Localizer, CnnBoxesGoThroughTheBoxRelationGroundTruthBoxesAreTheSpheres) {
+  // The same exact sphere box: as ground truth it gives the true range; as the shipped model's box (SOURCE_CNN) it
+  // stands for a larger sphere box (the model's boxes are smaller than the sphere's), so the target is nearer.
+  const Eigen::Vector3d p(10.0, 1.0, 0.5);
+  const auto camera_range = [&](int8_t source, const std::string& model_id) {
+    LocalizerOptions o;
+    o.tracker.birth_hits = 1;
+    Localizer loc(o, camera());
+    loc.on_own_pose(own_pose(kT0));
+    wingman::detections_t d = detections(kT0, 0, {kScene.sphere_box(p)});
+    d.source = source;
+    d.model_id = model_id;
+    const LocalizerOutput out = loc.on_detections(d);
+    EXPECT_TRUE(out.targets && out.targets->num_targets == 1);
+    return out.targets ? out.targets->targets[0].range : 0.0;
+  };
+  EXPECT_NEAR(camera_range(wingman::detections_t::SOURCE_GROUND_TRUTH, ""), p.norm(), 0.01);  // float boxes
+  const double cnn = camera_range(wingman::detections_t::SOURCE_CNN, "");
+  EXPECT_LT(cnn, 0.95 * p.norm());
+  EXPECT_GT(cnn, 0.5 * p.norm());
+}
+
+TEST(Localizer, DetectionsOfAModelTheBoxRelationWasNotMeasuredForAreDroppedNamingBoth) {
+  Localizer loc(LocalizerOptions{}, camera());
+  wingman::detections_t d = detections(kT0, 0, {kScene.sphere_box({10.0, 1.0, 0.5})});
+  d.source = wingman::detections_t::SOURCE_CNN;
+  d.model_id = "sha256:ffffffffffffffff";
+  try {
+    loc.on_detections(d);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("detections_t.model_id = 'sha256:ffffffffffffffff'"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("builtin:wingman-small"), std::string::npos);
+  }
+}

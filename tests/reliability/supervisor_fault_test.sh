@@ -78,10 +78,8 @@ input: {mode: realtime}
 # opencl, not auto: auto times both backends at every start (seconds here), which a restart should not wait for.
 model: {cfg: "builtin:wingman-small", weights: "builtin:wingman-small", backend: opencl}
 YAML
-# The radius calibrated to the shipped model's boxes (config/flights/cnn.localizer.yaml), the simulator's camera.
-radius=$(awk '/^target:/ {t = 1} t && /radius_m:/ {print $2; exit}' "$src/config/flights/cnn.localizer.yaml")
+# The simulator's camera; the target's size and the box relation at their defaults (as installed).
 cat > "$etc/localizer.yaml" <<YAML
-target: {radius_m: $radius}
 camera: {width: 640, height: 360, focal_px: 320.0}
 YAML
 cat > "$etc/follower_ctrl.yaml" <<YAML

@@ -8,6 +8,7 @@
 
 #include <wingman/common/config.hpp>
 #include <wingman/localizer/camera_model.hpp>
+#include <wingman/localizer/sphere_projection.hpp>
 #include <wingman/sim/drone_model.hpp>
 #include <wingman/sim/renderer.hpp>
 #include <wingman/sim/truth_box.hpp>
@@ -334,6 +335,20 @@ std::string DatasetSynthSummary::one_line() const {
                      images, train, val, out_dir, seconds, seconds > 0.0 ? images / seconds : 0.0, redrawn);
 }
 
+namespace {
+/// The "sphere_box" line of an image's metadata: the exact box of the target's bounding sphere (the box a sphere
+/// detector would draw, not clipped to the image; `wingman model box-relation` relates a model's boxes to it), or
+/// null when the sphere reaches behind the camera.
+std::string sphere_box_json(const localizer::CameraModel& camera, const Eigen::Vector3d& p_target_in_cam,
+                            double radius_m) {
+  const localizer::SphereImageBox s = localizer::project_sphere(camera, p_target_in_cam, radius_m);
+  if (!s.valid) return "  \"sphere_box\": null,\n";
+  const localizer::PixelBox b = s.pixel_box();
+  return fmt::format("  \"sphere_box\": {{\"cx\": {:.9g}, \"cy\": {:.9g}, \"w\": {:.9g}, \"h\": {:.9g}}},\n", b.cx,
+                     b.cy, b.w, b.h);
+}
+}  // namespace
+
 DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress) {
   const auto start = std::chrono::steady_clock::now();
   if (request.count <= 0) throw std::invalid_argument(fmt::format("--count {}: must be > 0", request.count));
@@ -470,6 +485,7 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
                   "  \"box\": {{\"cx\": {:.9g}, \"cy\": {:.9g}, \"w\": {:.9g}, \"h\": {:.9g}, \"truncated\": {}, "
                   "\"visible_pixels\": {}}},\n",
                   box.cx, box.cy, box.w, box.h, box.truncated ? "true" : "false", box.visible_pixels)
+           << sphere_box_json(cam, p_target_in_cam, model->bounding_radius())
            << fmt::format(
                   "  \"render\": {{\"scene_seed\": {}, \"exposure_gain\": {:.9g}, \"noise_std\": {:.9g}, "
                   "\"shot_noise\": {:.9g}, \"motion_blur_exposure_s\": {:.9g}, \"frame_seed\": {}}}\n",

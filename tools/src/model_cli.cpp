@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// `wingman model widen-classes`.
+// `wingman model widen-classes` and `wingman model box-relation`.
 #include "wingman/tools/model_cli.hpp"
 
 #include "run_verb.hpp"
+
+#include "wingman/tools/box_relation_fit.hpp"
 
 #include <wingman/detector/class_widening.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
@@ -24,6 +26,8 @@ namespace fs = std::filesystem;
 struct ModelVerbs::State {
   CLI::App* model = nullptr;
   CLI::App* widen = nullptr;
+  CLI::App* relation = nullptr;
+  BoxRelationRequest rq;
   std::string cfg = "builtin:wingman-small", weights = "builtin:wingman-small", out_cfg, out_weights, iou_loss;
   float iou_normalizer = 0.0f;
   int classes = 4;
@@ -51,12 +55,40 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                       "Weight of that box loss written into every [yolo] (default: the model's)");
   s.widen->add_option("--out-cfg", s.out_cfg, "The widened .cfg to write")->required();
   s.widen->add_option("--out-weights", s.out_weights, "The widened .weights to write")->required();
+
+  BoxRelationRequest& rq = s.rq;
+  s.relation = s.model->add_subcommand(
+      "box-relation",
+      "Measure how a detector model's boxes relate to the target's bounding sphere on rendered images with known "
+      "geometry (`wingman dataset synth`, config/datasets/box_relation.yaml) and write the relation file the "
+      "localizer reads (target.box_relation); or --check a relation on other images");
+  s.relation->add_option("--data", rq.data, "A `wingman dataset synth` folder (images and meta with sphere_box)")
+      ->required();
+  s.relation->add_option("--split", rq.split, "Its split (default val)");
+  s.relation->add_option("--detector-config", rq.detector_config,
+                         "The detector's process configuration (default: its built-in defaults, as installed)");
+  s.relation->add_option("--out", rq.out, "Fit: the relation file to write (beside the model's weights)");
+  s.relation->add_option("--check", rq.check,
+                         "Evaluate this relation instead of fitting: sphere, builtin:wingman-small or a file");
+  s.relation->add_option("--model-name", rq.model_name, "The model's name written into the file (default wingman-small)");
+  s.relation->add_option("--min-iou", rq.min_iou, "A detection is the target's at this IoU with its outline box (default 0.3)");
+  s.relation->add_option("--max-images", rq.max_images, "At most this many images (default 0: all)");
 }
 
 ModelVerbs::~ModelVerbs() = default;
 
 int ModelVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   State& s = *s_;
+  if (*s.relation) {
+    return run_verb("wingman model box-relation", err, [&] {
+      s.rq.command_line = fmt::format("wingman model box-relation --data {} --split {}{}", s.rq.data, s.rq.split,
+                                      s.rq.detector_config.empty() ? "" : " --detector-config " + s.rq.detector_config);
+      const BoxRelationSummary summary = run_box_relation(s.rq, err);
+      out << summary.markdown();
+      if (s.rq.check.empty()) out << "wrote " << s.rq.out << "\n";
+      return 0;
+    });
+  }
   if (!*s.widen) return -1;
   return run_verb("wingman model widen-classes", err, [&] {
     const detector::DarknetModel model = detector::load_model(s.cfg, s.weights);

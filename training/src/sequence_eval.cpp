@@ -172,6 +172,7 @@ ClipTracker::ClipTracker(const localizer::LocalizerOptions& options, localizer::
     throw std::invalid_argument(fmt::format("ClipTracker: fps = {}: must be > 0", fps));
   options_.camera.scale_to_image = false;  // the camera is the frames' own
   localizer_ = std::make_unique<localizer::Localizer>(options_, camera_);
+  relation_ = localizer::BoxRelation::load(options_.sphere.box_relation);
 }
 
 ClipTracker::~ClipTracker() = default;
@@ -221,7 +222,8 @@ void ClipTracker::add_frame(int frame_index, const std::vector<detector::Box>& b
                                         Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (size_t i = 0; i < drone.size(); ++i) {
     const localizer::PixelBox box{drone[i]->cx, drone[i]->cy, drone[i]->w, drone[i]->h};
-    const localizer::LocalizeResult r = localizer::localize_box(box, camera_, options_.sphere);
+    const localizer::LocalizeResult r = localizer::localize_box(
+        box, camera_, options_.sphere, relation_.at(box.w, box.h, static_cast<double>(camera_.width())));
     if (r.ok && r.measurement.range_valid) p_in_cam[i] = r.measurement.p_target_in_cam;
   }
   for (const wingman::target_t& t : out.targets->targets) {

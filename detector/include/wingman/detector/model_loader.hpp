@@ -30,6 +30,12 @@ inline constexpr const char* kBuiltinPrefix = "builtin:";
 std::vector<std::string> builtin_cfg_names();
 std::vector<std::string> builtin_weights_names();
 
+/// The identity of a model's weights as detections_t.model_id carries it: "sha256:" and the first 16 hex digits of
+/// the SHA-256 of the .weights bytes (`weights`: a path or "builtin:wingman-small"); "" for "". A box relation
+/// (localizer/box_relation.hpp) names the model it was measured for this way. Throws std::runtime_error as
+/// load_weights does for a missing file or unknown built-in.
+std::string weights_model_id(const std::string& weights);
+
 /// Loads a network: `cfg` is a .cfg path or "builtin:<name>" (builtin_cfg_names()); `weights` is a .weights path or
 /// "builtin:wingman-small" (the shipped model; its .cfg must be builtin:wingman-small or a copy of it). Throws
 /// std::runtime_error naming the file, line and key (see parse_darknet_cfg, load_darknet_weights), or the unknown

@@ -2,6 +2,7 @@
 // The localizer's logic without LCM: detections and own poses in, targets out.
 #pragma once
 
+#include "wingman/localizer/box_relation.hpp"
 #include "wingman/localizer/camera_model.hpp"
 #include "wingman/localizer/extrinsics.hpp"
 #include "wingman/localizer/localizer_options.hpp"
@@ -63,8 +64,9 @@ class Localizer {
 
   /// Localizes and tracks one detections message. Only drones are localized and tracked: a box with
   /// class_id != 0 (common::kDroneClassId) is left out and counted in LocalizerOutput::non_drone and
-  /// non_drone_boxes(). Throws std::invalid_argument naming the field for a message that cannot be used at all
-  /// (other camera, other image size, out of order); the caller drops and counts it.
+  /// non_drone_boxes(). Boxes of SOURCE_CNN go through target.box_relation, ground-truth boxes are the sphere's.
+  /// Throws std::invalid_argument naming the field for a message that cannot be used at all (other camera, other
+  /// image size, out of order, a model_id the box relation was not measured for); the caller drops and counts it.
   LocalizerOutput on_detections(const wingman::detections_t& detections);
 
   /// The non-drone boxes of every message since construction that passed the camera, image size and order checks.
@@ -75,6 +77,7 @@ class Localizer {
                                           const std::vector<CameraMeasurement>& measurements) const;
 
   LocalizerOptions options_;
+  BoxRelation cnn_relation_;  // options_.sphere.box_relation, for SOURCE_CNN detections
   CameraModel camera_;
   Extrinsics extrinsics_;
   PoseBuffer poses_;

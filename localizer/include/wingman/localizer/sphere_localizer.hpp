@@ -2,6 +2,7 @@
 // Box -> 3D: the target is a sphere of known radius; its position in the camera frame from a detection box.
 #pragma once
 
+#include "wingman/localizer/box_relation.hpp"
 #include "wingman/localizer/camera_model.hpp"
 #include "wingman/localizer/measurement.hpp"
 
@@ -26,9 +27,16 @@ enum class RangeMethod {
 /// Options of the sphere localizer: the target's size, the range method and limits, the pixel noise model and
 /// the border rule. Keys as in the localizer's YAML.
 struct SphereLocalizerOptions {
-  /// Bounding-sphere radius of the target, metres. Default: DJI F450 with spinning propellers, r_spin = 0.348 m
+  /// Bounding-sphere radius of the target airframe, metres: the farthest point of the drone from its centre, the
+  /// propeller tips swept round included (r_spin). A physical fact of the airframe, the same for every detector: the
+  /// box relation below says how a model's boxes relate to this sphere. Default: DJI F450, 0.348 m
   /// (shared/meshes/README.md; the thesis used 0.29 m). Holybro X500 V2: 0.429, Tarot T650: 0.494, 3DR Iris: 0.390.
   double radius_m = 0.348;
+  /// How the CNN's boxes relate to the bounding sphere's box (box_relation.hpp): builtin:wingman-small (the shipped
+  /// model's, measured: models/wingman-small.boxes.yaml), the relation file beside another model's weights, or
+  /// sphere (boxes are the sphere's: ratio 1). Ground-truth detections (detections_t.SOURCE_GROUND_TRUTH) always use
+  /// sphere. A CNN detections_t whose model_id is not the relation's is dropped, naming both.
+  std::string box_relation = "builtin:wingman-small";
   /// "exact" (tangent planes, default), "thesis" (eq. 24 + eq. 32) or "thesis_eq33" (eq. 24 + eq. 33).
   std::string range_method = "exact";
   /// Distances below this are rejected, metres. Must exceed radius_m.
@@ -49,7 +57,10 @@ struct SphereLocalizerOptions {
 
   template <class V>
   void visit(V& v) {
-    v("target.radius_m", radius_m, "bounding-sphere radius of the target drone, metres (DJI F450: 0.348)");
+    v("target.radius_m", radius_m,
+      "bounding-sphere radius of the target airframe, propeller tips included, metres (DJI F450: 0.348)");
+    v("target.box_relation", box_relation,
+      "how the CNN's boxes relate to that sphere: builtin:wingman-small, a relation file, or sphere (ratio 1)");
     v("range.method", range_method, "exact (tangent planes), thesis (eq. 24 + 32) or thesis_eq33 (eq. 33)");
     v("range.min_m", min_range_m, "reject distances below this, metres (> target.radius_m)");
     v("range.max_m", max_range_m, "reject distances above this, metres");
@@ -90,8 +101,14 @@ struct LocalizeResult {
 /// Covariance: see docs/localization.md and sphere_localizer.cpp. cov_p_in_cam = J S J^T with J = dp/d(edges)
 /// and S = edge_px^2 I + centre_px^2 (1 on each axis's 2x2 block).
 ///
+/// Box relation: `scale` says what the box stands for (BoxRelation::at() for the box; the default: the bounding
+/// sphere's own box). The left/right edge planes lie width_ratio x radius_m from the centre and the top/bottom ones
+/// height_ratio x radius_m; scale.edge_noise_rel adds to noise.edge_rel in quadrature, and scale.range_sigma_rel adds
+/// range_sigma_rel^2 p p^T to the covariance.
+///
 /// Rejected (ok = false): a non-finite box field, w or h <= 0, a centre outside the image, no sphere fitting the
 /// edges, a distance outside [min_range_m, max_range_m]. Precondition: options.validate() is empty.
-LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, const SphereLocalizerOptions& options);
+LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, const SphereLocalizerOptions& options,
+                            const BoxScale& scale = {});
 
 }  // namespace wingman::localizer

@@ -112,6 +112,7 @@ class ClipTracker {
  private:
   localizer::LocalizerOptions options_;
   localizer::CameraModel camera_;
+  localizer::BoxRelation relation_;  // options_.sphere.box_relation, as the Localizer applies it
   double fps_;
   std::unique_ptr<localizer::Localizer> localizer_;
   std::map<int32_t, TrackRecord> tracks_;

@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: MIT
+// How a detector model's boxes relate to the target's bounding sphere, so that target.radius_m is the airframe's
+// real bounding radius whatever drew the boxes.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace wingman::localizer {
+
+/// A box relation file, or a box relation name, that cannot be used: the message names the file and key.
+class BoxRelationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What one box of a model stands for, relative to the box of the target's bounding sphere (same centre):
+/// the sphere box is the model's box divided by the ratios. Ground-truth sphere boxes: ratios 1, spreads 0.
+struct BoxScale {
+  double width_ratio = 1.0;    ///< model box width / sphere box width (> 0)
+  double height_ratio = 1.0;   ///< model box height / sphere box height (> 0)
+  /// Relative spread of the range this leaves (1.4826 x the median absolute deviation of range / true range, over
+  /// the measured boxes like this one): the view's share of the range error, which one ratio per box cannot remove.
+  /// Enters the measurement covariance along the line of sight (>= 0).
+  double range_sigma_rel = 0.0;
+  /// Frame-to-frame wander of each box edge as a fraction of the box's width (left/right) or height (top/bottom),
+  /// added to noise.edge_rel in quadrature (>= 0).
+  double edge_noise_rel = 0.0;
+};
+
+/// The relation of one detector model (or of exact sphere boxes), as measured by `wingman model box-relation` on
+/// renders of many airframes, views and ranges with known geometry (docs/localization.md, "Box relation"), and
+/// stored in a YAML file beside the model's weights (models/wingman-small.boxes.yaml for the shipped model, also
+/// built in).
+///
+/// The ratios are tabulated over what is known from the box alone: its width as a fraction of the image width (the
+/// detector resizes every image to its network, so this is the box's size in network pixels, and the range's
+/// proxy that does not depend on the airframe's size) and its aspect h / w (the view: side-on, from behind, from
+/// above). Between the centres of the width bins the ratios are interpolated linearly in log(width), and held
+/// beyond the first and last centre; aspect bins are steps.
+class BoxRelation {
+ public:
+  /// Exact sphere boxes (ratios 1, no spread): ground truth, or a detector trained on sphere boxes.
+  static BoxRelation sphere();
+
+  /// Reads a relation: "sphere", "builtin:wingman-small" (the shipped model's, built in), or a YAML file's path.
+  /// Throws BoxRelationError naming the file and key, or the unknown built-in name.
+  static BoxRelation load(const std::string& spec);
+
+  /// Parses the YAML text of a relation file; `source_name` names it in errors. Throws BoxRelationError.
+  static BoxRelation parse(const std::string& yaml_text, const std::string& source_name);
+
+  /// The ratios for a box of `box_width_px` x `box_height_px` in an image `image_width_px` wide.
+  /// Preconditions: all > 0 (otherwise the sphere's BoxScale is returned).
+  BoxScale at(double box_width_px, double box_height_px, double image_width_px) const;
+
+  /// The YAML text of this relation (what parse() reads back), with `header` as leading comment lines.
+  std::string to_yaml(const std::string& header) const;
+
+  /// The model the relation was measured for, as detections_t.model_id carries it ("sha256:<16 hex digits>");
+  /// "" for the sphere relation (valid for any source).
+  const std::string& model_id() const { return model_id_; }
+  /// A readable name: "sphere", "builtin:wingman-small" or the file's path.
+  const std::string& name() const { return name_; }
+  bool is_sphere() const { return table_.size_edges.empty(); }
+
+  /// "" when boxes of the model `detections_model_id` (detections_t.model_id) may use this relation: the sphere
+  /// relation, a relation without a model_id, a detector that does not say (""), or the same id. Otherwise one line
+  /// naming both ids and the key to set.
+  std::string check_model(const std::string& detections_model_id) const;
+
+  /// The file's content (keys `box_relation.*`, read by the one config loader), for `wingman model box-relation`
+  /// and tests. size_edges: n + 1 increasing box-width fractions of the image width; aspect_edges: m + 1 increasing
+  /// h / w values; the tables n x m, row-major by size bin.
+  struct Table {
+    std::string model;          ///< the model's name (informative)
+    std::string model_id;       ///< "sha256:<16 hex digits>" of the weights (detections_t.model_id)
+    std::string measured_with;  ///< the command that measured it (informative)
+    double edge_noise_rel = 0.0;  ///< BoxScale::edge_noise_rel for every box, >= 0
+    std::vector<double> size_edges, aspect_edges;
+    std::vector<double> width_ratio, height_ratio, range_sigma_rel;
+    std::vector<int> count;  ///< boxes measured per bin (informative; 0: the bin was filled from its neighbours)
+
+    template <class V>
+    void visit(V& v) {
+      v("box_relation.model", model, "the model's name");
+      v("box_relation.model_id", model_id, "sha256: and the first 16 hex digits of the weights' SHA-256");
+      v("box_relation.measured_with", measured_with, "the command that measured this file");
+      v("box_relation.edge_noise_rel", edge_noise_rel,
+        "frame-to-frame wander of each box edge, fraction of the box's width/height");
+      v("box_relation.size_edges", size_edges, "box width / image width: edges of the size bins (n + 1)");
+      v("box_relation.aspect_edges", aspect_edges, "box height / width: edges of the aspect bins (m + 1)");
+      v("box_relation.width_ratio", width_ratio, "model box width / sphere box width, n x m row-major (median)");
+      v("box_relation.height_ratio", height_ratio, "model box height / sphere box height, n x m (median)");
+      v("box_relation.range_sigma_rel", range_sigma_rel,
+        "relative spread of the range after the ratios, n x m (1.4826 MAD)");
+      v("box_relation.count", count, "boxes measured per bin, n x m (0: filled from neighbours)");
+    }
+    /// One "key = value: rule" line per problem; empty when consistent.
+    std::vector<std::string> validate() const;
+  };
+  /// Builds a relation from a table; throws BoxRelationError (source `name`) when it is inconsistent.
+  static BoxRelation from_table(Table table, const std::string& name);
+  const Table& table() const { return table_; }
+
+ private:
+  std::string name_ = "sphere";
+  std::string model_id_;
+  Table table_;  // size_edges empty: the sphere relation
+};
+
+/// The shipped model's relation file (models/wingman-small.boxes.yaml), embedded at build time.
+const char* builtin_small_box_relation();
+
+}  // namespace wingman::localizer

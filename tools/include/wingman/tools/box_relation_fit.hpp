@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+// `wingman model box-relation`: measures how a detector model's boxes relate to the target's bounding sphere on
+// rendered images with known geometry, and writes the relation file the localizer reads (target.box_relation).
+#pragma once
+
+#include <wingman/localizer/box_relation.hpp>
+
+#include <cstdint>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace wingman::tools {
+
+/// What to measure on, and with which detector.
+struct BoxRelationRequest {
+  /// A folder written by `wingman dataset synth` (images/<split>/*, meta/<split>/*.json with sphere_box).
+  std::string data;
+  std::string split = "val";
+  /// The detector's process configuration (config/detector.yaml keys); "" = its built-in defaults, which are
+  /// what `cmake --install` installs. Its model.* and detection.* keys decide the boxes measured.
+  std::string detector_config;
+  /// Evaluate this relation ("sphere", "builtin:wingman-small" or a file) instead of fitting one.
+  std::string check;
+  /// Fitting: the relation file to write (required unless check is given).
+  std::string out;
+  /// The model's name written into the file (informative).
+  std::string model_name = "wingman-small";
+  /// Box-width bin edges (fraction of the image width) and aspect (h / w) bin edges of the fitted table.
+  std::vector<double> size_edges = {0.004, 0.008, 0.016, 0.032, 0.064, 0.128, 0.256, 0.8};
+  std::vector<double> aspect_edges = {0.05, 0.5, 0.75, 1.0, 1.5, 20.0};
+  /// Bins with fewer measured boxes are filled from their neighbours.
+  int min_bin_count = 8;
+  /// The frame-to-frame edge wander written into the file (BoxScale::edge_noise_rel; not measurable on single
+  /// images).
+  double edge_noise_rel = 0.1;
+  /// A detection belongs to the target when its IoU with the target's outline box reaches this.
+  double min_iou = 0.3;
+  int max_images = 0;  ///< 0: all
+  std::string command_line;  ///< written into the file as measured_with
+};
+
+/// The range error of the measured boxes under a relation, as range / true range - 1 (the localizer's exact method
+/// with the true camera and the airframe's true bounding radius).
+struct RangeErrorStats {
+  int64_t n = 0;
+  double median = 0;  ///< median relative error
+  double mad = 0;     ///< 1.4826 x median absolute deviation
+  double p90_abs = 0;  ///< 90th percentile of |error|
+};
+
+/// What a run measured.
+struct BoxRelationSummary {
+  int64_t images = 0, matched = 0, unmatched = 0, skipped_truncated = 0;
+  /// Relative range error with the sphere relation (ratio 1: the radius taken as is) and with the relation
+  /// fitted or checked, overall, per airframe and per true-range bin ("2-5 m", ...).
+  RangeErrorStats sphere_all, relation_all;
+  std::map<std::string, RangeErrorStats> sphere_by_airframe, relation_by_airframe, relation_by_range;
+  std::string relation_name;
+  /// The report as a Markdown table (what the verb prints).
+  std::string markdown() const;
+};
+
+/// Runs the measurement (and with request.out set and no check, writes the fitted relation there).
+/// Throws std::invalid_argument for bad options, std::runtime_error naming the file for unreadable data.
+BoxRelationSummary run_box_relation(const BoxRelationRequest& request, std::ostream& progress);
+
+}  // namespace wingman::tools

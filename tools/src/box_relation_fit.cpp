@@ -1,0 +1,336 @@
+// SPDX-License-Identifier: MIT
+// `wingman model box-relation`: detector boxes against the exact bounding-sphere boxes of rendered targets.
+#include "wingman/tools/box_relation_fit.hpp"
+
+#include <wingman/common/config.hpp>
+#include <wingman/detector/detector_options.hpp>
+#include <wingman/detector/input_size.hpp>
+#include <wingman/detector/model_loader.hpp>
+#include <wingman/detector/sized_detector.hpp>
+#include <wingman/localizer/camera_model.hpp>
+#include <wingman/localizer/sphere_localizer.hpp>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace wingman::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One rendered target and the detector's box on it.
+struct Sample {
+  std::string airframe;
+  double range_m = 0, radius_m = 0;
+  double det_w = 0, det_h = 0, image_w = 0;
+  double width_ratio = 0, height_ratio = 0;  // detected / sphere box
+  localizer::PixelBox det;
+  std::shared_ptr<const localizer::CameraModel> camera;
+};
+
+localizer::Distortion distortion_of(const std::string& name, const std::string& file) {
+  if (name == "none") return localizer::Distortion::kNone;
+  if (name == "plumb_bob") return localizer::Distortion::kRadTan;
+  if (name == "rational_polynomial") return localizer::Distortion::kRationalPolynomial;
+  if (name == "equidistant") return localizer::Distortion::kEquidistant;
+  throw std::runtime_error(fmt::format("{}: camera.distortion_model '{}' is not one the localizer knows", file, name));
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const size_t k = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(k), v.end());
+  double m = v[k];
+  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(k)));
+  return m;
+}
+
+RangeErrorStats stats_of(const std::vector<double>& e) {
+  RangeErrorStats s;
+  s.n = static_cast<int64_t>(e.size());
+  if (e.empty()) return s;
+  s.median = median(e);
+  std::vector<double> dev, abs_e;
+  for (double x : e) dev.push_back(std::abs(x - s.median)), abs_e.push_back(std::abs(x));
+  s.mad = 1.4826 * median(dev);
+  std::sort(abs_e.begin(), abs_e.end());
+  s.p90_abs = abs_e[std::min(abs_e.size() - 1, static_cast<size_t>(0.9 * static_cast<double>(abs_e.size())))];
+  return s;
+}
+
+double iou(const localizer::PixelBox& a, const localizer::PixelBox& b) {
+  const double x0 = std::max(a.cx - a.w / 2, b.cx - b.w / 2), x1 = std::min(a.cx + a.w / 2, b.cx + b.w / 2);
+  const double y0 = std::max(a.cy - a.h / 2, b.cy - b.h / 2), y1 = std::min(a.cy + a.h / 2, b.cy + b.h / 2);
+  const double inter = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0);
+  const double uni = a.w * a.h + b.w * b.h - inter;
+  return uni > 0 ? inter / uni : 0;
+}
+
+localizer::PixelBox read_box(const YAML::Node& n) {
+  return {n["cx"].as<double>(), n["cy"].as<double>(), n["w"].as<double>(), n["h"].as<double>()};
+}
+
+/// Relative range error of a sample under `relation`: the exact localizer with the true camera and radius.
+std::optional<double> range_error(const Sample& s, const localizer::BoxRelation& relation) {
+  localizer::SphereLocalizerOptions o;
+  o.radius_m = s.radius_m;
+  o.box_relation = "sphere";
+  o.min_range_m = s.radius_m * 1.01;
+  o.max_range_m = 1e4;
+  const localizer::LocalizeResult r = localizer::localize_box(s.det, *s.camera, o, relation.at(s.det_w, s.det_h, s.image_w));
+  if (!r.ok || !r.measurement.range_valid) return std::nullopt;
+  return r.measurement.range / s.range_m - 1.0;
+}
+
+std::string range_bin(double range_m) {
+  static const double edges[] = {2, 5, 10, 15, 20, 30};
+  for (size_t i = 0; i + 1 < std::size(edges); ++i)
+    if (range_m < edges[i + 1]) return fmt::format("{:>2g}-{:g} m", edges[i], edges[i + 1]);
+  return "30+ m";
+}
+
+/// The fitted table: per bin the median ratios; sparse bins take the nearest size bin of the same aspect with data,
+/// else the pooled median of that size, else of everything.
+localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std::vector<Sample>& samples) {
+  localizer::BoxRelation::Table t;
+  t.model = rq.model_name;
+  t.measured_with = rq.command_line;
+  t.edge_noise_rel = rq.edge_noise_rel;
+  t.size_edges = rq.size_edges;
+  t.aspect_edges = rq.aspect_edges;
+  const size_t n = t.size_edges.size() - 1, m = t.aspect_edges.size() - 1;
+  const auto bin = [](const std::vector<double>& edges, double x) {
+    const auto it = std::upper_bound(edges.begin(), edges.end(), x);
+    return static_cast<size_t>(std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
+  };
+  std::vector<std::vector<double>> kw(n * m), kh(n * m), kw_size(n), kh_size(n);
+  std::vector<double> kw_all, kh_all;
+  for (const Sample& s : samples) {
+    const size_t i = bin(t.size_edges, s.det_w / s.image_w), a = bin(t.aspect_edges, s.det_h / s.det_w);
+    kw[i * m + a].push_back(s.width_ratio), kh[i * m + a].push_back(s.height_ratio);
+    kw_size[i].push_back(s.width_ratio), kh_size[i].push_back(s.height_ratio);
+    kw_all.push_back(s.width_ratio), kh_all.push_back(s.height_ratio);
+  }
+  const auto enough = [&](size_t c) { return static_cast<int>(kw[c].size()) >= rq.min_bin_count; };
+  t.width_ratio.assign(n * m, 0), t.height_ratio.assign(n * m, 0), t.count.assign(n * m, 0);
+  t.range_sigma_rel.assign(n * m, 0);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t a = 0; a < m; ++a) {
+      const size_t c = i * m + a;
+      t.count[c] = static_cast<int>(kw[c].size());
+      size_t src = c;
+      if (!enough(c)) {
+        src = n * m;  // none yet
+        for (size_t d = 1; d < n && src == n * m; ++d) {
+          if (i >= d && enough((i - d) * m + a)) src = (i - d) * m + a;
+          else if (i + d < n && enough((i + d) * m + a)) src = (i + d) * m + a;
+        }
+        if (!enough(c)) t.count[c] = 0;
+      }
+      if (src < n * m) {
+        t.width_ratio[c] = median(kw[src]), t.height_ratio[c] = median(kh[src]);
+      } else if (static_cast<int>(kw_size[i].size()) >= rq.min_bin_count) {
+        t.width_ratio[c] = median(kw_size[i]), t.height_ratio[c] = median(kh_size[i]);
+      } else {
+        t.width_ratio[c] = median(kw_all), t.height_ratio[c] = median(kh_all);
+      }
+    }
+  }
+  return t;
+}
+
+}  // namespace
+
+std::string BoxRelationSummary::markdown() const {
+  std::string s = fmt::format(
+      "{} images: {} targets found by the detector (IoU with the outline box >= the threshold), {} not found, {} "
+      "skipped (cut by the image border)\n\n",
+      images, matched, unmatched, skipped_truncated);
+  s += fmt::format("Range error (range / true range - 1), the airframe's true bounding radius, exact localizer:\n\n");
+  s += "| boxes | n | sphere (ratio 1): median | MAD | " + relation_name + ": median | MAD | |error| p90 |\n";
+  s += "|---|---|---|---|---|---|---|\n";
+  const auto row = [&](const std::string& name, const RangeErrorStats& a, const RangeErrorStats& b) {
+    return fmt::format("| {} | {} | {:+.3f} | {:.3f} | {:+.3f} | {:.3f} | {:.3f} |\n", name, b.n, a.median, a.mad,
+                       b.median, b.mad, b.p90_abs);
+  };
+  s += row("all", sphere_all, relation_all);
+  for (const auto& [name, st] : relation_by_airframe) {
+    const auto it = sphere_by_airframe.find(name);
+    s += row(name, it == sphere_by_airframe.end() ? RangeErrorStats{} : it->second, st);
+  }
+  s += "\nBy true range (" + relation_name + "):\n\n| range | n | median | MAD | |error| p90 |\n|---|---|---|---|---|\n";
+  for (const auto& [name, st] : relation_by_range)
+    s += fmt::format("| {} | {} | {:+.3f} | {:.3f} | {:.3f} |\n", name, st.n, st.median, st.mad, st.p90_abs);
+  return s;
+}
+
+BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& progress) {
+  if (rq.data.empty()) throw std::invalid_argument("--data: a `wingman dataset synth` folder is required");
+  if (rq.check.empty() && rq.out.empty()) throw std::invalid_argument("--out FILE (fit) or --check RELATION is required");
+  if (rq.min_iou <= 0 || rq.min_iou > 1) throw std::invalid_argument(fmt::format("--min-iou {}: expected (0, 1]", rq.min_iou));
+  const fs::path meta_dir = fs::path(rq.data) / "meta" / rq.split;
+  if (!fs::is_directory(meta_dir))
+    throw std::runtime_error(fmt::format("{}: no such folder (expected a `wingman dataset synth` set)", meta_dir.string()));
+  std::vector<fs::path> metas;
+  for (const auto& e : fs::directory_iterator(meta_dir))
+    if (e.path().extension() == ".json") metas.push_back(e.path());
+  std::sort(metas.begin(), metas.end());
+  if (rq.max_images > 0 && metas.size() > static_cast<size_t>(rq.max_images)) metas.resize(static_cast<size_t>(rq.max_images));
+  if (metas.empty()) throw std::runtime_error(meta_dir.string() + ": no .json metadata");
+
+  detector::DetectorOptions dopt;
+  if (!rq.detector_config.empty()) dopt = common::load_options<detector::DetectorOptions>(rq.detector_config);
+  const std::string model_id = detector::weights_model_id(dopt.weights);
+  auto make_backend = [&](const detector::DarknetModel& sized) {
+    return detector::make_backend(dopt.backend, sized, dopt.opencl, 1, nullptr);
+  };
+  detector::SizedDetector pipeline(dopt.detection, detector::load_model(dopt.cfg, dopt.weights),
+                                   *detector::InputSize::parse(dopt.input_size), make_backend);
+
+  BoxRelationSummary summary;
+  std::vector<Sample> samples;
+  auto last = std::chrono::steady_clock::now();
+  for (size_t k = 0; k < metas.size(); ++k) {
+    const std::string file = metas[k].string();
+    YAML::Node meta;
+    try {
+      meta = YAML::LoadFile(file);
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(fmt::format("{}: not readable JSON: {}", file, e.what()));
+    }
+    ++summary.images;
+    try {
+      if (!meta["sphere_box"] || meta["sphere_box"].IsNull())
+        throw std::runtime_error("sphere_box: missing (render the set with this version of `wingman dataset synth`)");
+      if (meta["box"]["truncated"].as<bool>()) {
+        ++summary.skipped_truncated;
+        continue;
+      }
+      const int W = meta["width"].as<int>(), H = meta["height"].as<int>();
+      const localizer::PixelBox sphere = read_box(meta["sphere_box"]), outline = read_box(meta["box"]);
+      if (sphere.cx - sphere.w / 2 < 1 || sphere.cx + sphere.w / 2 > W - 1 || sphere.cy - sphere.h / 2 < 1 ||
+          sphere.cy + sphere.h / 2 > H - 1) {
+        ++summary.skipped_truncated;  // the sphere's box leaves the image: no whole ratio
+        continue;
+      }
+      const YAML::Node cam = meta["camera"];
+      auto camera = std::make_shared<const localizer::CameraModel>(
+          W, H, cam["fx"].as<double>(), cam["fy"].as<double>(), cam["cx"].as<double>(), cam["cy"].as<double>(),
+          distortion_of(cam["distortion_model"].as<std::string>(), file),
+          cam["distortion_model"].as<std::string>() == "none" ? std::vector<double>{}
+                                                                : cam["coefficients"].as<std::vector<double>>());
+      const std::string image = (fs::path(rq.data) / meta["image"].as<std::string>()).string();
+      const cv::Mat bgr = cv::imread(image, cv::IMREAD_COLOR);
+      if (bgr.empty()) throw std::runtime_error(image + ": cannot read the image");
+      double best = 0;
+      localizer::PixelBox det;
+      for (const detector::Box& b : pipeline.detect(bgr)) {
+        if (b.class_id != 0) continue;
+        const localizer::PixelBox pb{b.cx, b.cy, b.w, b.h};
+        if (const double o = iou(pb, outline); o > best) best = o, det = pb;
+      }
+      if (best < rq.min_iou) {
+        ++summary.unmatched;
+        continue;
+      }
+      ++summary.matched;
+      Sample s;
+      const std::string airframe = meta["target"]["airframe"].as<std::string>();
+      s.airframe = airframe.find('.') != std::string::npos ? airframe : "procedural " + airframe;
+      s.range_m = meta["target"]["range_m"].as<double>();
+      s.radius_m = meta["target"]["bounding_radius_m"].as<double>();
+      s.det = det, s.det_w = det.w, s.det_h = det.h, s.image_w = W;
+      s.width_ratio = det.w / sphere.w, s.height_ratio = det.h / sphere.h;
+      s.camera = camera;
+      samples.push_back(std::move(s));
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(fmt::format("{}: {}", file, e.what()));
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(fmt::format("{}: {}", file, e.what()));
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last > std::chrono::seconds(10) || k + 1 == metas.size()) {
+      progress << fmt::format("wingman model box-relation: {}/{} images, {} targets found\n", k + 1, metas.size(),
+                              summary.matched)
+               << std::flush;
+      last = now;
+    }
+  }
+  if (samples.empty()) throw std::runtime_error("the detector found none of the targets: nothing to measure");
+
+  localizer::BoxRelation relation;
+  if (!rq.check.empty()) {
+    relation = localizer::BoxRelation::load(rq.check);
+    if (const std::string bad = relation.check_model(model_id); !bad.empty()) throw std::runtime_error(bad);
+  } else {
+    localizer::BoxRelation::Table table = fit_table(rq, samples);
+    table.model_id = model_id;
+    relation = localizer::BoxRelation::from_table(table, rq.out);
+  }
+  summary.relation_name = rq.check.empty() ? "fitted" : relation.name();
+
+  // Errors per sample; the fitted table's range_sigma_rel from the residuals in each bin.
+  const localizer::BoxRelation sphere = localizer::BoxRelation::sphere();
+  std::vector<double> e_sphere_all, e_rel_all;
+  std::map<std::string, std::vector<double>> e_sphere_af, e_rel_af, e_rel_range;
+  const auto& tb = relation.table();
+  const size_t m = tb.aspect_edges.empty() ? 1 : tb.aspect_edges.size() - 1;
+  std::vector<std::vector<double>> residual_by_bin(relation.is_sphere() ? 0 : (tb.size_edges.size() - 1) * m);
+  for (const Sample& s : samples) {
+    const auto es = range_error(s, sphere);
+    const auto er = range_error(s, relation);
+    if (!es || !er) continue;
+    e_sphere_all.push_back(*es), e_sphere_af[s.airframe].push_back(*es);
+    e_rel_all.push_back(*er), e_rel_af[s.airframe].push_back(*er), e_rel_range[range_bin(s.range_m)].push_back(*er);
+    if (!residual_by_bin.empty()) {
+      const auto bin = [](const std::vector<double>& edges, double x) {
+        const auto it = std::upper_bound(edges.begin(), edges.end(), x);
+        return static_cast<size_t>(
+            std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
+      };
+      residual_by_bin[bin(tb.size_edges, s.det_w / s.image_w) * m + bin(tb.aspect_edges, s.det_h / s.det_w)].push_back(*er);
+    }
+  }
+  summary.sphere_all = stats_of(e_sphere_all), summary.relation_all = stats_of(e_rel_all);
+  for (const auto& [k, v] : e_sphere_af) summary.sphere_by_airframe[k] = stats_of(v);
+  for (const auto& [k, v] : e_rel_af) summary.relation_by_airframe[k] = stats_of(v);
+  for (const auto& [k, v] : e_rel_range) summary.relation_by_range[k] = stats_of(v);
+
+  if (rq.check.empty()) {
+    localizer::BoxRelation::Table table = relation.table();
+    // The spread of the range left in each bin: its residuals' 1.4826 MAD about zero (a bin's median stays in the
+    // spread); sparse bins take the spread of all boxes.
+    std::vector<double> abs_all;
+    for (double e : e_rel_all) abs_all.push_back(std::abs(e));
+    const double all_sigma = 1.4826 * median(abs_all);
+    for (size_t c = 0; c < residual_by_bin.size(); ++c) {
+      std::vector<double> a;
+      for (double e : residual_by_bin[c]) a.push_back(std::abs(e));
+      table.range_sigma_rel[c] = static_cast<int>(a.size()) >= rq.min_bin_count ? 1.4826 * median(a) : all_sigma;
+    }
+    relation = localizer::BoxRelation::from_table(table, rq.out);
+    const std::string header = fmt::format(
+        "How {} ({}) draws boxes relative to the target's bounding sphere, measured by `wingman model box-relation`\n"
+        "on {} targets found in {} rendered images (docs/localization.md, \"Box relation\"). The localizer reads it as\n"
+        "target.box_relation. Range error on these images with the airframe's true radius: ratio 1 median {:+.3f},\n"
+        "this relation {:+.3f} (MAD {:.3f}).",
+        rq.model_name, model_id, summary.matched, summary.images, summary.sphere_all.median,
+        summary.relation_all.median, summary.relation_all.mad);
+    if (const fs::path parent = fs::path(rq.out).parent_path(); !parent.empty()) fs::create_directories(parent);
+    std::ofstream f(rq.out);
+    f << relation.to_yaml(header);
+    f.close();
+    if (!f) throw std::runtime_error(rq.out + ": cannot write the relation");
+  }
+  return summary;
+}
+
+}  // namespace wingman::tools
