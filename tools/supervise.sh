@@ -7,7 +7,7 @@
 #                           [--standalone DIR]
 #   --bin         folder of the executables (default: build/bin of this checkout; installed: /usr/local/bin)
 #   --etc         folder of the process configurations camera_driver.yaml, detector.yaml, localizer.yaml,
-#                 follower_ctrl.yaml, recorder.yaml (default: config/ of this checkout; installed: /usr/local/etc/wingman)
+#                 follower_ctrl.yaml, mavlink_bridge.yaml, recorder.yaml (default: config/ of this checkout; installed: /usr/local/etc/wingman)
 #   --log-dir     folder of the processes' logs and the recorder's recordings/ (created; default:
 #                 build/supervisor/log; installed: /var/log/wingman)
 #   --lcm-url     LCM URL of the bus (default: the file's, udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304)
@@ -34,10 +34,10 @@ while [ $# -gt 0 ]; do
 done
 template="$src/config/supervisor/wingman.conf"
 [ -r "$template" ] || { echo "supervise: cannot read $template" >&2; exit 2; }
-for exe in wingman-camera-driver wingman-detector wingman-localizer wingman-follower-ctrl wingman-recorder; do
+for exe in wingman-camera-driver wingman-detector wingman-localizer wingman-follower-ctrl wingman-mavlink wingman-recorder; do
   [ -x "$bin/$exe" ] || { echo "supervise: --bin $bin: no executable $exe (build first: tools/build.sh)" >&2; exit 2; }
 done
-for cfg in camera_driver detector localizer follower_ctrl recorder; do
+for cfg in camera_driver detector localizer follower_ctrl mavlink_bridge recorder; do
   [ -r "$etc/$cfg.yaml" ] || { echo "supervise: --etc $etc: cannot read $cfg.yaml" >&2; exit 2; }
 done
 if [ -n "$standalone" ]; then

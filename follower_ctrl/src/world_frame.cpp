@@ -28,14 +28,9 @@ OwnState own_state_from_message(const wingman::own_pose_t& m) {
           .normalized()
           .toRotationMatrix();
   if (m.frame == wingman::own_pose_t::FRAME_NED) {
-    Eigen::Matrix3d R_ned_to_enu;
-    R_ned_to_enu << 0, 1, 0,  //
-        1, 0, 0,              //
-        0, 0, -1;
-    const Eigen::Matrix3d R_flu_to_frd = Eigen::Vector3d(1, -1, -1).asDiagonal();
     s.p_body_in_world = swap_ned_enu(p);
     s.v_body_in_world = swap_ned_enu(v);
-    s.R_body_to_world = R_ned_to_enu * R * R_flu_to_frd;
+    s.R_body_to_world = common::swap_ned_frd_enu_flu(R);
   } else {
     s.p_body_in_world = p;
     s.v_body_in_world = v;
@@ -43,13 +38,6 @@ OwnState own_state_from_message(const wingman::own_pose_t& m) {
   }
   return s;
 }
-
-double wrap_pi(double a) {
-  a = std::remainder(a, 2.0 * M_PI);  // [-pi, pi]
-  return a <= -M_PI ? a + 2.0 * M_PI : a;
-}
-
-double swap_ned_enu_yaw(double yaw_rad) { return wrap_pi(0.5 * M_PI - yaw_rad); }
 
 bool horizontal_azimuth(const Eigen::Vector3d& v, double min_horizontal, double* azimuth_rad) {
   if (std::hypot(v.x(), v.y()) < min_horizontal) return false;

@@ -89,6 +89,8 @@ localizer: {instance: localizer}
 YAML
 # The recorder at its defaults: recordings/ in its working directory, the log folder (tools/supervise.sh makes it).
 printf 'output: {directory: "recordings"}\n' > "$etc/recorder.yaml"
+# The MAVLink bridge at its defaults: it listens for an autopilot on UDP 14540 (none comes; it stays DEGRADED).
+cp "$src/config/mavlink_bridge.yaml" "$etc/mavlink_bridge.yaml"
 "$src/tools/supervise.sh" --bin "$bin" --etc "$etc" --lcm-url "$url" --standalone "$tmp/sup" > /dev/null
 conf="$tmp/sup/supervisord.conf" suplog="$tmp/sup/supervisord.log"
 # The rendered file is the shipped one with the paths substituted: same lines otherwise.

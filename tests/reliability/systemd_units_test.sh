@@ -3,7 +3,7 @@
 # Checks config/systemd/ with `systemd-analyze verify`: the units are rendered for the build tree (the executables'
 # folder substituted for /usr/local/bin, as for an install there) and any warning or error fails the test. Also
 # checks that each unit runs its process with its configuration, restarts it always, stops it with SIGTERM and
-# that wingman.target wants all five. Exits 77 (skipped) when systemd-analyze is not installed.
+# that wingman.target wants all six. Exits 77 (skipped) when systemd-analyze is not installed.
 # Usage: tests/reliability/systemd_units_test.sh SRC_DIR BIN_DIR
 set -euo pipefail
 src=$(cd "$1" && pwd) bin=$(cd "$2" && pwd)
@@ -16,7 +16,7 @@ trap 'rm -rf "$tmp"' EXIT
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 declare -A cfg=([wingman-camera-driver]=camera_driver [wingman-detector]=detector [wingman-localizer]=localizer
-                [wingman-follower-ctrl]=follower_ctrl [wingman-recorder]=recorder)
+                [wingman-follower-ctrl]=follower_ctrl [wingman-mavlink]=mavlink_bridge [wingman-recorder]=recorder)
 for unit in "$src"/config/systemd/*; do sed "s|/usr/local/bin/|$bin/|g" "$unit" > "$tmp/$(basename "$unit")"; done
 for exe in "${!cfg[@]}"; do
   u="$src/config/systemd/$exe.service"
@@ -35,4 +35,4 @@ if ! systemd-analyze verify --man=no "$tmp"/wingman.target "$tmp"/wingman-*.serv
   fail "systemd-analyze verify:"; cat "$tmp/verify.txt"
 fi
 [ "$failures" -eq 0 ] || exit 1
-echo "systemd_units_test: 5 units and wingman.target verified ($(systemd-analyze --version | head -n 1))"
+echo "systemd_units_test: ${#cfg[@]} units and wingman.target verified ($(systemd-analyze --version | head -n 1))"
