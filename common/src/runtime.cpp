@@ -69,6 +69,13 @@ std::string RuntimeOptions::validate() const {
   if (is_file_url(lcm_url) && lcm_url.find("mode=") != std::string::npos && lcm_url.find("mode=r") == std::string::npos)
     return fmt::format("--lcm-url = '{}': a log opened for writing cannot also be the input; use --lcm-out for it",
                        lcm_url);
+  if (const std::string in = lcm_in.empty() ? lcm_url : lcm_in; is_file_url(in)) {
+    try {
+      parse_lcm_file_url(in);
+    } catch (const std::invalid_argument& e) {
+      return fmt::format("{}: {}", lcm_in.empty() ? "--lcm-url" : "--lcm-in", e.what());
+    }
+  }
   if (is_file_url(lcm_out) && lcm_out.find("mode=w") == std::string::npos &&
       lcm_out.find("mode=a") == std::string::npos)
     return fmt::format("--lcm-out = '{}': a file output needs '?mode=w' (or mode=a)", lcm_out);
@@ -170,18 +177,81 @@ lcm::LCM& Runtime::input() {
   return *lcm_in_;
 }
 
+void Runtime::subscribe_file(const std::string& channel, RawHandler handler) {
+  file_subscriptions_.emplace_back(std::regex("^" + channel + "$"), std::move(handler));
+}
+
+bool Runtime::spin_file_once(int timeout_ms) {
+  if (!log_in_) {
+    const LcmFileUrl url = parse_lcm_file_url(in_url_);
+    LcmLogReadOptions read_options;
+    read_options.skip_corrupt = options_.skip_corrupt_log;
+    try {
+      log_in_ = std::make_unique<LcmLogReader>(url.path, read_options);
+    } catch (const LcmLogError& e) {
+      throw std::runtime_error(fmt::format("cannot open LCM input log '{}': {}", in_url_, e.what()));
+    }
+    log_speed_ = url.speed;
+  }
+  if (status_.state() == wingman::status_t::STATE_STARTING) status_.set_state(wingman::status_t::STATE_OK, "");
+  if (!log_pending_) {
+    log_pending_ = log_in_->read_next();  // a corrupt event throws (exit 1 naming its offset) unless skipped
+    if (log_in_->corrupt_events() > log_corrupt_counted_) {
+      const int64_t n = log_in_->corrupt_events() - log_corrupt_counted_;
+      log_corrupt_counted_ = log_in_->corrupt_events();
+      const std::string line =
+          fmt::format("{} (skipped: --skip-corrupt-log; {} corrupt stretch(es), {} bytes so far)",
+                      log_in_->first_corruption(), log_in_->corrupt_events(), log_in_->skipped_bytes());
+      spdlog::warn("{}", line);
+      status_.items_dropped(in_url_, n, line);
+    }
+    if (!log_pending_) {
+      end_of_input_ = true;
+      stop_reason_ = "end of input log";
+      heartbeat_if_due();
+      return false;
+    }
+  }
+  if (log_speed_ > 0) {  // the log's pace, divided by the speed
+    const auto now = std::chrono::steady_clock::now();
+    if (log_first_utime_ < 0) {
+      log_first_utime_ = log_pending_->timestamp;
+      log_start_ = now;
+    }
+    const double due_s = static_cast<double>(log_pending_->timestamp - log_first_utime_) * 1e-6 / log_speed_;
+    const auto due = log_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(std::max(0.0, due_s)));
+    if (now < due) {
+      const auto wait_ms = std::chrono::duration_cast<std::chrono::milliseconds>(due - now).count() + 1;
+      pollfd fd{wake_fd_, POLLIN, 0};
+      if (poll(&fd, 1, static_cast<int>(std::min<int64_t>(std::max(0, timeout_ms), wait_ms))) > 0) {
+        uint64_t count = 0;
+        [[maybe_unused]] const ssize_t n = read(wake_fd_, &count, sizeof count);
+      }
+      heartbeat_if_due();
+      return !stop_requested();
+    }
+  }
+  const LcmLogEvent* ev = log_pending_;
+  log_pending_ = nullptr;
+  lcm::ReceiveBuffer rbuf{};
+  rbuf.data = const_cast<void*>(ev->data);
+  rbuf.data_size = static_cast<uint32_t>(ev->datalen);
+  rbuf.recv_utime = ev->timestamp;
+  for (auto& [re, handle] : file_subscriptions_) {
+    if (std::regex_match(ev->channel, re)) handle(&rbuf, ev->channel);
+  }
+  heartbeat_if_due();
+  return !stop_requested();
+}
+
 bool Runtime::spin_once(int timeout_ms) {
   g_starting.store(false);
   if (stop_requested() || end_of_input_) return false;
+  if (input_is_file_) return spin_file_once(timeout_ms);
   lcm::LCM& in = input();
   if (status_.state() == wingman::status_t::STATE_STARTING) status_.set_state(wingman::status_t::STATE_OK, "");
-  if (input_is_file_) {
-    // A log read with speed=0 delivers its next event on every handle(); -1 means the end of the file.
-    if (in.handle() != 0) {
-      end_of_input_ = true;
-      stop_reason_ = "end of input log";
-    }
-  } else {
+  {
     // Wait for LCM's descriptor or a wake(); then handle what is there without blocking again.
     pollfd fds[2] = {{in.getFileno(), POLLIN, 0}, {wake_fd_, POLLIN, 0}};
     const int ready = poll(fds, 2, std::max(0, timeout_ms));
@@ -245,6 +315,8 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
                "Publish status after every handled message (for `wingman replay --lockstep`)");
   app.add_option("--status-period", ro.status_period_s, "Heartbeat period, seconds (default 1)");
   app.add_option("--log-level", ro.log_level, "trace, debug, info, warn or error (default info)");
+  app.add_flag("--skip-corrupt-log", ro.skip_corrupt_log,
+               "A corrupt event of a file:// input is skipped and counted (default: exit 1 naming its byte offset)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

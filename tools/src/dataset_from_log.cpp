@@ -2,6 +2,7 @@
 // `wingman dataset from-log`: a flight log's camera frames and ground-truth boxes as a YOLO dataset.
 #include "wingman/tools/dataset_from_log.hpp"
 
+#include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detector/preprocess.hpp>
 #include <wingman/ground_truth_t.hpp>
@@ -89,8 +90,7 @@ DatasetFromLogSummary run_dataset_from_log(const DatasetFromLogRequest& request,
                                       : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 3};
 
   for (const std::string& log_path : request.logs) {
-    lcm::LogFile log(log_path, "r");
-    if (!log.good()) throw std::runtime_error(fmt::format("{}: cannot open LCM log for reading", log_path));
+    common::LcmLogReader log(log_path);  // a corrupt event throws, naming its byte offset
     const std::string stem = fs::path(log_path).stem().string();
     Pending pending;
     int64_t images_seen = 0, truth_seen = 0, written_here = 0;
@@ -144,7 +144,7 @@ DatasetFromLogSummary run_dataset_from_log(const DatasetFromLogRequest& request,
         it = pending.truth.erase(it);
     };
 
-    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    while (const common::LcmLogEvent* ev = log.read_next()) {
       if (ev->channel == request.image_channel) {
         wingman::image_t image;
         if (image.decode(ev->data, 0, ev->datalen) < 0 || !common::validate_message(image).empty()) {

@@ -6,6 +6,7 @@
 #include "log_progress.hpp"
 #include "wingman/tools/report.hpp"
 
+#include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/ground_truth_t.hpp>
@@ -35,7 +36,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Decodes and validates `ev` as Msg; false (counted by the caller) when it is not one or is malformed.
 template <class Msg>
-bool decode(const lcm::LogEvent& ev, Msg* m) {
+bool decode(const common::LcmLogEvent& ev, Msg* m) {
   if (lcm_fingerprint(ev.data, ev.datalen) != static_cast<uint64_t>(Msg::getHash())) return false;
   if (m->decode(ev.data, 0, ev.datalen) < 0) return false;
   return common::validate_message(*m).empty();
@@ -212,8 +213,7 @@ EvalResult evaluate_log(const EvalOptions& o) {
   std::ifstream probe(o.log, std::ios::binary);
   if (!probe) throw std::runtime_error("wingman eval: cannot read the log '" + o.log + "'");
   probe.close();
-  lcm::LogFile file(o.log, "r");
-  if (!file.good()) throw std::runtime_error("wingman eval: cannot open the LCM log '" + o.log + "'");
+  common::LcmLogReader file(o.log);  // a corrupt event throws, naming its byte offset
 
   struct Estimate {
     int64_t utime;   // predicted_utime
@@ -237,8 +237,8 @@ EvalResult evaluate_log(const EvalOptions& o) {
   size_t targets_messages = 0;
   EvalResult r;
 
-  LogProgress progress(o.progress, o.log, file.getFilePtr());
-  while (const lcm::LogEvent* ev = file.readNextEvent()) {
+  LogProgress progress(o.progress, o.log, file.file_ptr());
+  while (const common::LcmLogEvent* ev = file.read_next()) {
     progress.tick();
     if (ev->channel == o.truth_channel) {
       wingman::ground_truth_t g;

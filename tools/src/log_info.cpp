@@ -4,6 +4,7 @@
 
 #include "lcm_fingerprint.hpp"
 
+#include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detector/preprocess.hpp>
 
@@ -39,9 +40,10 @@ std::pair<uint64_t, std::pair<std::string, Decoder>> entry() {
 
 }  // namespace
 
-LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png) {
-  lcm::LogFile log(log_path, "r");
-  if (!log.good()) throw std::runtime_error(fmt::format("{}: cannot open LCM log for reading", log_path));
+LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png, bool skip_corrupt) {
+  common::LcmLogReadOptions read_options;
+  read_options.skip_corrupt = skip_corrupt;
+  common::LcmLogReader log(log_path, read_options);  // a corrupt event throws, naming its byte offset
   const std::map<uint64_t, std::pair<std::string, Decoder>> types = {
       entry<wingman::image_t>(),       entry<wingman::detections_t>(), entry<wingman::own_pose_t>(),
       entry<wingman::targets_t>(),     entry<wingman::setpoint_t>(),   entry<wingman::status_t>(),
@@ -49,7 +51,7 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
   LogSummary summary;
   std::map<std::string, size_t> index;
   std::vector<uint8_t> last_image;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+  while (const common::LcmLogEvent* ev = log.read_next()) {
     auto [it, fresh] = index.emplace(ev->channel, summary.channels.size());
     if (fresh)
       summary.channels.push_back(ChannelSummary{ev->channel, ev->channel == "LCM_SELF_TEST" ? "(LCM internal)" : "?"});
@@ -88,6 +90,9 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
         throw std::runtime_error(fmt::format("{}: cannot write the snapshot", snapshot_png));
     }
   }
+  summary.corrupt_events = log.corrupt_events();
+  summary.corrupt_bytes = log.skipped_bytes();
+  summary.first_corruption = log.first_corruption();
   return summary;
 }
 
@@ -99,6 +104,9 @@ std::string LogSummary::report() const {
     s += fmt::format("{:<20} {:<22} {:>7} {:>11} {:>9.2f} {:>8}\n", c.channel, c.type, c.count, c.bytes, span,
                      c.undecodable);
   }
+  if (corrupt_events > 0)
+    s += fmt::format("corrupt: {} stretch(es), {} bytes skipped; the first: {}\n", corrupt_events, corrupt_bytes,
+                     first_corruption);
   if (!statuses.empty()) {
     s += "last status of each process:\n";
     for (const auto& [process, line] : statuses) s += fmt::format("  {:<16} {}\n", process, line);

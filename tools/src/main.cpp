@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
   r->add_option("--step-timeout", replay.step_timeout_s,
                 "Seconds to wait for the pipeline to settle after each message");
   r->add_option("--max-events", replay.max_events, "Play at most this many events (0 = all)");
+  r->add_flag("--skip-corrupt", replay.skip_corrupt,
+              "Skip and count corrupt log events (default: stop at the first with an error naming its byte offset)");
 
   SpyOptions spy;
   auto* s = app.add_subcommand("spy", "Start lcm-spy with the Wingman message types");
@@ -63,10 +65,13 @@ int main(int argc, char** argv) {
   mv->add_option("--fps", video.fps, "Frames per second (default 30)");
 
   std::string info_log, info_snapshot;
+  bool info_skip_corrupt = false;
   auto* li =
       app.add_subcommand("loginfo", "Summarize an LCM log: channels, types, counts, time spans, process statuses");
   li->add_option("log", info_log, "LCM log file")->required();
   li->add_option("--snapshot", info_snapshot, "Save the last image_t as this PNG file");
+  li->add_flag("--skip-corrupt", info_skip_corrupt,
+               "Skip and count corrupt log events (default: stop at the first with an error naming its byte offset)");
 
   LocalizeToolOptions localize;
   auto* lo = app.add_subcommand(
@@ -240,7 +245,7 @@ int main(int argc, char** argv) {
       std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;
     }
     if (*li) {
-      const LogSummary summary = summarize_log(info_log, info_snapshot);
+      const LogSummary summary = summarize_log(info_log, info_snapshot, info_skip_corrupt);
       std::cout << summary.report() << std::flush;
       if (!info_snapshot.empty() && summary.images_with_pixels > 0)
         std::cout << "last image saved to " << info_snapshot << std::endl;

@@ -2,6 +2,7 @@
 // `wingman replay`: plays an LCM log, optionally in lockstep with the pipeline's processes.
 #include "wingman/tools/replay.hpp"
 
+#include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/status_t.hpp>
 
@@ -99,6 +100,7 @@ std::string ReplayOptions::validate() const {
 std::string ReplaySummary::one_line() const {
   std::string s = fmt::format("replay {}: {} events played, {} skipped, {} recorded, {:.2f} s", ok ? "done" : "FAILED",
                               events_played, events_skipped, messages_recorded, wall_s);
+  if (corrupt_events > 0) s += fmt::format(", {} corrupt stretch(es) of the log skipped", corrupt_events);
   if (!error.empty()) s += ": " + error;
   return s;
 }
@@ -108,8 +110,9 @@ ReplaySummary run_replay(const ReplayOptions& options) {
   const auto t_start = Clock::now();
   ReplaySummary summary;
 
-  lcm::LogFile in(options.input_log, "r");
-  if (!in.good()) throw std::runtime_error(fmt::format("{}: cannot open LCM log for reading", options.input_log));
+  common::LcmLogReadOptions read_options;
+  read_options.skip_corrupt = options.skip_corrupt;
+  common::LcmLogReader in(options.input_log, read_options);  // a corrupt event throws, naming its byte offset
   std::unique_ptr<lcm::LogFile> record;
   if (!options.record_log.empty()) {
     record = std::make_unique<lcm::LogFile>(options.record_log, "w");
@@ -165,7 +168,8 @@ ReplaySummary run_replay(const ReplayOptions& options) {
   int64_t first_timestamp = -1;
   const auto play_start = Clock::now();
   while (options.max_events == 0 || summary.events_played < options.max_events) {
-    const lcm::LogEvent* ev = in.readNextEvent();
+    const common::LcmLogEvent* ev = in.read_next();
+    summary.corrupt_events = in.corrupt_events();
     if (ev == nullptr) break;
     const bool play = !is_status_channel(ev->channel) && !is_lcm_internal(ev->channel) &&
                       !stage_outputs.count(ev->channel) &&

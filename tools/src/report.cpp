@@ -5,6 +5,7 @@
 #include "lcm_fingerprint.hpp"
 #include "log_progress.hpp"
 
+#include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/detector/preprocess.hpp>
 #include <wingman/image_t.hpp>
 
@@ -253,11 +254,10 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
   std::set<size_t> wanted;  // indices among the image events, spread evenly
   const size_t k = std::min(n, static_cast<size_t>(o.report_frames));
   for (size_t i = 0; i < k; ++i) wanted.insert(k == 1 ? n / 2 : (i * (n - 1) + (k - 1) / 2) / (k - 1));
-  lcm::LogFile file(o.log, "r");
-  if (!file.good()) throw std::runtime_error("wingman report: cannot open the LCM log '" + o.log + "'");
-  LogProgress progress(o.progress, o.log, file.getFilePtr(), "drawing frames:");
+  common::LcmLogReader file(o.log);  // a corrupt event throws, naming its byte offset
+  LogProgress progress(o.progress, o.log, file.file_ptr(), "drawing frames:");
   size_t index = 0;
-  while (const lcm::LogEvent* ev = file.readNextEvent()) {
+  while (const common::LcmLogEvent* ev = file.read_next()) {
     progress.tick();
     if (ev->channel != o.image_channel ||
         lcm_fingerprint(ev->data, ev->datalen) != static_cast<uint64_t>(wingman::image_t::getHash()))

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wingman/common/config.hpp"
+#include "wingman/common/lcm_log_reader.hpp"
 #include "wingman/common/message_limits.hpp"
 #include "wingman/common/message_validation.hpp"
 #include "wingman/common/status_tracker.hpp"
@@ -16,6 +17,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -40,6 +42,9 @@ struct RuntimeOptions {
   bool lockstep = false;           ///< --lockstep: publish status after every handled message (for `wingman replay`)
   double status_period_s = 1.0;    ///< --status-period: heartbeat period, seconds (wall clock)
   std::string log_level = "info";  ///< --log-level: trace, debug, info, warn, error
+  /// --skip-corrupt-log: a corrupt event of a file:// input is skipped and counted (as drops of the input log)
+  /// instead of ending the process with exit 1 and a line naming its byte offset.
+  bool skip_corrupt_log = false;
 
   /// "" or one line naming the bad option.
   std::string validate() const;
@@ -117,6 +122,15 @@ class Runtime {
   template <class Msg>
   class Subscription;
 
+  /// Handles one raw message of a channel (a Subscription's on_message).
+  using RawHandler = std::function<void(const lcm::ReceiveBuffer*, const std::string&)>;
+  /// A subscription on a file:// input, read by LcmLogReader (LCM's own log reader is not used: it allocates
+  /// from unchecked length fields).
+  void subscribe_file(const std::string& channel, RawHandler handler);
+  /// spin_once() for a file:// input: one event per call (paced by the URL's speed), dispatched to the
+  /// subscriptions whose channel matches.
+  bool spin_file_once(int timeout_ms);
+
   template <class Msg>
   static std::function<std::string(const Msg&)> default_validator() {
     return [](const Msg& m) { return validate_message(m); };
@@ -137,6 +151,13 @@ class Runtime {
   lcm::LCM* lcm_out_ = nullptr;
   bool input_is_file_ = false;
   bool end_of_input_ = false;
+  std::unique_ptr<LcmLogReader> log_in_;      ///< a file:// input, opened on first use
+  double log_speed_ = 1.0;                    ///< its ?speed= (0: as fast as possible)
+  const LcmLogEvent* log_pending_ = nullptr;  ///< the next event, read but not yet due (speed > 0)
+  int64_t log_first_utime_ = -1;
+  std::chrono::steady_clock::time_point log_start_;
+  int64_t log_corrupt_counted_ = 0;  ///< corrupt stretches already counted as drops
+  std::vector<std::pair<std::regex, RawHandler>> file_subscriptions_;
   StatusTracker status_;
   MessageLimits message_limits_;
   std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
@@ -193,7 +214,12 @@ void Runtime::subscribe(const std::string& channel, std::function<void(const Msg
                                 " (add it to common/src/message_limits.cpp)");
   auto sub = std::make_unique<Subscription<Msg>>(this, channel, std::move(handler), std::move(validate));
   // LCM treats the channel as a regular expression; anchor it so "IMAGE" does not match "IMAGE_2".
-  input().subscribe("^" + channel + "$", &Subscription<Msg>::on_message, sub.get());
+  if (input_is_file_) {
+    Subscription<Msg>* s = sub.get();
+    subscribe_file(channel, [s](const lcm::ReceiveBuffer* rbuf, const std::string& ch) { s->on_message(rbuf, ch); });
+  } else {
+    input().subscribe("^" + channel + "$", &Subscription<Msg>::on_message, sub.get());
+  }
   status_.declare_input(channel);
   subscriptions_.push_back(std::move(sub));
 }

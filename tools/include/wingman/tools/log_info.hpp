@@ -27,11 +27,15 @@ struct LogSummary {
   /// 1 when the last valid image_t could be turned into a picture (the snapshot), else 0: only the last image is
   /// decoded (a log holds thousands).
   int64_t images_with_pixels = 0;
-  std::string report() const;  ///< a table for people
+  int64_t corrupt_events = 0;  ///< corrupt stretches skipped (skip_corrupt), and their bytes
+  int64_t corrupt_bytes = 0;
+  std::string first_corruption;  ///< the first one's line (offset and reason)
+  std::string report() const;    ///< a table for people
 };
 
 /// Reads `log_path` (throws std::runtime_error naming it when unreadable). When `snapshot_png` is
-/// not empty, the last image_t is saved there as PNG (MJPEG and YUYV are decoded).
-LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png = "");
+/// not empty, the last image_t is saved there as PNG (MJPEG and YUYV are decoded). A corrupt event throws
+/// common::LcmLogError naming its byte offset, or with `skip_corrupt` is skipped and counted in the summary.
+LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png = "", bool skip_corrupt = false);
 
 }  // namespace wingman::tools

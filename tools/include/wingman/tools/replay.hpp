@@ -11,6 +11,7 @@ namespace wingman::tools {
 /// Options of `wingman replay`.
 struct ReplayOptions {
   std::string input_log;            ///< LCM log to play
+  bool skip_corrupt = false;        ///< skip (and count) corrupt events of input_log instead of failing at the first
   std::string lcm_url;              ///< bus to publish on and listen to; "" = LCM_DEFAULT_URL or LCM's default
   std::vector<std::string> stages;  ///< lockstep: process instance names (status_t.process) to wait for
   std::string channels;             ///< regular expression of channels to play; "" = all
@@ -30,6 +31,7 @@ struct ReplaySummary {
   bool ok = false;
   int64_t events_played = 0;      ///< messages published from the log
   int64_t events_skipped = 0;     ///< log events not played (status, filtered, or stage outputs)
+  int64_t corrupt_events = 0;     ///< corrupt stretches of the input log skipped (skip_corrupt)
   int64_t messages_recorded = 0;  ///< messages written to the record log
   double wall_s = 0.0;            ///< wall-clock duration
   std::string error;              ///< why it failed, "" when ok
