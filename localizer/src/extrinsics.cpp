@@ -70,6 +70,7 @@ WorldMeasurement to_world(const CameraMeasurement& m, const Extrinsics& extrinsi
   w.cov_p_in_world = rotate_covariance(R_cam_to_world, m.cov_p_in_cam);
   w.cov_p_in_world = 0.5 * (w.cov_p_in_world + w.cov_p_in_world.transpose());  // exact symmetry for the filter
   w.p_target_in_cam = m.p_target_in_cam;
+  w.p_cam_in_world = R_body_to_world * extrinsics.p_cam_in_body + pose_at_exposure.p_body_in_world;
   w.range = m.range;
   w.confidence = m.confidence;
   return w;

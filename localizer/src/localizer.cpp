@@ -140,8 +140,8 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     copy33(t.cov_v, m.velocity_covariance);
     m.world_valid = true;
     m.range = t.range;
-    m.radius_m = options_.sphere.radius_m;  // the configured size (not estimated online)
-    m.radius_sigma_m = 0.0;
+    m.radius_m = t.size_scale * options_.sphere.radius_m;
+    m.radius_sigma_m = t.size_scale_sigma * options_.sphere.radius_m;
     m.confidence = static_cast<float>(t.confidence);
     m.age_s = static_cast<float>(t.age_s);
     m.source_utime = t.source_utime;

@@ -47,6 +47,7 @@ std::vector<std::string> TrackerOptions::validate() const {
   if (max_tracks < 1) p.push_back(problem("tracker.max_tracks", max_tracks, "must be >= 1"));
   if (!(merge_chi2 >= 0) || !std::isfinite(merge_chi2))
     p.push_back(problem("tracker.merge_chi2", merge_chi2, "must be finite and >= 0"));
+  for (const std::string& q : size.validate()) p.push_back(q);
   return p;
 }
 
@@ -86,7 +87,12 @@ void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeas
   for (size_t i = 0; i < tracks.size(); ++i)
     for (size_t j = 0; j < z.size(); ++j) {
       if (z_used[j]) continue;
-      const double d2 = mahalanobis2(tracks[i]->sc, z[j].p_target_in_world, z[j].cov_p_in_world);
+      // Against the detection the track predicts at its size: c + (p - c) / s (s = 1 without size estimation).
+      const double s = tracks[i]->scale.scale;
+      const Eigen::Vector3d c = z[j].p_cam_in_world;
+      const Eigen::Vector3d y = z[j].p_target_in_world - (c + (tracks[i]->sc.p() - c) / s);
+      const Eigen::Matrix3d S = tracks[i]->sc.P.topLeftCorner<3, 3>() / (s * s) + z[j].cov_p_in_world;
+      const double d2 = y.dot(S.ldlt().solve(y));
       if (d2 <= options_.gate_chi2) cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = d2;
     }
   track_to_z = association_ == AssociationMethod::kGreedy ? greedy_assign(cost) : hungarian(cost);
@@ -95,7 +101,21 @@ void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeas
 }
 
 void Tracker::hit(Track& t, const WorldMeasurement& z) {
-  t.sc = localizer::update(t.sc, z.p_target_in_world, z.cov_p_in_world);  // the filter, not Tracker::update
+  const Eigen::Vector3d c = z.p_cam_in_world;
+  t.size.add(z.utime, z.p_target_in_world, z.cov_p_in_world, c);
+  if (const SizeEstimate e = t.size.estimate(); e.acceptable(options_.size.accept_rel)) {
+    // Adopt it, and move the state along the ray from the camera to match (the track's past detections were taken
+    // at the old scale): p' = c + k (p - c), its covariance by k^2.
+    const double k = e.scale / t.scale.scale;
+    t.sc.x.head<3>() = c + k * (t.sc.p() - c);
+    t.sc.P.topLeftCorner<3, 3>() *= k * k;
+    t.sc.P.topRightCorner<3, 3>() *= k;
+    t.sc.P.bottomLeftCorner<3, 3>() *= k;
+    t.scale = e;
+  }
+  const double s = t.scale.scale;
+  // The filter, not Tracker::update: the detection at the track's size.
+  t.sc = localizer::update(t.sc, c + s * (z.p_target_in_world - c), s * s * z.cov_p_in_world);
   t.last_hit_utime = z.utime;
   t.last = z;
   t.window.push_back({z.utime, z.p_target_in_world, z.cov_p_in_world});
@@ -210,6 +230,9 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
     t.recent.push_back(true);
     t.last = z[j];
     t.window.push_back({utime, z[j].p_target_in_world, z[j].cov_p_in_world});
+    t.size = SizeEstimator(options_.size);
+    t.size.add(utime, z[j].p_target_in_world, z[j].cov_p_in_world, z[j].p_cam_in_world);
+    t.scale = t.size.estimate();  // the prior: 1 +- prior_rel (1 +- 0 when off)
     ++stats_.births;
     if (t.hits >= options_.birth_hits) {
       t.id = next_id_++;
@@ -259,8 +282,10 @@ TrackOutput Tracker::output(const Track& t, int64_t predict_to_utime) const {
   TrackOutput o;
   o.track_id = t.id;
   o.camera_id = t.last.camera_id;
-  o.p_target_in_cam = t.last.p_target_in_cam;
-  o.range = t.last.range;
+  o.size_scale = t.scale.scale;
+  o.size_scale_sigma = t.scale.sigma;
+  o.p_target_in_cam = o.size_scale * t.last.p_target_in_cam;
+  o.range = o.size_scale * t.last.range;
   const double hit_fraction =
       static_cast<double>(std::count(t.recent.begin(), t.recent.end(), true)) / options_.birth_window;
   o.confidence = std::clamp(hit_fraction * t.last.confidence, 0.0, 1.0);
@@ -299,6 +324,9 @@ TrackOutput Tracker::output(const Track& t, int64_t predict_to_utime) const {
   o.p_target_in_world = p.x.head<3>();
   o.v_target_in_world = p.x.tail<3>();
   o.cov_p = p.P.topLeftCorner<3, 3>();
+  // The size's share: the whole relative position scales with it.
+  const Eigen::Vector3d rel = o.p_target_in_world - t.last.p_cam_in_world;
+  o.cov_p += o.size_scale_sigma * o.size_scale_sigma / (o.size_scale * o.size_scale) * rel * rel.transpose();
   o.cov_v = p.P.bottomRightCorner<3, 3>();
   o.predicted_utime = t.state_utime + dt_us;
   return o;

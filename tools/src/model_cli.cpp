@@ -28,6 +28,8 @@ struct ModelVerbs::State {
   CLI::App* widen = nullptr;
   CLI::App* relation = nullptr;
   BoxRelationRequest rq;
+  double max_median_error = -1, max_mad = -1;
+  int min_targets = 0;
   std::string cfg = "builtin:wingman-small", weights = "builtin:wingman-small", out_cfg, out_weights, iou_loss;
   float iou_normalizer = 0.0f;
   int classes = 4;
@@ -73,6 +75,12 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.relation->add_option("--model-name", rq.model_name, "The model's name written into the file (default wingman-small)");
   s.relation->add_option("--min-iou", rq.min_iou, "A detection is the target's at this IoU with its outline box (default 0.3)");
   s.relation->add_option("--max-images", rq.max_images, "At most this many images (default 0: all)");
+  s.relation->add_option("--max-median-error", s.max_median_error,
+                         "Exit 1 when |median range error| over all targets exceeds this (a guard; default: none)");
+  s.relation->add_option("--max-mad", s.max_mad,
+                         "Exit 1 when the range error's 1.4826 MAD over all targets exceeds this (default: none)");
+  s.relation->add_option("--min-targets", s.min_targets,
+                         "Exit 1 when the detector finds fewer targets than this (default 0)");
 }
 
 ModelVerbs::~ModelVerbs() = default;
@@ -86,7 +94,23 @@ int ModelVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       const BoxRelationSummary summary = run_box_relation(s.rq, err);
       out << summary.markdown();
       if (s.rq.check.empty()) out << "wrote " << s.rq.out << "\n";
-      return 0;
+      int rc = 0;
+      const RangeErrorStats& all = summary.relation_all;
+      if (s.max_median_error >= 0 && std::abs(all.median) > s.max_median_error) {
+        err << fmt::format("wingman model box-relation: FAIL: median range error {:+.3f}, bound +-{}\n", all.median,
+                           s.max_median_error);
+        rc = 1;
+      }
+      if (s.max_mad >= 0 && all.mad > s.max_mad) {
+        err << fmt::format("wingman model box-relation: FAIL: range error MAD {:.3f}, bound {}\n", all.mad, s.max_mad);
+        rc = 1;
+      }
+      if (summary.matched < s.min_targets) {
+        err << fmt::format("wingman model box-relation: FAIL: {} targets found, bound {}\n", summary.matched,
+                           s.min_targets);
+        rc = 1;
+      }
+      return rc;
     });
   }
   if (!*s.widen) return -1;

@@ -34,6 +34,9 @@ struct WorldMeasurement {
   Eigen::Vector3d p_target_in_world = Eigen::Vector3d::Zero();   ///< metres
   Eigen::Matrix3d cov_p_in_world = Eigen::Matrix3d::Identity();  ///< m^2
   Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();     ///< kept for the output message, metres
+  /// The camera's optical centre at the exposure, world frame, metres: a target of another size than configured lies
+  /// along the ray from here (size_estimator.hpp).
+  Eigen::Vector3d p_cam_in_world = Eigen::Vector3d::Zero();
   double range = 0;                                              ///< metres
   double confidence = 1;                                         ///< 0..1
 };

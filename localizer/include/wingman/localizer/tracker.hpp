@@ -4,6 +4,7 @@
 
 #include "wingman/localizer/kalman_cv3d.hpp"
 #include "wingman/localizer/measurement.hpp"
+#include "wingman/localizer/size_estimator.hpp"
 
 #include <Eigen/Core>
 
@@ -60,6 +61,8 @@ struct TrackerOptions {
   /// ones are merged into the older id. 0 disables. Crossing targets differ in velocity and are not
   /// merged. >= 0.
   double merge_chi2 = 16.81;
+  /// Online size estimation (tracker.size_*): each track's range scale from the camera's motion relative to it.
+  SizeEstimatorOptions size;
 
   template <class V>
   void visit(V& v) {
@@ -76,6 +79,7 @@ struct TrackerOptions {
     v("tracker.max_tracks", max_tracks, "tracks (tentative + confirmed) kept at most");
     v("tracker.merge_chi2", merge_chi2,
       "merge confirmed tracks closer than this in state (6 dof: 16.81 = 99 %); 0 = off");
+    size.visit(v);
   }
   /// One "key = value: rule" line per problem; empty when valid.
   std::vector<std::string> validate() const;
@@ -94,8 +98,11 @@ struct TrackOutput {
   Eigen::Vector3d v_target_in_world = Eigen::Vector3d::Zero();  ///< m/s
   Eigen::Matrix3d cov_p = Eigen::Matrix3d::Identity();          ///< covariance of p_target_in_world, m^2
   Eigen::Matrix3d cov_v = Eigen::Matrix3d::Identity();          ///< covariance of v_target_in_world, (m/s)^2
-  Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();    ///< the last detection's, camera frame, m
-  double range = 0;                                             ///< the last detection's range, m
+  Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();    ///< the last detection's x size_scale, camera frame, m
+  double range = 0;  ///< the last detection's range, m, times size_scale
+  /// The track's range scale (true bounding radius / target.radius_m: SizeEstimator; 1 without size estimation) and
+  /// its standard deviation (0 without). cov_p includes the scale's share along the line of sight.
+  double size_scale = 1.0, size_scale_sigma = 0.0;
   double confidence = 0;        ///< fraction of the last N frames with a hit x last detection confidence, 0..1
   int64_t source_utime = 0;     ///< exposure utime of the newest image that updated the track
   int64_t predicted_utime = 0;  ///< time the state refers to (lag compensation), microseconds
@@ -168,7 +175,9 @@ class Tracker {
     int hits = 0;                    // hits since birth
     std::deque<bool> recent;         // hit or miss of the last birth_window frames
     std::deque<WindowEntry> window;  // last window_size detections
-    WorldMeasurement last;           // newest detection
+    WorldMeasurement last;           // newest detection (as detected: the configured size)
+    SizeEstimator size;              // the track's detections for its range scale
+    SizeEstimate scale;              // the adopted range scale: detections enter the filter at c + s (z - c)
   };
 
   void associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
