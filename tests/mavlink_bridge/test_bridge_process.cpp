@@ -11,9 +11,12 @@
 #include <wingman/setpoint_t.hpp>
 #include <wingman/status_t.hpp>
 
+#include <algorithm>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <functional>
+#include <map>
 
 namespace {
 
@@ -199,6 +202,50 @@ TEST(MavlinkBridgeProcess, NeverSwitchesModeOrArmsUnlessAllowedAndStreamsOnlyInG
   rig.run_for(1000ms, follower);
   ASSERT_FALSE(rig.autopilot.setpoints.empty());
   EXPECT_NEAR(rig.autopilot.setpoints.back().target.vy, 1.0f, 1e-6);
+  EXPECT_EQ(rig.stop(), 0);
+}
+
+TEST(MavlinkBridgeProcess, SetpointToLinkLatency) {
+  // From publishing a SETPOINT on LCM to the simulated autopilot receiving its SET_POSITION_TARGET_LOCAL_NED over UDP:
+  // LCM multicast on loopback, the bridge, UDP on loopback. Each setpoint carries its own speed to be matched.
+  BridgeRig rig;
+  rig.autopilot.set_mode(true, true);
+  rig.run_for(1500ms);  // time sync and own poses first
+  ASSERT_FALSE(rig.poses.empty()) << rig.err();
+  std::map<int, int64_t> published_ns;  // speed in mm/s -> when it was published
+  int k = 0;
+  int64_t last_ns = 0;
+  rig.run_for(4000ms, [&](int64_t now) {
+    if (now - last_ns < 20000000 || k >= 150) return;  // 50 Hz, 150 setpoints
+    ++k;
+    published_ns[k] = epoch_ns();
+    rig.publish(velocity_east(rig.poses.back().utime, k * 1e-3));
+    last_ns = now;
+  });
+  std::vector<double> latency_ms;
+  std::map<int, bool> seen;
+  for (const auto& r : rig.autopilot.setpoints) {
+    const int mm = static_cast<int>(std::lround(r.target.vy * 1000.0));
+    auto it = published_ns.find(mm);
+    if (it == published_ns.end() || seen[mm]) continue;  // the stream repeats a setpoint: its first arrival counts
+    seen[mm] = true;
+    latency_ms.push_back((r.epoch_ns - it->second) * 1e-6);
+  }
+  ASSERT_GT(latency_ms.size(), 140u);
+  std::sort(latency_ms.begin(), latency_ms.end());
+  const double p50 = latency_ms[latency_ms.size() / 2];
+  const double p99 = latency_ms[static_cast<size_t>(0.99 * static_cast<double>(latency_ms.size() - 1))];
+  std::printf(
+      "SETPOINT -> SET_POSITION_TARGET_LOCAL_NED at the autopilot: %zu setpoints, p50 %.3f ms, p99 %.3f ms, "
+      "max %.3f ms\n",
+      latency_ms.size(), p50, p99, latency_ms.back());
+  // The bridge's own share: its status latency is the SETPOINT handler's run time, the frame's UDP write included.
+  const status_t& st = rig.statuses.back();
+  std::printf("bridge SETPOINT handler incl. the UDP write (status, last 256): p50 %.3f ms, p99 %.3f ms, max %.3f ms\n",
+              st.latency_p50_ms, st.latency_p99_ms, st.latency_max_ms);
+  // The target is 2 ms p99 for the bridge alone; this measures LCM + bridge + UDP on a shared 2-core machine
+  // and its bound is loose so a loaded CI machine passes; the figures are printed.
+  EXPECT_LT(p99, 20.0);
   EXPECT_EQ(rig.stop(), 0);
 }
 
