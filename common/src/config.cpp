@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -30,6 +31,10 @@ std::string quote(const std::string& s) {
 }  // namespace
 
 ConfigLoader ConfigLoader::from_file(const std::string& path) {
+  // A directory opens as a stream on Linux and reads as empty, which meant all defaults with exit 0 (issue 33).
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(fmt::format("{}: is a directory, not a config file", path));
   std::ifstream in(path);
   if (!in) throw ConfigError(fmt::format("{}: cannot open config file", path));
   std::stringstream ss;

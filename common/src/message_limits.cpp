@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -292,7 +293,13 @@ std::string MessageLimits::validate() const {
 
 std::int64_t MessageLimits::image_bytes_limit() const {
   if (max_image_bytes > 0) return max_image_bytes;
-  return static_cast<std::int64_t>(image.max_width) * image.max_height * 4;
+  // Saturates instead of overflowing (2^31 - 1 x 2^31 - 1 x 4 once gave a negative limit: every frame dropped).
+  std::int64_t bytes = 0;
+  if (__builtin_mul_overflow(static_cast<std::int64_t>(image.max_width), static_cast<std::int64_t>(image.max_height),
+                             &bytes) ||
+      __builtin_mul_overflow(bytes, std::int64_t{4}, &bytes))
+    return std::numeric_limits<std::int64_t>::max();
+  return bytes;
 }
 
 bool knows_encoding(const std::string& type_name) { return schemas().count(type_name) > 0; }

@@ -13,8 +13,11 @@ std::vector<std::string> DetectorOptions::validate() const {
   std::vector<std::string> p;
   if (input_channel.empty()) p.push_back(problem("input.channel", input_channel, "must not be empty"));
   if (output_channel.empty()) p.push_back(problem("output.channel", output_channel, "must not be empty"));
-  if (max_image_width < 1) p.push_back(problem("input.max_image_width", max_image_width, "must be >= 1"));
-  if (max_image_height < 1) p.push_back(problem("input.max_image_height", max_image_height, "must be >= 1"));
+  // At most 65536 each: the byte limit derived from them (width x height x 4) stays far inside int64_t.
+  if (max_image_width < 1 || max_image_width > 65536)
+    p.push_back(problem("input.max_image_width", max_image_width, "must be in 1..65536"));
+  if (max_image_height < 1 || max_image_height > 65536)
+    p.push_back(problem("input.max_image_height", max_image_height, "must be in 1..65536"));
   if (mode != "realtime" && mode != "replay") p.push_back(problem("input.mode", mode, "must be realtime or replay"));
   if (backend != "auto" && backend != "opencl" && backend != "cpu")
     p.push_back(problem("model.backend", backend, "must be auto, opencl or cpu"));

@@ -122,4 +122,15 @@ TEST(ConfigPrinter, PrintedConfigReadsBackToTheSameValues) {
   EXPECT_EQ(print_options(back), print_options(d));
 }
 
+// Issue 33, finding 6: a directory given as --config read as an empty file (all defaults, exit 0).
+TEST(ConfigLoader, ADirectoryIsAnErrorNotAnEmptyConfig) {
+  const std::string dir = ::testing::TempDir();
+  try {
+    wingman::common::ConfigLoader::from_file(dir);
+    ADD_FAILURE() << "a directory was read as a config file";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), dir + ": is a directory, not a config file");
+  }
+}
+
 }  // namespace

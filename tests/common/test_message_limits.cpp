@@ -5,6 +5,7 @@
 #include <wingman/common/message_limits.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace {
@@ -125,6 +126,16 @@ TEST(CheckEncoded, RejectsNestedArraysLongerThanTheBytesLeft) {
   put_i32(b, at, 1000000);
   const std::string why = check_encoded<status_t>(b.data(), b.size(), {});
   EXPECT_NE(why.find("status_t.num_channels = 1000000"), std::string::npos) << why;
+}
+
+// Issue 33, finding 6: 2^31 - 1 x 2^31 - 1 x 4 overflowed into a negative byte limit, and every frame was dropped.
+TEST(MessageLimits, ImageByteLimitSaturatesInsteadOfOverflowing) {
+  MessageLimits l;
+  l.image.max_width = 2147483647;
+  l.image.max_height = 2147483647;
+  EXPECT_EQ(l.image_bytes_limit(), std::numeric_limits<int64_t>::max());
+  l.image.max_height = 8192;
+  EXPECT_EQ(l.image_bytes_limit(), int64_t{2147483647} * 8192 * 4);
 }
 
 TEST(CheckEncoded, RejectsImagesAndMessagesOverTheLimits) {

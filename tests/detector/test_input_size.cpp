@@ -242,5 +242,19 @@ TEST(SizedDetector, RejectsBadImagesAndAnEmptyFactory) {
                std::invalid_argument);
 }
 
+// Issue 33, finding 6: input.max_image_width: 2147483647 was accepted and overflowed the byte limit.
+TEST(InputSize, DetectorOptionsRefuseImageLimitsThatWouldOverflow) {
+  DetectorOptions o;
+  o.max_image_width = 2147483647;
+  o.max_image_height = 65537;
+  const auto p = o.validate();
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NE(p[0].find("input.max_image_width = 2147483647: must be in 1..65536"), std::string::npos) << p[0];
+  EXPECT_NE(p[1].find("input.max_image_height = 65537: must be in 1..65536"), std::string::npos) << p[1];
+  o.max_image_width = 65536;
+  o.max_image_height = 65536;
+  EXPECT_TRUE(o.validate().empty());
+}
+
 }  // namespace
 }  // namespace wingman::detector

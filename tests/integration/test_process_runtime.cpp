@@ -100,6 +100,17 @@ TEST(ProcessConfig, BadConfigExitsNonZeroWithOneLineNamingFileAndEveryBadKey) {
   }
 }
 
+// Issue 33, finding 6: every process ran on its defaults with exit 0 when --config named a directory.
+TEST(ProcessConfig, ADirectoryAsConfigIsAnErrorForEveryProcess) {
+  TempDir dir;
+  for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl",
+                          "wingman-recorder", "wingman-sim"}) {
+    const auto r = run({bin_path(exe), "--config", dir.path(), "--print-config"}, 10s);
+    EXPECT_EQ(r.exit_code, 2) << exe;
+    EXPECT_EQ(first_line(r.err), std::string(exe) + ": error: " + dir.path() + ": is a directory, not a config file");
+  }
+}
+
 TEST(ProcessConfig, MissingConfigFileAndBadOptionAreOneLineErrors) {
   const auto r = run({bin_path("wingman-detector"), "--config", "/nonexistent.yaml"}, 10s);
   EXPECT_EQ(r.exit_code, 2);

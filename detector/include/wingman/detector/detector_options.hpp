@@ -14,8 +14,8 @@ namespace wingman::detector {
 struct DetectorOptions {
   std::string input_channel = "IMAGE_CAM0";        ///< image_t input channel
   std::string output_channel = "DETECTIONS_CAM0";  ///< detections_t output channel
-  int max_image_width = 8192;                      ///< larger images are dropped and counted, pixels
-  int max_image_height = 8192;                     ///< pixels
+  int max_image_width = 8192;                      ///< larger images are dropped and counted, pixels, 1..65536
+  int max_image_height = 8192;                     ///< pixels, 1..65536
   /// realtime: when busy, keep only the newest frame (older ones are dropped and counted);
   /// replay: process every frame in order (deterministic; for logs and lockstep replays).
   std::string mode = "realtime";
