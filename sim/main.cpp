@@ -204,17 +204,30 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   return rt.shutdown(stop_reason);
 }
 
+// The keys of a --render-config file: the renderer's options (render.*), nothing else.
+struct RenderConfig {
+  sim::RenderOptions render;
+  template <class V>
+  void visit(V& v) {
+    render.visit(v);
+  }
+  std::vector<std::string> validate() const { return render.validate(); }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const common::ProcessInfo info{
       "sim", "wingman-sim",
       "Simulates a scenario (--scenario FILE, or scenario.file; --duration S: simulate S seconds instead of the "
-      "scenario's duration_s): publishes the camera vehicle's images and own pose and the ground truth, and flies the "
+      "scenario's duration_s; --render-config FILE: the renderer's render.* keys from FILE instead of --config's): "
+      "publishes the camera vehicle's images and own pose and the ground truth, and flies the "
       "camera vehicle on SETPOINT"};
 
-  // --scenario FILE and --duration S are this process's own options; the rest goes to the common runtime.
+  // --scenario FILE, --duration S and --render-config FILE are this process's own options; the rest goes to the
+  // common runtime.
   std::optional<std::string> scenario_arg;
+  std::optional<std::string> render_config_arg;
   std::optional<double> duration_arg;
   std::vector<char*> args;
   for (int i = 0; i < argc; ++i) {
@@ -227,6 +240,14 @@ int main(int argc, char** argv) {
       scenario_arg = argv[++i];
     } else if (a.rfind("--scenario=", 0) == 0) {
       scenario_arg = a.substr(11);
+    } else if (a == "--render-config") {
+      if (i + 1 >= argc) {
+        std::cerr << info.executable << ": error: --render-config needs a FILE (see --help)" << std::endl;
+        return 2;
+      }
+      render_config_arg = argv[++i];
+    } else if (a.rfind("--render-config=", 0) == 0) {
+      render_config_arg = a.substr(16);
     } else if (a == "--duration" || a.rfind("--duration=", 0) == 0) {
       const std::string value = a == "--duration" ? (i + 1 < argc ? argv[++i] : "") : a.substr(11);
       char* end = nullptr;
@@ -251,6 +272,11 @@ int main(int argc, char** argv) {
       throw common::ConfigError("built-in defaults invalid: " + problems.front());
     }
     if (scenario_arg) options.scenario = *scenario_arg;
+    if (render_config_arg) {
+      // A file of render.* keys only (e.g. the lighting `wingman scenario random` writes for a flight): the renderer's
+      // options come from it, its missing keys at their defaults; render.enabled stays as --config sets it.
+      options.render_options = common::load_options<RenderConfig>(*render_config_arg).render;
+    }
     if (print) {
       return common::print_options(options, info.executable + " effective configuration" +
                                                 (path.empty() ? " (built-in defaults)" : " (from " + path + ")"));

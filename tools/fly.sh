@@ -7,7 +7,8 @@
 #
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
-#                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE]
+#                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE] [--follower-config FILE]
+#                     [--render-config FILE]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -25,13 +26,17 @@
 #   --coarse-pass    the detector also detects at half the network input and fuses its large boxes (close drones)
 #   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any, else the
 #                    defaults: the leader's bounding radius, and the shipped model's box relation for cnn boxes)
+#   --follower-config   the follower's config (default: config/flights/NAME.follower_ctrl.yaml if any, else the
+#                    defaults); its formation.offset_m is also the offset the formation error is measured against
+#   --render-config  the simulator's render.* keys (lighting, scene) from this file (wingman-sim --render-config),
+#                    e.g. FILE.render.yaml written by `wingman scenario random` beside its scenario
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
-zoom_in=false flip_fusion=false coarse_pass=false localizer_config=""
+zoom_in=false flip_fusion=false coarse_pass=false localizer_config="" follower_config="" render_config=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -42,6 +47,8 @@ while [ $# -gt 0 ]; do
     --flip-fusion) flip_fusion=true; shift ;;
     --coarse-pass) coarse_pass=true; shift ;;
     --localizer-config) localizer_config=$(realpath "$2"); shift 2 ;;
+    --follower-config) follower_config=$(realpath "$2"); shift 2 ;;
+    --render-config) render_config=$(realpath "$2"); shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
     --record-images) record_images=true; shift ;;
@@ -70,9 +77,13 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   [ "$flip_fusion" != true ] || again+=(--flip-fusion)
   [ "$coarse_pass" != true ] || again+=(--coarse-pass)
   [ -z "$localizer_config" ] || again+=(--localizer-config "$localizer_config")
+  [ -z "$follower_config" ] || again+=(--follower-config "$follower_config")
+  [ -z "$render_config" ] || again+=(--render-config "$render_config")
   exec tools/netns_run.sh "$0" "${again[@]}"
 fi
-[ -z "$localizer_config" ] || [ -r "$localizer_config" ] || { echo "fly: --localizer-config $localizer_config: cannot read it" >&2; exit 2; }
+for f in "$localizer_config" "$follower_config" "$render_config"; do
+  [ -z "$f" ] || [ -r "$f" ] || { echo "fly: $f: cannot read it (--localizer-config, --follower-config or --render-config)" >&2; exit 2; }
+done
 
 mkdir -p "$out"
 out=$(realpath "$out")
@@ -107,7 +118,7 @@ case "$scenario_seed" in ''|*[!0-9]*) scenario_seed=1 ;; esac
 # flight_cfg PROCESS: sets cfg_args to (--config FILE) where that file exists, else to nothing.
 flight_cfg() { local f="$src/config/flights/$name.$1.yaml"; cfg_args=(); if [ -r "$f" ]; then cfg_args=(--config "$f"); fi; }
 if [ -n "$localizer_config" ]; then localizer_args=(--config "$localizer_config"); else flight_cfg localizer; localizer_args=("${cfg_args[@]}"); fi
-flight_cfg follower_ctrl; follower_args=("${cfg_args[@]}")
+if [ -n "$follower_config" ]; then follower_args=(--config "$follower_config"); else flight_cfg follower_ctrl; follower_args=("${cfg_args[@]}"); fi
 # Lockstep, paced at most 5x real time: the logger is outside the loop. Unpaced, a truth-mode flight ran ~2600
 # frames/s and a loaded machine's logger recorded 383 of 600 ground-truth frames; at 10x, 505-600 of 600 with six
 # busy loops beside it; at 5x, 600 of 600 in each of 10 such runs. Slower flights (rendering, the CNN) are not affected.
@@ -144,6 +155,7 @@ lcm-logger "${logger_args[@]}" "$log" & logger_pid=$!
 
 sim_args=(--lcm-url "$url" --config "$out/sim.yaml")
 [ -n "$duration" ] && sim_args+=(--duration "$duration")
+[ -n "$render_config" ] && sim_args+=(--render-config "$render_config")
 SECONDS=0
 "$bin/wingman-sim" "${sim_args[@]}"
 wall=$SECONDS

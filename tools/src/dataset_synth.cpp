@@ -5,6 +5,7 @@
 #include "wingman/tools/dataset_from_log.hpp"
 
 #include "run_verb.hpp"
+#include "synth_random.hpp"
 
 #include <wingman/common/config.hpp>
 #include <wingman/localizer/camera_model.hpp>
@@ -35,35 +36,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 constexpr int kMaxPlacements = 50;  // attempts to place a visible target in one image
 
-// A small counter-based generator (splitmix64): the same numbers on every platform and standard library, so a seed
-// gives the same dataset everywhere.
-class Random {
- public:
-  explicit Random(uint64_t seed) : state_(seed) {}
-  Random(uint64_t seed, uint64_t stream, uint64_t index) : state_(mix(mix(seed ^ mix(stream)) ^ mix(index + 1))) {}
-  uint64_t next() { return mix(state_ += 0x9E3779B97F4A7C15ull); }
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  ///< [0, 1)
-  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  double log_uniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
-  bool chance(double p) { return uniform() < p; }
-  size_t index(size_t n) { return static_cast<size_t>(uniform() * static_cast<double>(n)) % n; }
-  double normal() {  ///< standard normal (Box-Muller)
-    const double u1 = (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53;
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * uniform());
-  }
-  Eigen::Vector3d direction() {  ///< uniform on the unit sphere
-    const double z = uniform(-1.0, 1.0), a = uniform(0.0, 2.0 * kPi), r = std::sqrt(1.0 - z * z);
-    return {r * std::cos(a), r * std::sin(a), z};
-  }
-
- private:
-  static uint64_t mix(uint64_t x) {
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-  }
-  uint64_t state_;
-};
+using Random = SynthRandom;
 
 // Random streams: one per purpose, so that adding a draw in one place leaves the others alone.
 enum Stream : uint64_t { kCameraStream = 1, kImageStream = 2 };
@@ -109,8 +82,10 @@ localizer::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, i
                                 {k1, k2, rng.uniform(-0.002, 0.002), rng.uniform(-0.002, 0.002), 0.0}, name);
 }
 
+}  // namespace
+
 // The scene, light and sensor of one image, around the configured base.
-sim::RenderOptions random_scene(const DatasetSynthConfig& c, Random& rng) {
+sim::RenderOptions random_scene(const DatasetSynthConfig& c, SynthRandom& rng) {
   sim::RenderOptions o = c.render;
   o.seed = static_cast<int64_t>(rng.next() >> 1);
   o.sky_zenith_colour = pick(rng, kZenith);
@@ -140,10 +115,10 @@ sim::RenderOptions random_scene(const DatasetSynthConfig& c, Random& rng) {
 }
 
 // A random procedural multirotor: frame, size, colours, propellers, landing gear.
-sim::DroneSpec random_airframe(const DatasetSynthConfig& c, Random& rng) {
+sim::DroneSpec random_airframe(const DatasetSynthConfig& c, SynthRandom& rng, const std::string& frame) {
   sim::DroneSpec s;
-  const double frame = rng.uniform();
-  s.frame = frame < 0.6 ? "quad" : frame < 0.85 ? "hex" : "octo";
+  const double u = rng.uniform();  // drawn even when `frame` is given, so that the other draws stay the same
+  s.frame = !frame.empty() ? frame : u < 0.6 ? "quad" : u < 0.85 ? "hex" : "octo";
   const int n = s.arm_count();
   const double scale = rng.log_uniform(c.scale_min, c.scale_max);
   s.arm_length_m = 0.23 * scale * std::sqrt(n / 4.0) * rng.uniform(0.9, 1.1);
@@ -171,6 +146,8 @@ sim::DroneSpec random_airframe(const DatasetSynthConfig& c, Random& rng) {
   s.gear_colour = pick(rng, kAirframe);
   return s;
 }
+
+namespace {
 
 Eigen::Matrix3d rpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *

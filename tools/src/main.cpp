@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy, loginfo, make-video, localize, predict,
-// bench detector, eval (flight errors against ground truth), report (its HTML page), dataset synth, train / val /
-// import-halmstad (training).
+// bench detector, eval (flight errors against ground truth), report (its HTML page), dataset synth, scenario random
+// (out-of-sample flights), train / val / import-halmstad (training).
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
 #include "wingman/tools/localize.hpp"
@@ -14,6 +14,7 @@
 #include "wingman/tools/train_cli.hpp"
 #ifdef WINGMAN_WITH_SIM
 #include "wingman/tools/dataset_synth.hpp"
+#include "wingman/tools/scenario_random.hpp"
 #endif
 
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -197,7 +198,8 @@ int main(int argc, char** argv) {
   TrainingVerbs training(app);  // train, val, import-halmstad
   ModelVerbs model_verbs(app);  // model widen-classes
 #ifdef WINGMAN_WITH_SIM
-  DatasetVerbs dataset(app);  // dataset synth
+  DatasetVerbs dataset(app);    // dataset synth
+  ScenarioVerbs scenario(app);  // scenario random
 #endif
 
   try {
@@ -224,6 +226,7 @@ int main(int argc, char** argv) {
     if (const int rc = model_verbs.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #ifdef WINGMAN_WITH_SIM
     if (const int rc = dataset.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+    if (const int rc = scenario.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #endif
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);

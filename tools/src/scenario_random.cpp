@@ -1,0 +1,327 @@
+// SPDX-License-Identifier: MIT
+// `wingman scenario random`: a seeded random formation flight for wingman-sim, with the configs fly.sh flies it with.
+#include "wingman/tools/scenario_random.hpp"
+
+#include "run_verb.hpp"
+#include "synth_random.hpp"
+
+#include <wingman/common/config.hpp>
+#include <wingman/sim/drone_model.hpp>
+#include <wingman/sim/scenario.hpp>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace wingman::tools {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = kSynthPi / 180.0;
+
+// Random streams: one per purpose, so that a change in one draw leaves the others alone.
+enum Stream : uint64_t { kPathStream = 11, kSceneStream = 12, kAirframeStream = 13 };
+
+// The localizer's keys this flight sets: the leader's true size, and the shortest range accepted, which must exceed
+// it (the localizer's defaults for everything else).
+struct LocalizerTarget {
+  double radius_m = 0.348;
+  double min_range_m = 0.5;
+  template <class V>
+  void visit(V& v) {
+    v("target.radius_m", radius_m,
+      "the leader's bounding-sphere radius, propellers spinning, metres (the simulator's)");
+    v("range.min_m", min_range_m, "the localizer's default 0.5 m, or 1.5 x the radius where that is larger");
+  }
+  std::vector<std::string> validate() const {
+    if (radius_m > 0.0 && std::isfinite(radius_m) && min_range_m > radius_m) return {};
+    return {common::problem("target.radius_m", radius_m, "must be > 0 and < range.min_m")};
+  }
+};
+
+// The follower's keys this flight sets: the formation offset, and the leader's height followed.
+struct FollowerFormation {
+  std::vector<double> offset_m = {0.0, -6.0, 0.0};
+  std::string height_mode = "target";
+  template <class V>
+  void visit(V& v) {
+    v("formation.offset_m", offset_m, "follower position relative to the leader, ENU [east, north, up], m");
+    v("formation.height_mode", height_mode, "target: keep the offset's height above the leader as it climbs");
+  }
+  std::vector<std::string> validate() const { return {}; }
+};
+
+// The simulator's render.* keys (its config's other keys keep their defaults).
+struct RenderSection {
+  sim::RenderOptions render;
+  template <class V>
+  void visit(V& v) {
+    render.visit(v);
+  }
+  std::vector<std::string> validate() const { return render.validate(); }
+};
+
+// A DroneSpec as the scenario's `drone:` mapping, one "key: value" line each at `indent`.
+class YamlSpecWriter {
+ public:
+  explicit YamlSpecWriter(std::string indent) : indent_(std::move(indent)) {}
+  template <class T>
+  void operator()(const std::string& key, const T& value, const char* /*doc*/) {
+    text_ += indent_ + key + ": " + format(value) + "\n";
+  }
+  const std::string& str() const { return text_; }
+
+ private:
+  static std::string format(int v) { return std::to_string(v); }
+  static std::string format(double v) { return fmt::format("{:.9g}", v); }
+  static std::string format(const std::string& v) {
+    std::string out = "\"";
+    for (char ch : v) {
+      if (ch == '"' || ch == '\\') out += '\\';
+      out += ch;
+    }
+    return out + "\"";
+  }
+  static std::string format(const std::vector<double>& v) { return fmt::format("[{:.9g}]", fmt::join(v, ", ")); }
+  std::string indent_, text_;
+};
+
+std::string vec(const Eigen::Vector3d& p) { return fmt::format("[{:.4f}, {:.4f}, {:.4f}]", p.x(), p.y(), p.z()); }
+
+// Seconds to fly a straight leg of `length_m` from rest to rest at cruise `speed` with acceleration `accel`.
+double leg_time_s(double length_m, double speed, double accel) {
+  if (length_m >= speed * speed / accel) return length_m / speed + speed / accel;
+  return 2.0 * std::sqrt(length_m / accel);  // never reaches the cruise speed
+}
+
+// The two lighting set-ups, applied over the scene drawn for the seed.
+void apply_lighting(const std::string& lighting, sim::RenderOptions& o) {
+  o.exposure_jitter = 0.0;
+  o.motion_blur_exposure_s = 0.0;  // as the other flights: no blur (it multiplies the rendering time)
+  o.noise_std = 1.5;
+  o.shot_noise = 0.3;
+  if (lighting == "A") {  // midday, clear
+    o.sun_azimuth_deg = 135.0;
+    o.sun_elevation_deg = 45.0;
+    o.sun_intensity = 1.0;
+    o.ambient_intensity = 0.45;
+    o.sky_zenith_colour = {0.25, 0.45, 0.8};
+    o.sky_horizon_colour = {0.75, 0.82, 0.9};
+    o.cloud_cover = 0.3;
+    o.visibility_m = 8000.0;
+    o.exposure_gain = 1.0;
+  } else {  // B: evening, low sun in the west, warm haze, clouds, less light
+    o.sun_azimuth_deg = 280.0;
+    o.sun_elevation_deg = 8.0;
+    o.sun_intensity = 0.6;
+    o.ambient_intensity = 0.3;
+    o.sky_zenith_colour = {0.45, 0.5, 0.65};
+    o.sky_horizon_colour = {0.9, 0.75, 0.55};
+    o.cloud_cover = 0.7;
+    o.visibility_m = 3000.0;
+    o.exposure_gain = 0.8;
+  }
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw std::runtime_error("cannot write '" + path + "'");
+  f << text;
+  f.close();
+  if (!f) throw std::runtime_error("cannot write '" + path + "'");
+}
+
+}  // namespace
+
+std::vector<std::string> ScenarioRandomOptions::validate() const {
+  std::vector<std::string> p;
+  if (view != "behind" && view != "side") p.push_back("--view = '" + view + "': must be behind or side");
+  if (lighting != "A" && lighting != "B") p.push_back("--lighting = '" + lighting + "': must be A or B");
+  if (out.empty()) p.push_back("--out: required (the scenario file to write, e.g. build/suite/flight.yaml)");
+  if (!out.empty() && fs::path(out).extension() != ".yaml") p.push_back("--out = '" + out + "': must end in .yaml");
+  if (airframe.empty()) p.push_back("--airframe: must be quad, hex, octo or a mesh file");
+  const auto range = [&](const char* lo_key, double lo, const char* hi_key, double hi, double floor) {
+    if (!(lo >= floor && hi >= lo && std::isfinite(hi)))
+      p.push_back(fmt::format("{} = {}, {} = {}: need {} <= {} <= {}", lo_key, lo, hi_key, hi, floor, lo_key, hi_key));
+  };
+  range("duration_min_s", duration_min_s, "duration_max_s", duration_max_s, 1.0);
+  range("speed_min_mps", speed_min_mps, "speed_max_mps", speed_max_mps, 0.01);
+  range("offset_min_m", offset_min_m, "offset_max_m", offset_max_m, 1.0);
+  range("altitude_min_m", altitude_min_m, "altitude_max_m", altitude_max_m, 1.0);
+  range("leg_min_m", leg_min_m, "leg_max_m", leg_max_m, 0.1);
+  if (!(offset_elevation_max_deg >= 0.0 && offset_elevation_max_deg <= 25.0))
+    p.push_back(common::problem("offset_elevation_max_deg", offset_elevation_max_deg, "must be in [0, 25]"));
+  if (!(climb_max >= 0.0 && climb_max <= 1.0))
+    p.push_back(common::problem("climb_max", climb_max, "must be in [0, 1]"));
+  if (!(accel_mps2 > 0.0 && accel_mps2 <= 4.0))
+    p.push_back(common::problem("accel_mps2", accel_mps2, "must be in (0, 4]"));
+  return p;
+}
+
+std::string ScenarioRandomResult::one_line() const {
+  return fmt::format("wrote {} ({:.1f} s, {} legs, {}, offset {:.1f} m, bounding radius {:.3f} m) and its configs",
+                     scenario_path, duration_s, legs, airframe, offset_in_world.norm(), bounding_radius_m);
+}
+
+ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
+  if (const auto problems = o.validate(); !problems.empty())
+    throw std::invalid_argument(fmt::format("{}", fmt::join(problems, "; ")));
+  ScenarioRandomResult r;
+  const DatasetSynthConfig synth;  // the ranges `wingman dataset synth` draws airframes and scenes from
+
+  // The leader's airframe and its bounding radius (propellers spinning), as the simulator computes and reports it.
+  sim::DroneSpec spec;
+  if (o.airframe == "quad" || o.airframe == "hex" || o.airframe == "octo") {
+    SynthRandom rng(o.seed, kAirframeStream, 0);
+    spec = random_airframe(synth, rng, o.airframe);
+    r.airframe = "procedural " + o.airframe;
+  } else {
+    if (!fs::is_regular_file(o.airframe))
+      throw std::invalid_argument("--airframe = '" + o.airframe + "': not quad, hex, octo nor a mesh file");
+    spec.frame = "mesh";
+    spec.mesh_path = fs::absolute(o.airframe).lexically_normal().string();
+    r.airframe = fs::path(o.airframe).filename().string();
+  }
+  r.bounding_radius_m = sim::DroneModel::from_spec(spec).bounding_radius();
+
+  // The formation offset, and the headings that give the view.
+  SynthRandom rng(o.seed, kPathStream, 0);
+  r.duration_s = std::round(rng.uniform(o.duration_min_s, o.duration_max_s) * 10.0) / 10.0;
+  const double distance = rng.uniform(o.offset_min_m, o.offset_max_m);
+  const double bearing = rng.uniform(-kSynthPi, kSynthPi);
+  const double elevation = rng.uniform(-o.offset_elevation_max_deg, o.offset_elevation_max_deg) * kDeg;
+  r.offset_in_world = distance * Eigen::Vector3d(std::cos(elevation) * std::cos(bearing),
+                                                 std::cos(elevation) * std::sin(bearing), std::sin(elevation));
+  const double yaw_to_leader = std::atan2(-r.offset_in_world.y(), -r.offset_in_world.x());  // the camera's heading
+  const double side = rng.chance(0.5) ? 1.0 : -1.0;
+  const double leader_yaw = o.view == "behind" ? yaw_to_leader : yaw_to_leader + side * 0.5 * kSynthPi;
+  const double floor_z = o.altitude_min_m + std::max(0.0, -r.offset_in_world.z());  // the follower stays above 1 m
+  const Eigen::Vector3d p_leader(0.0, 0.0, rng.uniform(std::max(floor_z, o.altitude_min_m), o.altitude_max_m));
+  const Eigen::Vector3d p_follower = p_leader + r.offset_in_world;
+
+  // The leader's path: legs from rest to rest until the flight's duration is covered.
+  std::string waypoints;
+  Eigen::Vector3d p = p_leader;
+  for (double t = 0.0; t < r.duration_s;) {
+    const double heading = rng.uniform(-kSynthPi, kSynthPi);
+    const double length = rng.uniform(o.leg_min_m, o.leg_max_m);
+    double dz = rng.uniform(-o.climb_max, o.climb_max) * length;
+    dz = std::clamp(p.z() + dz, std::max(floor_z, o.altitude_min_m), o.altitude_max_m) - p.z();
+    const Eigen::Vector3d next = p + Eigen::Vector3d(length * std::cos(heading), length * std::sin(heading), dz);
+    const double speed = std::round(rng.uniform(o.speed_min_mps, o.speed_max_mps) * 100.0) / 100.0;
+    const double stop = rng.chance(0.3) ? std::round(rng.uniform(0.5, 3.0) * 10.0) / 10.0 : 0.0;
+    t += leg_time_s((next - p).norm(), speed, o.accel_mps2) + stop;
+    waypoints += fmt::format("        - {{position: {}, speed: {:.2f}, stop_s: {:.1f}}}\n", vec(next), speed, stop);
+    p = next;
+    ++r.legs;
+  }
+
+  const fs::path out(o.out);
+  const std::string stem = (out.parent_path() / out.stem()).string();
+  r.scenario_path = o.out;
+  r.localizer_path = stem + ".localizer.yaml";
+  r.follower_path = stem + ".follower_ctrl.yaml";
+  r.render_path = stem + ".render.yaml";
+  r.json_path = stem + ".json";
+  if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
+
+  const std::string command =
+      fmt::format("wingman scenario random --seed {} --airframe {} --view {} --lighting {}", o.seed,
+                  spec.frame == "mesh" ? spec.mesh_path : o.airframe, o.view, o.lighting);
+  YamlSpecWriter drone("      ");
+  spec.visit(drone, "");
+  std::string yaml = fmt::format(
+      "# Written by `{}`: an out-of-sample formation flight (tools/experiment.sh suite). Keys: docs/simulation.md.\n"
+      "# Fly it with its configs: tools/fly.sh --scenario {} --localizer-config {} --follower-config {} "
+      "--render-config {}\n",
+      command, out.filename().string(), fs::path(r.localizer_path).filename().string(),
+      fs::path(r.follower_path).filename().string(), fs::path(r.render_path).filename().string());
+  yaml += fmt::format("name: {}\n", out.stem().string());
+  yaml += fmt::format(
+      "description: \"seed {}: {} leader seen {}, lighting {}; formation offset {:.1f} m; {} legs at 0.3-3 m/s\"\n",
+      o.seed, r.airframe, o.view == "behind" ? "from behind" : "side-on", o.lighting, distance, r.legs);
+  yaml += "start_utime: 1767225600000000\n";
+  yaml += fmt::format("duration_s: {:.1f}\ncommand_delay_s: 0.1\nseed: {}\n\nvehicles:\n", r.duration_s, o.seed);
+  yaml += fmt::format(
+      "  - name: follower\n    id: 0\n    control: setpoints\n    initial:\n      position: {}\n      yaw_deg: "
+      "{:.3f}\n\n",
+      vec(p_follower), yaw_to_leader / kDeg);
+  yaml += fmt::format(
+      "  - name: leader\n    id: 1\n    control: script\n    initial:\n      position: {}\n"
+      "      yaw_deg: {:.3f}\n    drone:\n{}",
+      vec(p_leader), leader_yaw / kDeg, drone.str());
+  yaml += fmt::format("    dynamics:\n      max_speed_xy: {:.2f}\n      max_accel_xy: {:.2f}\n", o.speed_max_mps + 1.0,
+                      std::max(2.0, 2.0 * o.accel_mps2));
+  yaml += fmt::format("    motion:\n      type: waypoints\n      accel: {:.2f}\n      waypoints:\n{}", o.accel_mps2,
+                      waypoints);
+  write_file(r.scenario_path, yaml);
+
+  const std::string header = "written by `" + command + "` for " + out.filename().string();
+  LocalizerTarget target;
+  target.radius_m = r.bounding_radius_m;
+  target.min_range_m = std::max(target.min_range_m, 1.5 * r.bounding_radius_m);
+  write_file(r.localizer_path, common::print_options(target, header + " (the localizer's defaults otherwise)"));
+  FollowerFormation formation;
+  formation.offset_m = {r.offset_in_world.x(), r.offset_in_world.y(), r.offset_in_world.z()};
+  write_file(r.follower_path, common::print_options(formation, header + " (the follower's defaults otherwise)"));
+  RenderSection render;
+  SynthRandom scene_rng(o.seed, kSceneStream, 0);
+  render.render = random_scene(synth, scene_rng);  // ground, treeline, clouds as dataset synth draws them
+  apply_lighting(o.lighting, render.render);
+  write_file(r.render_path, common::print_options(render, header + ": lighting " + o.lighting));
+
+  // What was drawn, for the suite's table (tools/experiment_summary.py suite).
+  write_file(r.json_path,
+             fmt::format("{{\"seed\": {}, \"airframe\": \"{}\", \"view\": \"{}\", \"lighting\": \"{}\", "
+                         "\"duration_s\": {:.1f}, \"legs\": {}, \"offset_m\": [{:.4f}, {:.4f}, {:.4f}], "
+                         "\"offset_distance_m\": {:.4f}, \"bounding_radius_m\": {:.6f}}}\n",
+                         o.seed, r.airframe, o.view, o.lighting, r.duration_s, r.legs, r.offset_in_world.x(),
+                         r.offset_in_world.y(), r.offset_in_world.z(), r.offset_in_world.norm(), r.bounding_radius_m));
+
+  // What was written loads with the readers that will use it.
+  sim::load_scenario(r.scenario_path);
+  common::load_options<LocalizerTarget>(r.localizer_path);
+  common::load_options<FollowerFormation>(r.follower_path);
+  common::load_options<RenderSection>(r.render_path);
+  return r;
+}
+
+struct ScenarioVerbs::State {
+  CLI::App* random = nullptr;
+  ScenarioRandomOptions options;
+};
+
+ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
+  CLI::App* scenario = app.add_subcommand("scenario", "Simulation scenarios: random out-of-sample formation flights");
+  scenario->require_subcommand(1);
+  ScenarioRandomOptions& o = s_->options;
+  s_->random = scenario->add_subcommand(
+      "random",
+      "Write a seeded random formation flight for wingman-sim (leader on a random 3-D path at 0.3-3 m/s for 30-60 s, "
+      "follower 4-20 m away) and, beside it, FILE.localizer.yaml (the leader's bounding radius), "
+      "FILE.follower_ctrl.yaml (the formation offset) and FILE.render.yaml (lighting) for tools/fly.sh");
+  s_->random->add_option("--seed", o.seed, "Seed (default 1001): the same seed gives the same files")->required();
+  s_->random->add_option("--airframe", o.airframe,
+                         "quad, hex or octo (procedural, drawn as dataset synth draws them) or a mesh file, e.g. "
+                         "../shared/meshes/holybro_x500v2.glb (default quad)");
+  s_->random->add_option("--view", o.view, "behind (the leader's rear faces the camera) or side (default behind)");
+  s_->random->add_option("--lighting", o.lighting, "A (midday, clear) or B (evening, low sun, haze; default A)");
+  s_->random->add_option("--out", o.out, "The scenario file to write, FILE.yaml")->required();
+}
+
+ScenarioVerbs::~ScenarioVerbs() = default;
+
+int ScenarioVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (!*s_->random) return -1;
+  return run_verb("wingman scenario random", err, [&] {
+    out << write_random_scenario(s_->options).one_line() << std::endl;
+    return 0;
+  });
+}
+
+}  // namespace wingman::tools
