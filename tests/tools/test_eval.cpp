@@ -45,6 +45,8 @@ target_t world_target(int id, double x, double y, double z, int64_t utime) {
   t.p_target_in_world[2] = z;
   t.world_valid = true;
   t.range = 1.0;
+  t.radius_m = 0.348;
+  t.radius_sigma_m = 0.0125;
   t.confidence = 1.0f;
   t.source_utime = utime;
   t.predicted_utime = utime;
@@ -291,11 +293,15 @@ TEST(Eval, CountsLeaderIdSwitchesAndFalseTracks) {
   std::vector<std::string> lines;
   for (std::string line; std::getline(csv, line);) lines.push_back(line);
   ASSERT_EQ(lines.size(), 15u);
-  EXPECT_EQ(lines[0], "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m");
-  // range_m: the true range of the matched vehicle; range_est_m: target_t.range (1 m in these targets).
-  EXPECT_EQ(lines[1], "0.000000,7,1,10.0000,0.0000,10.0000,5.0000,0.0000,10.0000,5.0000,0.0000,1.0000");
-  EXPECT_NE(std::find(lines.begin(), lines.end(), "0.200000,20,-1,1.0000,50.0000,50.0000,50.0000,,,,,1.0000"),
-            lines.end());
+  EXPECT_EQ(lines[0],
+            "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m,radius_m,"
+            "radius_sigma_m");
+  // range_m: the true range of the matched vehicle; range_est_m: target_t.range (1 m in these targets); radius_m and
+  // radius_sigma_m: the track's size estimate as published (target_t.radius_m, radius_sigma_m).
+  EXPECT_EQ(lines[1], "0.000000,7,1,10.0000,0.0000,10.0000,5.0000,0.0000,10.0000,5.0000,0.0000,1.0000,0.3480,0.0125");
+  EXPECT_NE(
+      std::find(lines.begin(), lines.end(), "0.200000,20,-1,1.0000,50.0000,50.0000,50.0000,,,,,1.0000,0.3480,0.0125"),
+      lines.end());
 }
 
 /// Ten frames; the logger saw ground truth k at W_k = 5e12 + k s and the targets from it (L_k = k + 1 ms) later. Frame

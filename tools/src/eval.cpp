@@ -386,7 +386,8 @@ EvalResult evaluate_log(const EvalOptions& o) {
     if (best_id < 0) {
       ++r.false_targets;
       false_tracks.insert(t.track_id);
-      r.targets.push_back({secs(u), t.track_id, -1, t.range, p_est, Eigen::Vector3d::Constant(kNaN), kNaN, t.range});
+      r.targets.push_back({secs(u), t.track_id, -1, t.range, p_est, Eigen::Vector3d::Constant(kNaN), kNaN, t.range,
+                           t.radius_m, t.radius_sigma_m});
       continue;
     }
     ++r.target_estimates;
@@ -395,7 +396,8 @@ EvalResult evaluate_log(const EvalOptions& o) {
     for (int k = 0; k < 3; ++k) axis[k].add(e[k]);
     const double range = have_follower ? (best_p - p_f).norm() : t.range;
     by_range.add(range, e.norm());
-    r.targets.push_back({secs(u), t.track_id, best_id, range, p_est, best_p, e.norm(), t.range});
+    r.targets.push_back(
+        {secs(u), t.track_id, best_id, range, p_est, best_p, e.norm(), t.range, t.radius_m, t.radius_sigma_m});
     if (have_follower && (best_p - p_f).norm() > 1e-6) {
       const Eigen::Vector3d los = (best_p - p_f).normalized();
       const double along = e.dot(los);
@@ -607,12 +609,15 @@ std::string EvalResult::json() const {
 }
 
 std::string EvalResult::csv() const {
-  std::string s = "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m\n";
+  std::string s =
+      "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m,radius_m,"
+      "radius_sigma_m\n";
   const auto num = [](double v) { return std::isnan(v) ? std::string() : fmt::format("{:.4f}", v); };
   for (const auto& t : targets) {
-    s += fmt::format("{:.6f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{:.4f}\n", t.t_s, t.track_id, t.vehicle_id,
-                     t.range_m, t.p_est.x(), t.p_est.y(), t.p_est.z(), num(t.p_truth.x()), num(t.p_truth.y()),
-                     num(t.p_truth.z()), num(t.error_m), t.range_est_m);
+    s += fmt::format("{:.6f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{:.4f},{:.4f},{:.4f}\n", t.t_s, t.track_id,
+                     t.vehicle_id, t.range_m, t.p_est.x(), t.p_est.y(), t.p_est.z(), num(t.p_truth.x()),
+                     num(t.p_truth.y()), num(t.p_truth.z()), num(t.error_m), t.range_est_m, t.radius_m,
+                     t.radius_sigma_m);
   }
   return s;
 }

@@ -154,6 +154,8 @@ struct EvalResult {
     Eigen::Vector3d p_est, p_truth;  ///< world frame, metres; p_truth is NaN for a false target
     double error_m;                  ///< |p_est - p_truth|, NaN for a false target
     double range_est_m;              ///< target_t.range: the localizer's camera-to-target distance, metres
+    double radius_m;                 ///< target_t.radius_m: the track's size estimate (bounding radius), metres
+    double radius_sigma_m;           ///< target_t.radius_sigma_m: its standard deviation, metres (0: not estimated)
   };
   std::vector<TargetSample> targets;
   /// One matched detection's box width (the report's scatter).
