@@ -15,8 +15,19 @@
 #                  follow_1d     the 1-D PID follow (thesis section 5.3)
 #                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
 #                  max_range     the farthest range at which the detector still finds an F450-sized drone at 1280x720
-#                  all           all of them, one after the other (the calibration after the static sweep)
+#                  suite         out of sample: 8 formation flights nothing was tuned on (seeds 1001-1008, used nowhere
+#                                else), drawn by `wingman scenario random`: the four shared airframes
+#                                (../shared/meshes; skipped with a message when absent) and procedural quad, hex and
+#                                octo, from behind and side-on, lighting A and B; the localizer at its defaults but
+#                                target.radius_m = the leader's true bounding radius. One table (RMS, by range, false
+#                                targets, ids, size estimate); --quick: the first 8 s of 2 of them (s1005, and s1001
+#                                or without the meshes s1008), exit 1 when one breaks the bounds: 3-D RMS <=
+#                                WINGMAN_SUITE_MAX_RMS m (default 2.5), false targets <= WINGMAN_SUITE_MAX_FALSE
+#                                (default 150). These guard against regressions (measured: 2.10 m / 108 and
+#                                1.71 m / 67, docs/results.md); they are far from issue 29's targets (0.3 m, 3 %, 0)
+#                  all           all of them but the suite, one after the other (the calibration after the static sweep)
 #   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
+#   --duration S   suite: fly only the first S seconds of each flight (default: each scenario's own 30-60 s)
 #   --out DIR      output folder (default build/experiments, or build/experiments-truth with --detections truth)
 #   --detections   cnn (default): the shipped model on rendered images; truth: boxes from the simulator's ground truth
 #                  (the bounding sphere's box, 1 px noise; no rendering): what the rest of the pipeline does with
@@ -31,12 +42,13 @@ bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 name="${1:-}"
 [ -n "$name" ] || { sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 2; }
 shift
-quick=false out_root="" detections=cnn
+quick=false out_root="" detections=cnn suite_duration=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=true; shift ;;
     --out) out_root="$2"; shift 2 ;;
     --detections) detections="$2"; shift 2 ;;
+    --duration) suite_duration="$2"; shift 2 ;;
     -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "experiment: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -151,8 +163,43 @@ max_range() {
   py max_range "$out" "$out/single/eval.json"
 }
 
+suite() {
+  local out="$out_root/suite" dur="$suite_duration" meshes flights=()
+  meshes=$(realpath -m "$src/../shared/meshes")
+  $quick && { out="$out_root/suite-quick"; dur=8; }
+  rm -rf "$out"; mkdir -p "$out/scenarios"
+  # seed airframe view lighting. The seeds are used nowhere else: nothing (box relation, tracker, controller) was
+  # tuned on these flights.
+  if [ -d "$meshes" ]; then
+    flights+=("1001 $meshes/dji_f450.glb behind A" "1002 $meshes/holybro_x500v2.glb side B"
+              "1003 $meshes/tarot_t650.glb behind B" "1004 $meshes/3dr_iris.glb side A")
+  else
+    echo "experiment: suite: no ../shared/meshes ($meshes): the four shared airframes are skipped, procedural only" >&2
+  fi
+  flights+=("1005 quad side A" "1006 hex behind B" "1007 octo side B" "1008 quad behind A")
+  if $quick; then
+    flights=("1005 quad side A")
+    if [ -d "$meshes" ]; then flights+=("1001 $meshes/dji_f450.glb behind A"); else flights+=("1008 quad behind A"); fi
+  fi
+  local evals=()
+  for f in "${flights[@]}"; do
+    read -r seed airframe view lighting <<< "$f"
+    local scn="$out/scenarios/s$seed.yaml"
+    "$bin/wingman" scenario random --seed "$seed" --airframe "$airframe" --view "$view" --lighting "$lighting" \
+      --out "$scn" >&2
+    local args=(--scenario "$scn" --localizer-config "${scn%.yaml}.localizer.yaml"
+                --follower-config "${scn%.yaml}.follower_ctrl.yaml" --render-config "${scn%.yaml}.render.yaml")
+    [ -z "$dur" ] || args+=(--duration "$dur")
+    fly "$out/s$seed" "${args[@]}"
+    evals+=("$out/s$seed/eval.json")
+  done
+  local bounds=()
+  $quick && bounds=(--max-rms "${WINGMAN_SUITE_MAX_RMS:-2.5}" --max-false "${WINGMAN_SUITE_MAX_FALSE:-150}")
+  py suite "$out" "${bounds[@]}" "${evals[@]}"
+}
+
 case "$name" in
-  static_sweep|calibration|distance|follow_1d|formation_2d|max_range) "$name" ;;
+  static_sweep|calibration|distance|follow_1d|formation_2d|max_range|suite) "$name" ;;
   all) static_sweep; calibration; distance; follow_1d; formation_2d; max_range ;;
   *) echo "experiment: unknown experiment '$name' (see --help)" >&2; exit 2 ;;
 esac

@@ -57,7 +57,7 @@ PY
 )
 got=$(val "$work/calibration/results.json" "'%.6f %d' % (r['radius_m'], r['n'])")
 [ "$got" = "$want" ] || fail "calibrated radius and count $got, want $want"
-grep -q "^| \*\*calibrated radius\*\* (m) | \*\*$(printf '%.3f' "${want% *}")\*\* |" "$work/calibration/results.md" || fail "calibration table: $(cat "$work/calibration/results.md")"
+grep -q "^| radius that would make it 1 (m) | $(printf "%.3f" "${want% *}") |" "$work/calibration/results.md" || fail "calibration table: $(cat "$work/calibration/results.md")"
 if python3 "$summary" calibration "$work/calibration" abc "$run" 2> "$work/err"; then fail "radius 'abc' accepted"; fi
 grep -q "radius 'abc': expected metres" "$work/err" || fail "bad radius not named: $(cat "$work/err")"
 # Distance: the along-the-line-of-sight mean and max.
@@ -67,6 +67,27 @@ grep -q "^| single detection, unfiltered | 1.59 / 19.77 | $along |" "$work/dista
 grep -q "^| mean absolute X error | 1.12 m |" "$work/follow_1d/results.md" || fail "follow table"
 grep -q "≈ 13.75 m" "$work/max_range/results.md" || fail "range table"
 python3 -c "import json; r=json.load(open('$work/max_range/results.json')); assert r['bins'] and sum(b['visible'] for b in r['bins']) > 0" || fail "max_range has no bins"
+# Suite (issue 29): one row per flight from its eval.json, targets.csv and the scenario's drawing; the RMS is the eval's,
+# the bins are the leader's targets by true range, and the bounds fail the summary (exit 1) naming the flight.
+mkdir -p "$work/suite/scenarios" "$work/suite/s1001"
+cp "$work/run/eval.json" "$work/run/targets.csv" "$work/suite/s1001/"
+echo '{"seed": 1001, "airframe": "procedural quad", "view": "side", "lighting": "A", "duration_s": 30.0, "legs": 4,
+ "offset_m": [0, -6, 0], "offset_distance_m": 6.0, "bounding_radius_m": 0.348}' > "$work/suite/scenarios/s1001.json"
+python3 "$summary" suite "$work/suite" --max-rms 1000 --max-false 1000000 "$work/suite/s1001/eval.json" > /dev/null \
+  || fail "suite within loose bounds failed"
+want_near=$(python3 - "$work/run/targets.csv" <<'PY'
+import csv, sys
+e = [float(x["error_m"]) for x in csv.DictReader(open(sys.argv[1])) if x["vehicle_id"] == "1" and float(x["range_m"]) < 10]
+print("%.2f (n = %d)" % ((sum(v * v for v in e) / len(e)) ** 0.5, len(e)) if e else "— (n = 0)")
+PY
+)
+grep -q "^| s1001 | procedural quad | side | A | 6.0 | [0-9]* | $(printf '%.3f' "$rms") | $want_near |" "$work/suite/results.md" \
+  || fail "suite row, want RMS $rms and below 10 m $want_near: $(cat "$work/suite/results.md")"
+if python3 "$summary" suite "$work/suite" --max-rms 0.0001 "$work/suite/s1001/eval.json" > "$work/out" 2>&1; then
+  fail "suite bound 0.0001 m passed"
+fi
+grep -q "BROKEN: s1001: 3-D RMS" "$work/out" || fail "broken bound not named: $(cat "$work/out")"
+
 # Wrong arguments: the usage, not a traceback.
 if python3 "$summary" formation_2d "$work" "$run" 2> "$work/err"; then fail "two runs accepted"; fi
 grep -q "Usage" "$work/err" || fail "no usage on bad arguments: $(cat "$work/err")"
