@@ -136,11 +136,14 @@ std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const s
   std::ofstream(localizer_cfg) << "camera: {width: 160, height: 120, focal_px: 100.0}\n";
   stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url,
                                                                     "--lockstep", "--config", localizer_cfg}));
+  // The follower with its default configuration (it watches the localizer's heartbeat; issue 33, finding 7).
+  stages.push_back(std::make_unique<Child>(
+      std::vector<std::string>{bin_path("wingman-follower-ctrl"), "--lcm-url", url, "--lockstep"}));
   const std::string record = dir.file("record" + std::to_string(run_index) + ".lcmlog");
-  const auto r =
-      run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for", "blob_stage,detector,localizer",
-           "--record", record, "--start-timeout", "20", "--step-timeout", "10"},
-          120s);
+  const auto r = run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for",
+                      "blob_stage,detector,localizer,follower_ctrl", "--record", record, "--start-timeout", "20",
+                      "--step-timeout", "10"},
+                     120s);
   *replay_err = r.err;
   for (auto& s : stages) {
     s->signal(SIGTERM);
@@ -192,6 +195,63 @@ TEST(Replay, LockstepReplayThroughLiveProcessesGivesIdenticalPayloadsAcrossTenRu
       EXPECT_EQ(wingman::testing::first_difference(reference, p), "") << "run " << i;
     }
   }
+}
+
+// Issue 33, finding 7: with the follower in --wait-for the replay never settled: the follower counts the localizer's
+// heartbeats (STATUS_LOCALIZER) as an input, which the player neither plays nor counts.
+TEST(Replay, LockstepSettlesWithTheFollowerThatWatchesTheLocalizerHeartbeat) {
+  TempDir dir;
+  std::vector<wingman::testing::LogEvent> events;
+  const int64_t t0 = 1700000000000000;
+  for (int k = 0; k < 40; ++k) {
+    const int64_t t = t0 + k * 20000;
+    wingman::own_pose_t p{};
+    p.utime = t;
+    p.frame = wingman::own_pose_t::FRAME_ENU;
+    p.p_body_in_world[2] = 5.0;
+    p.q_body_to_world[0] = 1.0;
+    events.push_back(wingman::testing::make_event("OWN_POSE", p, t));
+    if (k % 2 == 1) {  // detections of the image 20 ms earlier: a box straight ahead, 10 m away
+      wingman::detections_t d{};
+      d.utime = t - 20000;
+      d.seq = k / 2;
+      d.image_width = 160;
+      d.image_height = 120;
+      d.source = wingman::detections_t::SOURCE_GROUND_TRUTH;
+      wingman::detection_t b{};
+      b.cx = 79.5f;
+      b.cy = 59.5f;
+      b.w = 7.0f;
+      b.h = 7.0f;
+      b.confidence = 0.9f;
+      d.detections.push_back(b);
+      d.num_detections = 1;
+      events.push_back(wingman::testing::make_event("DETECTIONS_CAM0", d, t));
+    }
+  }
+  const std::string log = dir.file("poses_and_detections.lcmlog");
+  wingman::testing::write_log(log, events);
+  const std::string url = wingman::testing::netns_lcm_url();
+  const std::string localizer_cfg = dir.file("localizer.yaml");
+  std::ofstream(localizer_cfg) << "camera: {width: 160, height: 120, focal_px: 100.0}\n";
+  std::vector<std::unique_ptr<Child>> stages;
+  stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url,
+                                                                    "--lockstep", "--config", localizer_cfg}));
+  stages.push_back(std::make_unique<Child>(
+      std::vector<std::string>{bin_path("wingman-follower-ctrl"), "--lcm-url", url, "--lockstep"}));
+  const std::string record = dir.file("record.lcmlog");
+  const auto r = run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for", "localizer,follower_ctrl",
+                      "--record", record, "--start-timeout", "20", "--step-timeout", "10"},
+                     120s);
+  for (auto& s : stages) {
+    s->signal(SIGTERM);
+    EXPECT_EQ(s->wait(5s), 0) << s->err();
+  }
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("replay done: 60 events played"), std::string::npos) << r.err;
+  const auto p = payloads_by_channel(read_log(record));
+  EXPECT_EQ(p.count("TARGETS") ? p.at("TARGETS").size() : 0, 20u) << "one targets_t per detections_t";
+  EXPECT_GE(p.count("SETPOINT") ? p.at("SETPOINT").size() : 0, 20u) << "one setpoint per targets_t at least";
 }
 
 TEST(Replay, LockstepReportsAStageThatNeverStarted) {

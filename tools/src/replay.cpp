@@ -75,6 +75,9 @@ std::string unsettled(const BusObserver& bus, const std::vector<std::string>& st
     const auto& s = bus.statuses_.at(name);
     for (const auto& c : s.channels) {
       if (c.direction != wingman::channel_stats_t::DIRECTION_IN) continue;
+      // Heartbeats are wall-clock liveness, never played nor counted (a follower watches STATUS_LOCALIZER): a
+      // stage's count of them says nothing about the replay having settled.
+      if (is_status_channel(c.channel)) continue;
       const auto it = bus.bus_counts_.find(c.channel);
       const int64_t on_bus = it == bus.bus_counts_.end() ? 0 : it->second;
       const int64_t handled = c.count - baseline.at(name).at(c.channel);
