@@ -52,6 +52,10 @@ std::vector<std::string> FormationOptions::validate() const {
   finite_nonneg("formation.avoid_radius_m", avoid_radius_m);
   finite_nonneg("formation.avoid_climb_mps", avoid_climb_mps);
   finite_nonneg("formation.yaw_kp", yaw_kp);
+  finite_nonneg("formation.weave_m", weave_m);
+  if (!(weave_period_s >= 1.0) || !std::isfinite(weave_period_s))
+    p.push_back(problem("formation.weave_period_s", weave_period_s, "must be a finite number >= 1"));
+  finite_nonneg("formation.weave_until_rel", weave_until_rel);
   // The formation point must lie outside the avoidance sphere, or the follower would hover at its rim.
   if (offset_ok && parse_height_mode(height_mode) && avoid_radius_m > 0) {
     const bool with_z = *parse_height_mode(height_mode) == HeightMode::kTarget;
@@ -86,8 +90,23 @@ Eigen::Vector3d FormationController::desired_position(const TargetState& target,
 
 VelocityCommand FormationController::update(const TargetState& target, const OwnState& own, int64_t utime,
                                             double start_height_m) {
-  const Eigen::Vector3d e = desired_position(target, start_height_m) - own.p_body_in_world;
-  Eigen::Vector3d v_wanted = options_.feedforward_gain * target.v_target_in_world;
+  Eigen::Vector3d p_des = desired_position(target, start_height_m);
+  Eigen::Vector3d v_weave = Eigen::Vector3d::Zero();
+  if (options_.weave_m > 0 && target.size_sigma_rel > options_.weave_until_rel) {
+    // Across the line of sight, horizontally: a sine of message time (its phase from utime modulo the period).
+    const Eigen::Vector3d los = target.p_target_in_world - own.p_body_in_world;
+    const Eigen::Vector3d across = Eigen::Vector3d(-los.y(), los.x(), 0.0);
+    if (across.norm() > kMinBearingDistanceM) {
+      const int64_t period_us = static_cast<int64_t>(std::llround(options_.weave_period_s * 1e6));
+      const double phase = 2.0 * M_PI * static_cast<double>(((utime % period_us) + period_us) % period_us) /
+                           static_cast<double>(period_us);
+      const Eigen::Vector3d n = across.normalized();
+      p_des += options_.weave_m * std::sin(phase) * n;
+      v_weave = options_.weave_m * (2.0 * M_PI / options_.weave_period_s) * std::cos(phase) * n;
+    }
+  }
+  const Eigen::Vector3d e = p_des - own.p_body_in_world;
+  Eigen::Vector3d v_wanted = options_.feedforward_gain * target.v_target_in_world + v_weave;
   if (height_mode_ != HeightMode::kTarget) v_wanted.z() = 0.0;  // a constant height ignores the target's climb
   for (int i = 0; i < 3; ++i) v_wanted[i] += pid_[i].update(e[i], utime).output();
 

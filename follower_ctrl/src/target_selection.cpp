@@ -45,6 +45,7 @@ std::vector<TargetState> usable_targets(const wingman::targets_t& msg, int64_t m
     s.source_utime = t.source_utime;
     s.confidence = t.confidence;
     s.detection_source = t.detection_source;
+    s.size_sigma_rel = t.radius_m > 0 && std::isfinite(t.radius_sigma_m) ? t.radius_sigma_m / t.radius_m : 0.0;
     out.push_back(s);
   }
   return out;

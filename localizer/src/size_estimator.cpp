@@ -47,7 +47,7 @@ SizeEstimate SizeEstimator::estimate() const {
   const SizeEstimate prior{1.0, options_.prior_rel, false};
   if (!options_.enabled) return {1.0, 0.0, false};
   const double span_s = samples_.empty() ? 0.0 : 1e-6 * static_cast<double>(samples_.back().utime - samples_.front().utime);
-  if (static_cast<int>(samples_.size()) < options_.min_detections || span_s < 0.5 * options_.window_s) return prior;
+  if (static_cast<int>(samples_.size()) < options_.min_detections || span_s < 0.9 * options_.window_s) return prior;
 
   using Matrix10d = Eigen::Matrix<double, 10, 10>;
   using Vector10d = Eigen::Matrix<double, 10, 1>;

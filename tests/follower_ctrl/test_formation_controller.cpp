@@ -195,3 +195,29 @@ TEST(FormationController, ValidateNamesEveryBadKey) {
 }
 
 }  // namespace
+
+TEST(FormationController, WhileTheTargetsSizeIsInDoubtItWeavesAcrossTheLineOfSightThenStops) {
+  // Target 6 m north: the line of sight is along north, so the weave is along east-west (x), to the left of the line
+  // of sight (west) at a quarter period (sin = 1).
+  FormationOptions o = fixed_height(10.0);
+  o.weave_m = 1.0;
+  o.weave_period_s = 4.0;
+  FormationController c(o, wide_limits(), default_mount());
+  TargetState doubtful = target_at({0, 0, 10});
+  doubtful.size_sigma_rel = 0.3;
+  const int64_t quarter = 1'000'000;  // 1 s of a 4-s period
+  const int64_t t = kT0 - kT0 % 4'000'000 + quarter;
+  // On station at the formation point: the weave's offset (1 m west at sin = 1) is the whole position error, and its
+  // velocity (cos = 0) none.
+  const VelocityCommand weaving = c.update(doubtful, own_at({0, -6, 10}), t, 0.0);
+  EXPECT_VEC_NEAR(weaving.v_body_in_world, Vector3d(-o.kp * 1.0, 0.0, 0.0), 1e-6);
+  // Size known (sigma 2 %): no weave, on station.
+  FormationController d(o, wide_limits(), default_mount());
+  TargetState known = doubtful;
+  known.size_sigma_rel = 0.02;
+  EXPECT_VEC_NEAR(d.update(known, own_at({0, -6, 10}), t, 0.0).v_body_in_world, Vector3d::Zero(), 1e-9);
+  // Off: no weave either.
+  o.weave_m = 0.0;
+  FormationController off(o, wide_limits(), default_mount());
+  EXPECT_VEC_NEAR(off.update(doubtful, own_at({0, -6, 10}), t, 0.0).v_body_in_world, Vector3d::Zero(), 1e-9);
+}

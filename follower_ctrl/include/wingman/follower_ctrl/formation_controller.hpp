@@ -42,6 +42,14 @@ struct FormationOptions {
   double avoid_radius_m = 3.0;
   double avoid_climb_mps = 0.5;  ///< climb rate while avoiding, m/s (<= limits.max_vertical_speed_mps)
   double yaw_kp = 1.0;           ///< yaw rate per radian between the optical axis and the target's bearing, 1/s
+  /// Weave for the size: while the followed track's size is in doubt (target_t.radius_sigma_m / radius_m above
+  /// weave_until_rel), the follower swings this far (metres, horizontally across the line of sight, positive to its
+  /// left, a sine of weave_period_s and message time) about its formation position, so that the localizer can see the target's size from the parallax
+  /// (docs/localization.md, "Online size"). In a straight formation the camera otherwise moves in lock step with the
+  /// target and the size is not observable. 0 disables.
+  double weave_m = 1.0;
+  double weave_period_s = 6.0;   ///< period of the weave, s
+  double weave_until_rel = 0.03;  ///< weave while the size's relative sigma is above this
 
   template <class V>
   void visit(V& v) {
@@ -62,6 +70,10 @@ struct FormationOptions {
       "collision avoidance: target closer than this (3-D), m -> no approach and climb; 0 disables");
     v("formation.avoid_climb_mps", avoid_climb_mps, "climb rate while avoiding, m/s");
     v("formation.yaw_kp", yaw_kp, "yaw rate per radian of bearing error of the camera's optical axis, 1/s");
+    v("formation.weave_m", weave_m,
+      "while the target's size is in doubt, swing this far across the line of sight (parallax for the size), m; 0 off");
+    v("formation.weave_period_s", weave_period_s, "period of that weave, s");
+    v("formation.weave_until_rel", weave_until_rel, "weave while target_t.radius_sigma_m / radius_m is above this");
   }
   /// One "key = value: rule" line per problem; empty when valid.
   std::vector<std::string> validate() const;

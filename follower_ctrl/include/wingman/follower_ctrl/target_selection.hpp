@@ -22,6 +22,8 @@ struct TargetState {
   int64_t source_utime = 0;     ///< exposure utime of the newest image that updated the track
   float confidence = 0.0f;      ///< track confidence, 0..1
   int8_t detection_source = 0;  ///< detections_t.SOURCE_ of that image
+  /// The track's size doubt: target_t.radius_sigma_m / radius_m (0 when the localizer does not estimate the size).
+  double size_sigma_rel = 0.0;
 
   /// The state moved to `utime` at constant velocity (the tracker's motion model).
   TargetState predicted_to(int64_t utime) const;

@@ -21,7 +21,8 @@ struct SizeEstimatorOptions {
   /// Detections of the last window_s seconds are fitted (the target is taken to fly at constant acceleration over
   /// it). > 0.
   double window_s = 4.0;
-  /// A scale is reported only from at least this many detections spanning at least half the window. >= 3.
+  /// A scale is reported only from at least this many detections spanning 90 % of the window at least (a fit on the
+  /// first seconds of a track, through the follower's start, was adopted 21 % off in a flight). >= 3.
   int min_detections = 10;
   /// The tracker adopts a fit only when its sigma is at most this fraction of the scale and the straight-path model
   /// fits (chi-square per degree of freedom <= kMaxFitChi2Dof); until then the track keeps the scale it has (1 at
@@ -34,7 +35,7 @@ struct SizeEstimatorOptions {
       "estimate each target's size (range scale) online from the camera's motion across the line of sight");
     v("tracker.size_prior_rel", prior_rel, "standard deviation of the range scale before evidence (target.radius_m's doubt)");
     v("tracker.size_window_s", window_s, "detections of this many seconds are fitted (constant acceleration), s");
-    v("tracker.size_min_detections", min_detections, "detections a scale needs (spanning half the window at least)");
+    v("tracker.size_min_detections", min_detections, "detections a scale needs (spanning 90 % of the window at least)");
     v("tracker.size_accept_rel", accept_rel,
       "a track adopts a fitted scale only when its sigma is at most this fraction of it (and the fit holds)");
   }
