@@ -38,7 +38,7 @@ class SimulatedAutopilot {
   /// Sends to 127.0.0.1:`bridge_port` from an ephemeral port. Its boot was `boot_age_s` seconds ago; its clock runs
   /// `ppm` fast.
   SimulatedAutopilot(int bridge_port, double boot_age_s, double ppm) : ppm_(ppm) {
-    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (fd_ < 0) throw std::runtime_error("socket");
     sockaddr_in local{};
     local.sin_family = AF_INET;
@@ -72,7 +72,17 @@ class SimulatedAutopilot {
     hb_.system_status = mav::kMavStateActive;
     last_hb_ns_ = 0;  // announce at once
   }
+  /// Talks over `fd` (a serial line: a pty master, not owned) instead of UDP from now on; -1: the line is gone.
+  void attach_serial(int fd) {
+    serial_fd_ = fd;
+    serial_ = true;
+  }
   void send_raw(const std::vector<uint8_t>& bytes) {
+    if (serial_) {
+      if (serial_fd_ >= 0) [[maybe_unused]]
+        const ssize_t n = ::write(serial_fd_, bytes.data(), bytes.size());
+      return;
+    }
     ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&bridge_), sizeof bridge_);
   }
   template <class Msg>
@@ -85,17 +95,20 @@ class SimulatedAutopilot {
   void step(int64_t now_ns, int pose_period_ms = 20) {
     uint8_t buf[2048];
     for (;;) {
-      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+      const int from = serial_ ? serial_fd_ : fd_;
+      if (from < 0) break;
+      const ssize_t n = serial_ ? ::read(from, buf, sizeof buf) : ::recv(from, buf, sizeof buf, 0);
       if (n <= 0) break;
       parser_.feed(buf, static_cast<size_t>(n), [&](const mav::Frame& f) { on_frame(f, now_ns); });
-      parser_.end_of_datagram([&](const mav::Frame& f) { on_frame(f, now_ns); });
+      if (!serial_) parser_.end_of_datagram([&](const mav::Frame& f) { on_frame(f, now_ns); });
     }
     if (!silent && now_ns - last_hb_ns_ >= 1000000000) {
       send(hb_);
       last_hb_ns_ = now_ns;
     }
     if (!silent && now_ns - last_pose_ns_ >= pose_period_ms * 1000000LL) {
-      const uint32_t ms = static_cast<uint32_t>(boot_ns(now_ns) / 1000000);
+      // Measured measurement_delay_ms before it is sent (an estimator's delay): stamping on arrival would be late.
+      const uint32_t ms = static_cast<uint32_t>(boot_ns(now_ns - measurement_delay_ms * 1000000LL) / 1000000);
       const double s = ms * 1e-3;
       mav::AttitudeQuaternion a;
       a.time_boot_ms = ms;
@@ -114,6 +127,7 @@ class SimulatedAutopilot {
   }
 
   bool silent = false;                     ///< sends nothing of its own (answers still)
+  int measurement_delay_ms = 30;           ///< poses are sent this long after their measurement time
   std::vector<Received> setpoints;         ///< SET_POSITION_TARGET_LOCAL_NED received
   std::vector<mav::CommandLong> commands;  ///< COMMAND_LONG received
   std::vector<uint32_t> pose_times_ms;     ///< time_boot_ms of every pose sent
@@ -161,6 +175,8 @@ class SimulatedAutopilot {
   }
 
   int fd_ = -1;
+  bool serial_ = false;
+  int serial_fd_ = -1;
   sockaddr_in bridge_{};
   int64_t boot_epoch_ns_ = 0;
   double ppm_ = 0;

@@ -5,7 +5,9 @@
 #include "simulated_autopilot.hpp"
 #include "test_support.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <pty.h>
 #include <lcm/lcm-cpp.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/setpoint_t.hpp>
@@ -14,6 +16,7 @@
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -31,10 +34,14 @@ constexpr int kBridgePort = 14540;
 /// The bridge process with its config, an LCM client, and the simulated autopilot, stepped together.
 class BridgeRig {
  public:
-  explicit BridgeRig(const std::string& extra_yaml = "", double boot_age_s = 1234.5, double ppm = 200)
+  /// `link_yaml`: the link section ("" = listen on UDP kBridgePort).
+  explicit BridgeRig(const std::string& extra_yaml = "", double boot_age_s = 1234.5, double ppm = 200,
+                     const std::string& link_yaml = "")
       : autopilot(kBridgePort, boot_age_s, ppm), lcm_(wingman::testing::netns_lcm_url()) {
     if (!lcm_.good()) throw std::runtime_error("LCM not good");
-    std::ofstream(dir_.file("bridge.yaml")) << "link: {url: 'udp://:" << kBridgePort << "'}\n" << extra_yaml;
+    std::ofstream(dir_.file("bridge.yaml"))
+        << (link_yaml.empty() ? "link: {url: 'udp://:" + std::to_string(kBridgePort) + "'}\n" : link_yaml)
+        << extra_yaml;
     lcm_.subscribe("OWN_POSE", &BridgeRig::on_pose, this);
     lcm_.subscribe("STATUS_MAVLINK_BRIDGE", &BridgeRig::on_status, this);
     child_ = std::make_unique<wingman::testing::Child>(
@@ -103,7 +110,7 @@ TEST(MavlinkBridgeProcess, OwnPosesCarryTheAutopilotsMeasurementTimeThroughTimes
   EXPECT_GT(rig.autopilot.timesync_requests, 4);
   EXPECT_GT(rig.autopilot.heartbeats_from_bridge, 2);
   // Every pose's utime is the epoch time at which the autopilot's clock read its time_boot_ms (ms resolution, plus
-  // the offset's error: loopback round trips are well under 1 ms).
+  // the offset's error: half the asymmetry of loopback round trips of a few ms).
   double worst_us = 0;
   for (const auto& p : rig.poses) {
     const double north = p.p_body_in_world[1];
@@ -117,7 +124,10 @@ TEST(MavlinkBridgeProcess, OwnPosesCarryTheAutopilotsMeasurementTimeThroughTimes
     EXPECT_NEAR(p.p_body_in_world[2], 5.0, 1e-6);  // up
     EXPECT_NEAR(p.v_body_in_world[1], 1.0, 1e-6);  // flying north
   }
-  EXPECT_LT(worst_us, 2000.0) << "own pose time against the autopilot's measurement time";
+  // The autopilot sends each pose 30 ms after measuring it: stamping on arrival would be 30 ms late.
+  std::printf("own pose utime against the autopilot's measurement time: worst %.0f us over %zu poses\n", worst_us,
+              rig.poses.size());
+  EXPECT_LT(worst_us, 5000.0) << "own pose time against the autopilot's measurement time";
   ASSERT_FALSE(rig.statuses.empty());
   // OK but for the follower's missing setpoints (no follower runs here).
   const status_t& last = rig.statuses.back();
@@ -247,6 +257,51 @@ TEST(MavlinkBridgeProcess, SetpointToLinkLatency) {
   // and its bound is loose so a loaded CI machine passes; the figures are printed.
   EXPECT_LT(p99, 20.0);
   EXPECT_EQ(rig.stop(), 0);
+}
+
+TEST(MavlinkBridgeProcess, ASerialLineThatDisappearsAndComesBackIsReopened) {
+  // The autopilot on a serial line: a pty pair whose slave the bridge opens through a device link, as udev's
+  // /dev/serial/by-id names are; the line goes away (a USB autopilot rebooting) and comes back behind the same name.
+  wingman::testing::TempDir dir;
+  const std::string device = dir.file("ttyAUTOPILOT");
+  auto open_line = [&](int* master) {
+    int slave = -1;
+    char name[256];
+    if (::openpty(master, &slave, name, nullptr, nullptr) != 0) throw std::runtime_error("openpty failed");
+    ::close(slave);
+    ::fcntl(*master, F_SETFL, ::fcntl(*master, F_GETFL) | O_NONBLOCK);
+    ::fcntl(*master, F_SETFD, FD_CLOEXEC);  // the bridge, started from this process, must not hold the line open
+    std::filesystem::remove(device);
+    std::filesystem::create_symlink(name, device);
+  };
+  int master = -1;
+  open_line(&master);
+  BridgeRig rig("", 1234.5, 200, "link: {url: '" + device + "', baud: 921600, reopen_period_s: 0.2}\n");
+  rig.autopilot.attach_serial(master);
+  rig.autopilot.set_mode(true, false);
+  rig.run_for(2000ms);
+  const size_t first = rig.poses.size();
+  ASSERT_GT(first, 20u) << rig.err();
+  // The line disappears for a second.
+  ::close(master);
+  rig.autopilot.attach_serial(-1);
+  std::filesystem::remove(device);
+  rig.run_for(1000ms);
+  const size_t during = rig.poses.size();
+  EXPECT_LT(during - first, 10u) << "no poses while the line is gone";
+  // It comes back under the same name.
+  open_line(&master);
+  rig.autopilot.attach_serial(master);
+  rig.autopilot.set_mode(true, false);
+  rig.run_for(2500ms);
+  EXPECT_GT(rig.poses.size(), during + 20) << "own poses again after the bridge reopened the line; " << rig.err();
+  const status_t& last = rig.statuses.back();
+  const auto* link = channel(last, "MAVLINK");
+  ASSERT_NE(link, nullptr);
+  EXPECT_GE(link->drops, 1) << "the lost line is counted; " << last.detail;
+  EXPECT_EQ(rig.stop(), 0);
+  EXPECT_NE(rig.err().find("link lost"), std::string::npos) << rig.err();
+  ::close(master);
 }
 
 TEST(MavlinkBridgeProcess, BadInputIsCountedAndSurvived) {
