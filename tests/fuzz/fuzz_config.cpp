@@ -9,6 +9,7 @@
 #include <wingman/detector/detector_options.hpp>
 #include <wingman/follower_ctrl/follower_options.hpp>
 #include <wingman/localizer/localizer_options.hpp>
+#include <wingman/mavlink_bridge/bridge_options.hpp>
 #ifdef WINGMAN_FUZZ_WITH_SIM
 #include <wingman/sim/sim_options.hpp>
 #endif
@@ -39,7 +40,7 @@ void one(const std::string& text) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const std::string text(reinterpret_cast<const char*>(data) + 1, size - 1);
-  switch (data[0] % 5) {
+  switch (data[0] % 6) {
     case 0:
       one<wingman::camera_driver::CameraDriverOptions>(text);
       break;
@@ -51,6 +52,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       break;
     case 3:
       one<wingman::follower_ctrl::FollowerOptions>(text);
+      break;
+    case 5:
+      one<wingman::mavlink_bridge::BridgeOptions>(text);
       break;
     default:
 #ifdef WINGMAN_FUZZ_WITH_SIM
