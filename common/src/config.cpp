@@ -2,6 +2,8 @@
 // YAML configuration loader and printer.
 #include "wingman/common/config.hpp"
 
+#include "wingman/common/yaml_limits.hpp"
+
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -43,6 +45,9 @@ ConfigLoader ConfigLoader::from_file(const std::string& path) {
 }
 
 ConfigLoader ConfigLoader::from_string(const std::string& yaml_text, const std::string& source_name) {
+  // Size and alias expansion bounded before yaml-cpp builds anything: a 663-byte alias bomb took 4.2 GB, 31 s and
+  // a 630 MB error line (issue 33).
+  if (const std::string bad = check_yaml_bounds(yaml_text, source_name); !bad.empty()) throw ConfigError(bad);
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);

@@ -193,7 +193,8 @@ const std::map<std::string, const WireStruct*>& schemas() {
 /// Walks one encoded struct; `top` holds the integer values of the top-level fields (for the image limits).
 class Walker {
  public:
-  Walker(const uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  Walker(const uint8_t* data, std::size_t size, std::int64_t max_elements = std::numeric_limits<std::int64_t>::max())
+      : data_(data), size_(size), max_elements_(max_elements) {}
 
   std::size_t pos() const { return pos_; }
 
@@ -222,6 +223,11 @@ class Walker {
         count = ints[j];
         const std::string length_name = path + "." + f.length_field;
         if (count < 0) return fmt::format("{} = {}: a length must not be negative", length_name, count);
+        // Arrays of structs and strings (boxes, targets, channel stats) cost far more than their bytes to decode
+        // and handle: bounded by count (MessageLimits::max_array_elements), before anything is decoded.
+        if ((f.type == Wire::kStruct || f.type == Wire::kString) && count > max_elements_)
+          return fmt::format("{} = {}: more than the {} elements accepted (max_array_elements)", length_name, count,
+                             max_elements_);
         // Every element takes at least one byte: a count beyond the bytes left can never decode, and the
         // generated decoder would allocate `count` elements before finding that out.
         const std::size_t min_element = f.type == Wire::kStruct ? min_size(*f.nested) : fixed_size(f.type);
@@ -277,6 +283,7 @@ class Walker {
  private:
   const uint8_t* data_;
   std::size_t size_;
+  std::int64_t max_elements_;
   std::size_t pos_ = 0;
 };
 
@@ -288,6 +295,8 @@ std::string MessageLimits::validate() const {
     return fmt::format("image max_width x max_height = {} x {}: must be positive", image.max_width, image.max_height);
   if (max_image_bytes < 0)
     return fmt::format("max_image_bytes = {}: must be >= 0 (0 = from the size)", max_image_bytes);
+  if (max_array_elements < 1)
+    return fmt::format("max_array_elements = {}: must be >= 1", max_array_elements);
   return "";
 }
 
@@ -311,7 +320,7 @@ std::string check_encoded(const std::string& type_name, std::int64_t fingerprint
   if (size > limits.max_message_bytes)
     return fmt::format("{} bytes: larger than the {} bytes accepted (max_message_bytes)", size,
                        limits.max_message_bytes);
-  Walker w(static_cast<const uint8_t*>(data), size);
+  Walker w(static_cast<const uint8_t*>(data), size, limits.max_array_elements);
   if (size < 8) return fmt::format("{} bytes: too short for an LCM message (8-byte fingerprint)", size);
   if (w.read_be(8) != fingerprint)
     return fmt::format("{} bytes: fingerprint is not {}'s (wrong type on this channel)", size, type_name);

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
 // ConfigLoader / ConfigPrinter: defaults, every bad key reported at once, round trip.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <wingman/common/config.hpp>
+#include <wingman/common/time_sanity.hpp>
+
+#include <chrono>
 
 namespace {
 
@@ -131,6 +135,32 @@ TEST(ConfigLoader, ADirectoryIsAnErrorNotAnEmptyConfig) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), dir + ": is a directory, not a config file");
   }
+}
+
+// Issue 33, finding 5: a 663-byte alias bomb in a mapping took 4.2 GB, 31 s and wrote a 630 MB error line.
+TEST(ConfigLoader, AnAliasBombIsANamedProblemNotGigabytes) {
+  // Mappings of mappings: the loader walks every key of every expansion.
+  std::string bomb = "a: &a {k: 1, l: 1, m: 1, n: 1, o: 1, p: 1, q: 1, r: 1, s: 1}\n";
+  for (char c = 'b'; c <= 'i'; ++c) {
+    const char p = static_cast<char>(c - 1);
+    bomb += fmt::format(
+        "{0}: &{0} {{k: *{1}, l: *{1}, m: *{1}, n: *{1}, o: *{1}, p: *{1}, q: *{1}, r: *{1}, s: *{1}}}\n", c, p);
+  }
+  ASSERT_LT(bomb.size(), 700u);  // 9^9 = 387 million keys once expanded
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    load_options_from_string<wingman::common::TimeSanityOptions>(bomb, "bomb.yaml");
+    ADD_FAILURE() << "an alias bomb was loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "bomb.yaml: YAML aliases expand to more than 100000 nodes (an alias bomb?)");
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  // A few aliases, as a person might write, still load.
+  EXPECT_NO_THROW(load_options_from_string<wingman::common::TimeSanityOptions>(
+      "time: {max_ahead_s: &t 0.5, resync_after_s: *t}\n", "ok.yaml"));
+  // And a document larger than 1 MiB is refused by its size.
+  EXPECT_THROW(load_options_from_string<wingman::common::TimeSanityOptions>(std::string(2 << 20, '#'), "big.yaml"),
+               ConfigError);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // would make LCM's decoder allocate more than they carry (or exceed the limits) are rejected before decoding.
 #include <gtest/gtest.h>
 #include <wingman/common/message_limits.hpp>
+#include <wingman/detections_t.hpp>
 
 #include <cstdint>
 #include <limits>
@@ -136,6 +137,27 @@ TEST(MessageLimits, ImageByteLimitSaturatesInsteadOfOverflowing) {
   EXPECT_EQ(l.image_bytes_limit(), std::numeric_limits<int64_t>::max());
   l.image.max_height = 8192;
   EXPECT_EQ(l.image_bytes_limit(), int64_t{2147483647} * 8192 * 4);
+}
+
+// Issue 33, finding 5: one detections_t of 10^6 boxes cost the localizer 1.5 GB and 15 s; arrays of structs are
+// bounded by count before anything is decoded.
+TEST(CheckEncoded, RejectsMoreBoxesThanMaxArrayElementsBeforeDecoding) {
+  const MessageLimits limits;
+  wingman::detections_t d{};
+  d.image_width = 640;
+  d.image_height = 480;
+  d.detections.resize(static_cast<size_t>(limits.max_array_elements));
+  d.num_detections = static_cast<int32_t>(d.detections.size());
+  const std::vector<uint8_t> ok = encode(d);
+  EXPECT_EQ(check_encoded<wingman::detections_t>(ok.data(), ok.size(), limits), "");
+  d.detections.resize(1000000);
+  d.num_detections = 1000000;
+  const std::vector<uint8_t> huge = encode(d);
+  EXPECT_EQ(check_encoded<wingman::detections_t>(huge.data(), huge.size(), limits),
+            "detections_t.num_detections = 1000000: more than the 4096 elements accepted (max_array_elements)");
+  MessageLimits bad;
+  bad.max_array_elements = 0;
+  EXPECT_NE(bad.validate().find("max_array_elements = 0"), std::string::npos);
 }
 
 TEST(CheckEncoded, RejectsImagesAndMessagesOverTheLimits) {

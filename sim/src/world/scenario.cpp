@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
+#include <wingman/common/yaml_limits.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -165,6 +166,8 @@ const VehicleSpec& Scenario::camera_vehicle() const {
 }
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name, const std::string& base_dir) {
+  // Size and alias expansion bounded before yaml-cpp builds anything (a 663-byte alias bomb took 4.2 GB).
+  if (const std::string bad = common::check_yaml_bounds(yaml_text, source_name); !bad.empty()) throw ScenarioError(bad);
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
