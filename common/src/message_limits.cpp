@@ -295,8 +295,7 @@ std::string MessageLimits::validate() const {
     return fmt::format("image max_width x max_height = {} x {}: must be positive", image.max_width, image.max_height);
   if (max_image_bytes < 0)
     return fmt::format("max_image_bytes = {}: must be >= 0 (0 = from the size)", max_image_bytes);
-  if (max_array_elements < 1)
-    return fmt::format("max_array_elements = {}: must be >= 1", max_array_elements);
+  if (max_array_elements < 1) return fmt::format("max_array_elements = {}: must be >= 1", max_array_elements);
   return "";
 }
 
