@@ -246,14 +246,17 @@ void Bridge::tick(int64_t mono_us, int64_t wall_ns, BridgeOutput& out) {
     t->target_component = static_cast<uint8_t>(o_.autopilot_component_id);
     send(*t, out);
   }
-  // Mode and arm requests: only where a config key allows them, and only while the follower has live setpoints.
+  // Mode and arm requests: only where a config key allows them, and only while the follower has live setpoints. A
+  // refusal is counted once per setpoint received, not per tick.
+  const bool count_refusal = streamer_.setpoint_mono_us() != refusal_counted_for_us_;
   const bool wants = streamer_.state() == StreamState::kReady ||
                      (autopilot_.kind == AutopilotKind::kArdupilot && streamer_.wants_control(mono_us));
   if (autopilot_.known && !autopilot_.engaged && wants) {
     if (!o_.allow_mode_switch) {
-      refuse("mode_switch_not_allowed",
-             "setpoints are live but the autopilot is not in OFFBOARD/GUIDED; the pilot "
-             "must engage it (safety.allow_mode_switch is false)");
+      if (count_refusal)
+        refuse("mode_switch_not_allowed",
+               "setpoints are live but the autopilot is not in OFFBOARD/GUIDED; the pilot "
+               "must engage it (safety.allow_mode_switch is false)");
     } else if (last_mode_request_us_ < 0 || mono_us - last_mode_request_us_ >= kRequestRetryUs) {
       const bool px4 = autopilot_.kind == AutopilotKind::kPx4;
       send_command(kMavCmdDoSetMode, kMavModeFlagCustomModeEnabled,
@@ -263,14 +266,16 @@ void Bridge::tick(int64_t mono_us, int64_t wall_ns, BridgeOutput& out) {
   }
   if (autopilot_.known && !autopilot_.armed && streamer_.wants_control(mono_us)) {
     if (!o_.allow_arm) {
-      refuse("arm_not_allowed",
-             "setpoints are live but the vehicle is disarmed; the pilot must arm it "
-             "(safety.allow_arm is false)");
+      if (count_refusal)
+        refuse("arm_not_allowed",
+               "setpoints are live but the vehicle is disarmed; the pilot must arm it "
+               "(safety.allow_arm is false)");
     } else if (last_arm_request_us_ < 0 || mono_us - last_arm_request_us_ >= kRequestRetryUs) {
       send_command(kMavCmdComponentArmDisarm, 1, 0, 0, 0, out);
       last_arm_request_us_ = mono_us;
     }
   }
+  refusal_counted_for_us_ = streamer_.setpoint_mono_us();
 }
 
 std::string Bridge::detail() const {

@@ -74,6 +74,7 @@ class Bridge {
   int64_t last_timesync_tx_us_ = -1;
   int64_t last_mode_request_us_ = -1;
   int64_t last_arm_request_us_ = -1;
+  int64_t refusal_counted_for_us_ = -1;  ///< setpoint (its arrival) whose mode/arm refusals were counted
   int64_t newest_pose_utime_ = 0;
   int64_t poses_ = 0;
   uint8_t seq_ = 0;

@@ -66,6 +66,8 @@ class OffboardStreamer {
 
   /// True while the follower's setpoints are live (received within setpoint_timeout_s) and not MODE_HOLD.
   bool wants_control(int64_t mono_us) const;
+  /// When the newest usable setpoint arrived (monotonic us; 0 before the first).
+  int64_t setpoint_mono_us() const { return setpoint_mono_us_; }
   StreamState state() const { return state_; }
   const Refusals& refusals() const { return refusals_; }
   int64_t sent() const { return sent_; }

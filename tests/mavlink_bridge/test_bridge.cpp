@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: MIT
+// Bridge without I/O: mode and arm requests only where allowed, at most once a second, and refusals counted once
+// per setpoint.
+#include <wingman/mavlink/enums.hpp>
+#include <wingman/mavlink/parser.hpp>
+#include <wingman/mavlink_bridge/bridge.hpp>
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+using namespace wingman::mavlink_bridge;
+namespace mav = wingman::mavlink;
+
+namespace {
+
+constexpr int64_t kMs = 1000;
+
+/// The frame of an autopilot message, as the parser hands it on.
+template <class Msg>
+mav::Frame frame_of(const Msg& m) {
+  const auto bytes = mav::encode(m, mav::Sender{1, 1, 0});
+  mav::Frame out;
+  mav::Parser p;
+  p.feed(bytes.data(), bytes.size(), [&](const mav::Frame& f) { out = f; });
+  return out;
+}
+
+/// COMMAND_LONGs among `frames`.
+std::vector<mav::CommandLong> commands(const std::vector<std::vector<uint8_t>>& frames) {
+  std::vector<mav::CommandLong> out;
+  mav::Parser p;
+  for (const auto& f : frames)
+    p.feed(f.data(), f.size(), [&](const mav::Frame& fr) {
+      mav::CommandLong c;
+      if (mav::decode(fr, c)) out.push_back(c);
+    });
+  return out;
+}
+
+/// Runs 3 s: an ArduPilot in LOITER, disarmed; setpoints every 100 ms. Returns the commands the bridge sent.
+std::vector<mav::CommandLong> fly(Bridge& bridge) {
+  mav::Heartbeat hb;
+  hb.autopilot = mav::kMavAutopilotArdupilotmega;
+  hb.base_mode = mav::kMavModeFlagCustomModeEnabled;
+  hb.custom_mode = mav::kCopterModeLoiter;
+  BridgeOutput out;
+  wingman::setpoint_t sp{};
+  sp.mode = wingman::setpoint_t::MODE_VELOCITY;
+  sp.velocity[0] = 1;
+  for (int64_t t = 0; t < 3000; t += 5) {
+    if (t % 1000 == 0) bridge.on_frame(frame_of(hb), t * kMs, 0, out);
+    if (t % 100 == 0) bridge.on_setpoint(sp, t * kMs, out);
+    bridge.tick(t * kMs, 0, out);
+  }
+  return commands(out.frames);
+}
+
+}  // namespace
+
+TEST(Bridge, NeverRequestsModeOrArmingUnlessAllowedAndCountsEachSetpointOnce) {
+  Bridge bridge(BridgeOptions{}, nullptr);
+  for (const auto& c : fly(bridge)) {
+    EXPECT_NE(c.command, mav::kMavCmdDoSetMode);
+    EXPECT_NE(c.command, mav::kMavCmdComponentArmDisarm);
+  }
+  // 30 setpoints: each refused once for the mode, once for arming and once for not being engaged.
+  EXPECT_EQ(bridge.refusals().count_of("mode_switch_not_allowed"), 30);
+  EXPECT_EQ(bridge.refusals().count_of("arm_not_allowed"), 30);
+  EXPECT_EQ(bridge.streamer().refusals().count_of("setpoint_not_engaged"), 30);
+}
+
+TEST(Bridge, WhenAllowedRequestsGuidedAndArmingAtMostOnceASecond) {
+  BridgeOptions o;
+  o.allow_mode_switch = true;
+  o.allow_arm = true;
+  Bridge bridge(o, nullptr);
+  int mode = 0, arm = 0;
+  for (const auto& c : fly(bridge)) {
+    if (c.command == mav::kMavCmdDoSetMode) {
+      ++mode;
+      EXPECT_FLOAT_EQ(c.param1, mav::kMavModeFlagCustomModeEnabled);
+      EXPECT_FLOAT_EQ(c.param2, static_cast<float>(mav::kCopterModeGuided));
+    }
+    if (c.command == mav::kMavCmdComponentArmDisarm) {
+      ++arm;
+      EXPECT_FLOAT_EQ(c.param1, 1.0f);
+    }
+  }
+  EXPECT_GE(mode, 2);
+  EXPECT_LE(mode, 3) << "at most once a second over 3 s";
+  EXPECT_GE(arm, 2);
+  EXPECT_LE(arm, 3);
+}
