@@ -9,7 +9,9 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <sys/eventfd.h>
+#include <sys/socket.h>
 #include <sys/syscall.h>
+#include <sys/un.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
@@ -17,6 +19,8 @@
 #include <cctype>
 #include <cerrno>
 #include <csignal>
+#include <cstddef>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -69,6 +73,8 @@ std::string RuntimeOptions::validate() const {
   if (is_file_url(lcm_url) && lcm_url.find("mode=") != std::string::npos && lcm_url.find("mode=r") == std::string::npos)
     return fmt::format("--lcm-url = '{}': a log opened for writing cannot also be the input; use --lcm-out for it",
                        lcm_url);
+  if (!(watchdog_s == 0.0 || (watchdog_s >= 0.1 && watchdog_s <= 3600.0)))
+    return fmt::format("--watchdog = {}: must be 0 (off) or in [0.1, 3600] seconds", watchdog_s);
   if (const std::string in = lcm_in.empty() ? lcm_url : lcm_in; is_file_url(in)) {
     try {
       parse_lcm_file_url(in);
@@ -124,7 +130,76 @@ Runtime::Runtime(const ProcessInfo& info, const RuntimeOptions& options)
 }
 
 Runtime::~Runtime() {
+  watchdog_stop_.store(true);
+  if (watchdog_.joinable()) watchdog_.join();
   if (wake_fd_ >= 0) close(wake_fd_);
+}
+
+namespace {
+
+int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+/// sd_notify(0, message) without libsystemd: one datagram to $NOTIFY_SOCKET ("@name": abstract). False when there is
+/// no socket to tell.
+bool notify_service_manager(const char* message) {
+  const char* path = std::getenv("NOTIFY_SOCKET");
+  if (path == nullptr || path[0] == '\0' || std::strlen(path) >= sizeof(sockaddr_un{}.sun_path)) return false;
+  const int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return false;
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::strncpy(addr.sun_path, path, sizeof(addr.sun_path) - 1);
+  if (path[0] == '@') addr.sun_path[0] = '\0';
+  const socklen_t len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + std::strlen(path));
+  const bool ok =
+      sendto(fd, message, std::strlen(message), MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&addr), len) >= 0;
+  close(fd);
+  return ok;
+}
+
+}  // namespace
+
+void Runtime::note_progress() { progress_ns_.store(steady_ns(), std::memory_order_relaxed); }
+
+void Runtime::start_watchdog() {
+  note_progress();
+  if (watchdog_checked_) return;
+  watchdog_checked_ = true;
+  const char* usec = std::getenv("WATCHDOG_USEC");
+  const int64_t systemd_ns = usec != nullptr ? std::strtoll(usec, nullptr, 10) * 1000 : 0;
+  const int64_t own_ns = static_cast<int64_t>(options_.watchdog_s * 1e9);
+  if (own_ns <= 0 && systemd_ns <= 0) return;
+  notify_service_manager("READY=1");
+  const std::string executable = info_.executable;
+  const double watchdog_s = options_.watchdog_s;
+  watchdog_ = std::thread([this, own_ns, systemd_ns, executable, watchdog_s] {
+    // Checks often enough to react within a tenth of the bound (at least every 100 ms).
+    const int64_t tick_ns = std::min<int64_t>(
+        100000000,
+        std::max<int64_t>(1000000,
+                          std::min(own_ns > 0 ? own_ns : INT64_MAX, systemd_ns > 0 ? systemd_ns : INT64_MAX) / 10));
+    int64_t last_ping = 0;
+    while (!watchdog_stop_.load()) {
+      std::this_thread::sleep_for(std::chrono::nanoseconds(tick_ns));
+      const int64_t now = steady_ns();
+      const int64_t idle = now - progress_ns_.load(std::memory_order_relaxed);
+      if (own_ns > 0 && idle > own_ns) {
+        // The loop is stuck (e.g. a handler that never returns): say so and exit, so the supervisor restarts us.
+        std::fprintf(stderr, "%s: error: watchdog: the main loop made no progress for %.1f s (--watchdog %g)\n",
+                     executable.c_str(), static_cast<double>(idle) * 1e-9, watchdog_s);
+        std::fflush(stderr);
+        std::_Exit(1);
+      }
+      // systemd (WatchdogSec): ping at half its interval, and only while the loop progresses.
+      if (systemd_ns > 0 && idle < systemd_ns / 2 && now - last_ping >= systemd_ns / 2) {
+        notify_service_manager("WATCHDOG=1");
+        last_ping = now;
+      }
+    }
+  });
 }
 
 void Runtime::wake() {
@@ -247,6 +322,7 @@ bool Runtime::spin_file_once(int timeout_ms) {
 
 bool Runtime::spin_once(int timeout_ms) {
   g_starting.store(false);
+  start_watchdog();  // start-up is over: from here on the loop must keep coming back
   if (stop_requested() || end_of_input_) return false;
   if (input_is_file_) return spin_file_once(timeout_ms);
   lcm::LCM& in = input();
@@ -315,6 +391,8 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
                "Publish status after every handled message (for `wingman replay --lockstep`)");
   app.add_option("--status-period", ro.status_period_s, "Heartbeat period, seconds (default 1)");
   app.add_option("--log-level", ro.log_level, "trace, debug, info, warn or error (default info)");
+  app.add_option("--watchdog", ro.watchdog_s,
+                 "Exit 1 when the main loop makes no progress for this many seconds (default 0: off)");
   app.add_flag("--skip-corrupt-log", ro.skip_corrupt_log,
                "A corrupt event of a file:// input is skipped and counted (default: exit 1 naming its byte offset)");
   try {

@@ -10,6 +10,7 @@
 
 #include <csignal>
 #include <fstream>
+#include <iostream>
 #include <thread>
 
 namespace {
@@ -150,6 +151,41 @@ TEST(ProcessSignals, SigtermAndSigintEndEveryProcessWithExitZeroWithinOneSecond)
       EXPECT_LT(elapsed, stop_latency_bound()) << "took " << std::chrono::duration<double>(elapsed).count() << " s";
     }
   }
+}
+
+// Issue 33, Deliver 2: a handler that never returns (a livelock) left a process alive and useless, and nothing
+// restarted it. With --watchdog S the runtime exits 1 with one line once the loop has made no progress for S.
+TEST(ProcessWatchdog, AStuckHandlerEndsTheProcessWithExitOneWithinTheBound) {
+  TempDir dir;
+  std::vector<wingman::testing::LogEvent> events;
+  for (int i = 0; i < 4; ++i) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+  const std::string cfg = dir.file("stage.yaml");
+  std::ofstream(cfg) << "test: {hang_on_seq: 2}\n";
+  const std::vector<std::string> cmd = {wingman::testing::test_bin_path("wingman-test-blob-stage"),
+                                        "--config",
+                                        cfg,
+                                        "--lcm-in",
+                                        "file://" + dir.file("in.lcmlog") + "?speed=0",
+                                        "--lcm-out",
+                                        "file://" + dir.file("out.lcmlog") + "?mode=w"};
+  std::vector<std::string> watched = cmd;
+  watched.insert(watched.end(), {"--watchdog", "1"});
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = run(watched, 10s);
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("wingman-test-blob-stage: error: watchdog: the main loop made no progress for 1."),
+            std::string::npos)
+      << r.err;
+  EXPECT_LT(took_s, 5.0);
+  std::cout << "watchdog: stuck handler ended after " << took_s << " s (bound 1 s)\n";
+  // Without it the process stays stuck (killed here by the test's bound).
+  const auto stuck = run(cmd, 3s);
+  EXPECT_EQ(stuck.exit_code, -1) << "timed out";
+  const auto bad = run({wingman::testing::test_bin_path("wingman-test-blob-stage"), "--watchdog", "0.01"}, 10s);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--watchdog = 0.01: must be 0 (off) or in [0.1, 3600] seconds"), std::string::npos) << bad.err;
 }
 
 TEST(ProcessFileIo, DetectorCountsFramesMissingFromTheSequenceAsDropsButNotThoseThatArrivedBroken) {

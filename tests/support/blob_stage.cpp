@@ -11,13 +11,15 @@ namespace {
 struct BlobStageOptions {
   std::string input_channel = "IMAGE_CAM0";
   std::string output_channel = "DETECTIONS_CAM0";
-  int threshold = 200;  ///< grey level above which a pixel belongs to the blob, 0..255
+  int threshold = 200;       ///< grey level above which a pixel belongs to the blob, 0..255
+  int64_t hang_on_seq = -1;  ///< tests of the watchdog: the handler of the image with this seq never returns; -1 never
 
   template <class V>
   void visit(V& v) {
     v("input.channel", input_channel, "image_t input channel");
     v("output.channel", output_channel, "detections_t output channel");
     v("blob.threshold", threshold, "grey level above which a pixel is part of the blob, 0..255");
+    v("test.hang_on_seq", hang_on_seq, "the handler of this image seq never returns (watchdog tests); -1 never");
   }
   std::vector<std::string> validate() const {
     std::vector<std::string> p;
@@ -35,6 +37,11 @@ int main(int argc, char** argv) {
   return common::run_process<BlobStageOptions>(info, argc, argv, [](common::Runtime& rt, const BlobStageOptions& o) {
     rt.status().declare_output(o.output_channel);
     rt.subscribe<image_t>(o.input_channel, [&](const image_t& img) {
+      if (img.seq == o.hang_on_seq) {
+        // A livelock for the watchdog tests: busy for ever (the watchdog or the test's time bound ends it).
+        volatile uint64_t spins = 0;
+        for (;;) spins = spins + 1;
+      }
       if (img.pixel_format != image_t::GRAY8 && img.pixel_format != image_t::BGR8) {
         throw std::runtime_error("image_t.pixel_format = " + common::pixel_format_name(img.pixel_format) +
                                  ": blob stage takes GRAY8 or BGR8");

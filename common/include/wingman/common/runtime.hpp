@@ -20,6 +20,7 @@
 #include <regex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace wingman::common {
@@ -45,6 +46,11 @@ struct RuntimeOptions {
   /// --skip-corrupt-log: a corrupt event of a file:// input is skipped and counted (as drops of the input log)
   /// instead of ending the process with exit 1 and a line naming its byte offset.
   bool skip_corrupt_log = false;
+  /// --watchdog S: when the process's loop makes no progress (no spin_once() returns, e.g. a handler that never
+  /// ends) for S seconds after start-up, one line `<executable>: error: watchdog: ...` and exit 1, so the supervisor
+  /// restarts it. Seconds of wall time, 0 = off (default), else 0.1..3600. Under systemd with WatchdogSec, the
+  /// same progress also pings the service manager (sd_notify WATCHDOG=1), which catches a stopped process too.
+  double watchdog_s = 0.0;
 
   /// "" or one line naming the bad option.
   std::string validate() const;
@@ -167,6 +173,13 @@ class Runtime {
   bool stop_requested_locally_ = false;
   bool record_handler_latency_ = true;
   int wake_fd_ = -1;  ///< eventfd that wake() writes and spin_once() waits on beside LCM's descriptor
+  /// The progress watchdog (--watchdog, systemd's WATCHDOG_USEC): a thread started at the first spin_once().
+  void start_watchdog();
+  void note_progress();
+  std::atomic<int64_t> progress_ns_{0};  ///< steady clock of the last loop progress
+  std::atomic<bool> watchdog_stop_{false};
+  bool watchdog_checked_ = false;  ///< start_watchdog() has decided whether a thread is needed
+  std::thread watchdog_;
 };
 
 template <class Msg>
