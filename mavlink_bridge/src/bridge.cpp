@@ -134,6 +134,13 @@ void Bridge::on_frame(const Frame& f, int64_t mono_us, int64_t wall_ns, BridgeOu
     return;
   }
   if (!from_autopilot) return;
+  if (f.msgid == SystemTime::kId) {
+    SystemTime st;
+    decode(f, st);
+    if (st.time_unix_usec != 0)
+      unix_diff_s_ = (static_cast<double>(st.time_unix_usec) - static_cast<double>(wall_ns / 1000)) * 1e-6;
+    return;
+  }
   std::string why;
   std::optional<NedPose> pose;
   switch (f.msgid) {
@@ -178,6 +185,7 @@ void Bridge::on_frame(const Frame& f, int64_t mono_us, int64_t wall_ns, BridgeOu
       return;
   }
   if (!why.empty()) refuse("bad_pose_message", why);
+  if (pose && pose->position_std_m >= 0) position_std_m_ = pose->position_std_m;
   if (pose) publish_pose(*pose, out);
 }
 
@@ -296,6 +304,16 @@ std::string Bridge::detail() const {
     s += "; no time sync yet";
   }
   s += "; own poses " + std::to_string(poses_);
+  if (position_std_m_ >= 0) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, " (position std %.3f m)", position_std_m_);
+    s += buf;
+  }
+  if (std::isfinite(unix_diff_s_)) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "; autopilot Unix clock %+.3f s from ours", unix_diff_s_);
+    s += buf;
+  }
   s += "; refusals: " + streamer_.refusals().summary() + "; " + refusals_.summary();
   return s;
 }

@@ -92,3 +92,27 @@ TEST(Bridge, WhenAllowedRequestsGuidedAndArmingAtMostOnceASecond) {
   EXPECT_GE(arm, 2);
   EXPECT_LE(arm, 3);
 }
+
+TEST(Bridge, OdometryCovarianceAndTheAutopilotsUnixClockAreReported) {
+  Bridge bridge(BridgeOptions{}, nullptr);
+  BridgeOutput out;
+  mav::Heartbeat hb;
+  hb.autopilot = mav::kMavAutopilotPx4;
+  bridge.on_frame(frame_of(hb), 0, 0, out);
+  const int64_t wall_ns = 1796428800LL * 1000000000LL;
+  mav::SystemTime st;
+  st.time_unix_usec = static_cast<uint64_t>(wall_ns / 1000 + 2500000);  // 2.5 s ahead of ours
+  bridge.on_frame(frame_of(st), 0, wall_ns, out);
+  EXPECT_NEAR(bridge.autopilot_unix_minus_ours_s(), 2.5, 1e-6);
+  mav::Odometry o;
+  o.time_usec = 2000000000000000;  // Unix time: stamped as it is, no TIMESYNC needed
+  o.frame_id = mav::kMavFrameLocalNed;
+  o.child_frame_id = mav::kMavFrameBodyFrd;
+  o.pose_covariance[0] = o.pose_covariance[6] = o.pose_covariance[11] = 0.01f;
+  bridge.on_frame(frame_of(o), 0, wall_ns, out);
+  ASSERT_EQ(out.poses.size(), 1u);
+  EXPECT_EQ(out.poses[0].utime, 2000000000000000);
+  EXPECT_NEAR(bridge.position_std_m(), 0.1, 1e-6);
+  EXPECT_NE(bridge.detail().find("position std 0.100 m"), std::string::npos) << bridge.detail();
+  EXPECT_NE(bridge.detail().find("autopilot Unix clock +2.500 s from ours"), std::string::npos) << bridge.detail();
+}

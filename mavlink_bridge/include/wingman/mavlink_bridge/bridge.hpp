@@ -12,6 +12,7 @@
 #include <wingman/own_pose_t.hpp>
 #include <wingman/setpoint_t.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -48,6 +49,11 @@ class Bridge {
   /// Refusals outside the stream (poses that could not be made or stamped, commands the autopilot refused).
   const Refusals& refusals() const { return refusals_; }
   int64_t poses_published() const { return poses_; }
+  /// The newest ODOMETRY's position standard deviation, metres (own_pose_t has no covariance); -1 unknown.
+  double position_std_m() const { return position_std_m_; }
+  /// SYSTEM_TIME: the autopilot's Unix clock minus ours at its arrival, seconds (monitoring only: own poses are
+  /// stamped through TIMESYNC); NaN before one with a Unix time arrived.
+  double autopilot_unix_minus_ours_s() const { return unix_diff_s_; }
   /// True when the autopilot is heard and its clock is synchronised (the process reports OK).
   bool healthy() const { return autopilot_.known && time_sync_.synced(); }
   /// One line: autopilot, mode, armed, stream state, time offset and jitter, refusals.
@@ -77,6 +83,8 @@ class Bridge {
   int64_t refusal_counted_for_us_ = -1;  ///< setpoint (its arrival) whose mode/arm refusals were counted
   int64_t newest_pose_utime_ = 0;
   int64_t poses_ = 0;
+  double position_std_m_ = -1;
+  double unix_diff_s_ = NAN;
   uint8_t seq_ = 0;
   int64_t start_mono_us_ = -1;
   /// Message-rate requests still to be acknowledged: (message id, interval us); the front one is outstanding.
