@@ -28,9 +28,14 @@ StatusTracker::StatusTracker(std::string process, int32_t pid, size_t latency_wi
       latency_window_(std::max<size_t>(1, latency_window)),
       state_(wingman::status_t::STATE_STARTING) {}
 
-StatusTracker::Channel& StatusTracker::channel(const std::string& name, int8_t direction) {
-  const auto key = std::make_pair(name, direction);
+StatusTracker::Channel& StatusTracker::channel(const std::string& name, int8_t direction, bool declaring) {
+  auto key = std::make_pair(name, direction);
   auto it = channels_.find(key);
+  if (it == channels_.end() && !declaring && channels_.size() >= kMaxChannels) {
+    // A table that grew with every name ever seen made the recorder's heartbeat 8.4 MB after 200k names (issue 33).
+    key = std::make_pair(std::string(kOtherChannels), direction);
+    it = channels_.find(key);
+  }
   if (it == channels_.end()) {
     it = channels_.emplace(key, Channel{}).first;
     it->second.direction = direction;
@@ -39,8 +44,8 @@ StatusTracker::Channel& StatusTracker::channel(const std::string& name, int8_t d
   return it->second;
 }
 
-void StatusTracker::declare_input(const std::string& ch) { channel(ch, kIn).declared = true; }
-void StatusTracker::declare_output(const std::string& ch) { channel(ch, kOut); }
+void StatusTracker::declare_input(const std::string& ch) { channel(ch, kIn, true).declared = true; }
+void StatusTracker::declare_output(const std::string& ch) { channel(ch, kOut, true); }
 
 void StatusTracker::input(const std::string& ch, int64_t utime) {
   Channel& c = channel(ch, kIn);

@@ -152,4 +152,22 @@ TEST(StatusTracker, OutputsAreNeverStale) {
   EXPECT_EQ(t.heartbeat(60 * kS, 0, 60.0).state, kOk);
 }
 
+// Issue 33, finding 5: the recorder's heartbeat listed every channel name ever seen (8.4 MB after 200 k names).
+TEST(StatusTracker, AFloodOfChannelNamesSharesOneEntryAndTheHeartbeatStaysBounded) {
+  using wingman::common::StatusTracker;
+  StatusTracker t("recorder", 7);
+  t.declare_input("IMAGE_CAM0");
+  for (int i = 0; i < 200000; ++i) t.input("FLOOD_" + std::to_string(i), 0);
+  t.declare_output("LATE_DECLARED");  // declared channels are always listed
+  const wingman::status_t s = t.heartbeat(0, 0, 1.0);
+  EXPECT_EQ(s.num_channels, static_cast<int32_t>(StatusTracker::kMaxChannels) + 2);
+  EXPECT_LT(s.getEncodedSize(), 64 * 1024);
+  int64_t counted = 0;
+  for (const auto& c : s.channels) counted += c.count;
+  EXPECT_EQ(counted, 200000) << "every message is still counted";
+  EXPECT_EQ(t.input_count(StatusTracker::kOtherChannels),
+            200000 - static_cast<int64_t>(StatusTracker::kMaxChannels) + 1);
+  EXPECT_EQ(t.messages_handled(), 200000);
+}
+
 }  // namespace

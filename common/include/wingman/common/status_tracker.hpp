@@ -29,6 +29,11 @@ class StatusTracker {
  public:
   /// Default of stale_after_s(), seconds of wall time.
   static constexpr double kDefaultStaleAfterS = 3.0;
+  /// Most channels listed one by one; messages on further channels that were not declared (a recorder that takes
+  /// every channel, under a flood of names) are counted together under kOtherChannels, so the heartbeat stays
+  /// bounded. input_count() and friends of such a channel are those of the shared entry's name only.
+  static constexpr size_t kMaxChannels = 256;
+  static constexpr const char* kOtherChannels = "(other channels)";
 
   /// `process`: instance name shown in status_t.process. `latency_window`: how many recent
   /// latency samples the percentiles cover.
@@ -88,7 +93,8 @@ class StatusTracker {
     int64_t fresh_wall_utime = -1;  ///< inputs: wall time of the heartbeat that last saw a handled message, -1 never
     bool declared = false;          ///< inputs: declared with declare_input (watched for staleness)
   };
-  Channel& channel(const std::string& name, int8_t direction);
+  /// The entry of `name`; past kMaxChannels entries, an undeclared new name shares the kOtherChannels entry.
+  Channel& channel(const std::string& name, int8_t direction, bool declaring = false);
 
   std::string process_;
   int32_t pid_;
