@@ -2,13 +2,16 @@
 // wingman-recorder: every LCM channel (but images, by default) into size-rotated LCM log files.
 #include "wingman/recorder/recorder.hpp"
 
+#include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/runtime.hpp>
+#include <wingman/common/time.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <memory>
 #include <stdexcept>
 
 namespace {
@@ -78,8 +81,17 @@ int run(common::Runtime& rt, const recorder::RecorderOptions& o) {
   const common::RuntimeOptions& ro = rt.options();
   const std::string url = ro.lcm_in.empty() ? ro.lcm_url : ro.lcm_in;
   const bool from_file = url.rfind("file://", 0) == 0;
-  lcm::LCM in(url);
-  if (!in.good()) throw std::runtime_error("cannot open LCM input '" + url + "'");
+  // A log input is read with headers checked before allocating (LCM's own reader crashed on a corrupt length).
+  std::unique_ptr<common::LcmLogReader> log;
+  std::unique_ptr<lcm::LCM> bus;
+  if (from_file) {
+    common::LcmLogReadOptions read_options;
+    read_options.skip_corrupt = ro.skip_corrupt_log;
+    log = std::make_unique<common::LcmLogReader>(common::parse_lcm_file_url(url).path, read_options);
+  } else {
+    bus = std::make_unique<lcm::LCM>(url);
+    if (!bus->good()) throw std::runtime_error("cannot open LCM input '" + url + "'");
+  }
 
   recorder::Recorder rec(o);  // throws (exit 1) only with errors.require_directory_at_start
   Monitor monitor(rec, rt.status(), o.retry_period_s);
@@ -88,16 +100,28 @@ int run(common::Runtime& rt, const recorder::RecorderOptions& o) {
   if (!first.failing) spdlog::info("recording to {}", first.segment);
 
   Tap tap{&rec, recorder::ChannelFilter(o.include, o.exclude), &rt.status()};
-  in.subscribe(".*", &Tap::on_event, &tap);
+  if (bus) bus->subscribe(".*", &Tap::on_event, &tap);
   std::string reason;
+  int64_t corrupt_counted = 0;
   while (!rt.stop_requested()) {
-    if (from_file) {
-      if (in.handle() != 0) {
+    if (log) {
+      const common::LcmLogEvent* ev = log->read_next();  // corrupt: throws naming the offset, unless skipped
+      if (log->corrupt_events() > corrupt_counted) {
+        rt.status().items_dropped(url, log->corrupt_events() - corrupt_counted, log->first_corruption());
+        spdlog::warn("{} (skipped: --skip-corrupt-log)", log->first_corruption());
+        corrupt_counted = log->corrupt_events();
+      }
+      if (ev == nullptr) {
         rec.wait_idle(10.0);  // a log read as input is recorded completely
         reason = "end of input log";
         break;
       }
-    } else if (in.handleTimeout(100) < 0 && !rt.stop_requested()) {
+      lcm::ReceiveBuffer rbuf{};
+      rbuf.data = const_cast<void*>(ev->data);
+      rbuf.data_size = static_cast<uint32_t>(ev->datalen);
+      rbuf.recv_utime = common::wall_utime();  // as LCM's file provider delivered it: the receive time is now
+      tap.on_event(&rbuf, ev->channel);
+    } else if (bus->handleTimeout(100) < 0 && !rt.stop_requested()) {
       throw std::runtime_error("LCM input failed while waiting for messages");
     }
     monitor.update();

@@ -9,6 +9,8 @@
 #include <wingman/setpoint_t.hpp>
 #include <wingman/status_t.hpp>
 
+#include <sys/stat.h>
+
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -93,6 +95,28 @@ TEST(CorruptLog, AProcessStopsWithExitOneNamingTheOffsetOrSkipsAndCountsOnReques
   EXPECT_NE(status.last_error.find(expected + " (skipped: --skip-corrupt-log; 1 corrupt stretch(es), 52 bytes"),
             std::string::npos)
       << status.last_error;
+}
+
+TEST(CorruptLog, TheRecorderReadingALogStopsNamingTheOffsetOrSkipsOnRequest) {
+  TempDir dir;
+  size_t bad_at = 0;
+  const std::string in = corrupt_log(dir, &bad_at);
+  const std::string rec_dir = dir.file("rec");
+  ASSERT_EQ(::mkdir(rec_dir.c_str(), 0755), 0);
+  const std::string cfg = dir.file("recorder.yaml");
+  std::ofstream(cfg) << "output: {directory: " << rec_dir << "}\n";
+  const std::vector<std::string> cmd = {bin_path("wingman-recorder"), "--config",  cfg,      "--lcm-in",
+                                        "file://" + in + "?speed=0",  "--lcm-out", "memq://"};
+  const auto strict = run(cmd, 30s);
+  EXPECT_EQ(strict.exit_code, 1) << strict.err;
+  EXPECT_NE(strict.err.find("wingman-recorder: error: " + in + ": corrupt event at byte " + std::to_string(bad_at)),
+            std::string::npos)
+      << strict.err;
+  std::vector<std::string> skipping = cmd;
+  skipping.push_back("--skip-corrupt-log");
+  const auto skip = run(skipping, 30s);
+  EXPECT_EQ(skip.exit_code, 0) << skip.err;
+  EXPECT_NE(skip.err.find("recorded 100 events"), std::string::npos) << skip.err;
 }
 
 TEST(CorruptLog, ToolVerbsStopWithANonZeroExitNamingTheOffset) {
