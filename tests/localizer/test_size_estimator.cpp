@@ -43,7 +43,9 @@ using Path = std::function<Eigen::Vector3d(double)>;
 std::pair<double, double> fly(const Path& target, const Path& camera, double true_scale, double seconds,
                               unsigned seed) {
   std::mt19937 rng(seed);
-  Tracker tracker;
+  TrackerOptions o;
+  o.size.enabled = true;
+  Tracker tracker(o);
   std::pair<double, double> result{0, 0};
   for (int k = 0; k <= static_cast<int>(seconds / kDt); ++k) {
     const double t = k * kDt;
@@ -111,9 +113,9 @@ TEST(SizeEstimator, AFollowerLaggingATurningLeaderAdoptsNoWrongSize) {
   }
 }
 
-TEST(SizeEstimator, OffItIsTheConfiguredSizeAndTheTrackerIsUnchanged) {
+TEST(SizeEstimator, OffByDefaultItIsTheConfiguredSizeAndTheTrackerIsUnchanged) {
   TrackerOptions off;
-  off.size.enabled = false;
+  EXPECT_FALSE(off.size.enabled);
   Tracker a(off);
   SizeEstimator e(off.size);
   e.add(kT0, {1, 2, 3}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
@@ -128,7 +130,9 @@ TEST(SizeEstimator, OffItIsTheConfiguredSizeAndTheTrackerIsUnchanged) {
 }
 
 TEST(SizeEstimator, TooFewDetectionsGiveThePrior) {
-  SizeEstimator e;
+  SizeEstimatorOptions on;
+  on.enabled = true;
+  SizeEstimator e(on);
   for (int k = 0; k < 5; ++k)
     e.add(kT0 + k * 100'000, {10.0 + k, 0, 0}, 0.01 * Eigen::Matrix3d::Identity(), {0.0 + k, 1.0 * k, 0});
   const SizeEstimate s = e.estimate();

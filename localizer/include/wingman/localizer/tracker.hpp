@@ -178,6 +178,8 @@ class Tracker {
     WorldMeasurement last;           // newest detection (as detected: the configured size)
     SizeEstimator size;              // the track's detections for its range scale
     SizeEstimate scale;              // the adopted range scale: detections enter the filter at c + s (z - c)
+    SizeEstimate candidate;          // an acceptable fit waiting for a second, later one that agrees with it
+    int64_t candidate_utime = -1;    // its time; -1: none
   };
 
   void associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
