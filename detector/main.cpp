@@ -46,7 +46,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   if (o.weights.empty()) return run_without_model(rt, o, limits);
 
   detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
-  const std::string model_id = detector::weights_model_id(o.weights);  // detections_t.model_id
+  const std::string model_id = detector::weights_model_id(o.weights);                // detections_t.model_id
   const detector::InputSize input_size = *detector::InputSize::parse(o.input_size);  // validated with the options
   // model.backend = opencl: no usable OpenCL device, or a kernel that fails to build, throws here (exit 1, one line).
   // The first network is built at start-up (the cfg's size, or model.input_size's WxH); with input_size auto,

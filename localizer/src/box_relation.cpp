@@ -44,8 +44,7 @@ std::vector<std::string> BoxRelation::Table::validate() const {
   if (size_edges.size() < 2 || !all_finite_positive(size_edges) || !strictly_increasing(size_edges))
     p.push_back(fmt::format("box_relation.size_edges = {}: must be >= 2 increasing numbers > 0", vec(size_edges)));
   if (aspect_edges.size() < 2 || !all_finite_positive(aspect_edges) || !strictly_increasing(aspect_edges))
-    p.push_back(
-        fmt::format("box_relation.aspect_edges = {}: must be >= 2 increasing numbers > 0", vec(aspect_edges)));
+    p.push_back(fmt::format("box_relation.aspect_edges = {}: must be >= 2 increasing numbers > 0", vec(aspect_edges)));
   if (!p.empty()) return p;
   const size_t cells = (size_edges.size() - 1) * (aspect_edges.size() - 1);
   const auto table = [&](const char* key, const std::vector<double>& v, bool positive) {
@@ -100,8 +99,8 @@ BoxRelation BoxRelation::load(const std::string& spec) {
   if (spec == "sphere") return sphere();
   if (spec.rfind("builtin:", 0) == 0) {
     if (spec != kBuiltinSmall)
-      throw BoxRelationError(fmt::format("target.box_relation = '{}': unknown built-in (known: {}, sphere)", spec,
-                                         kBuiltinSmall));
+      throw BoxRelationError(
+          fmt::format("target.box_relation = '{}': unknown built-in (known: {}, sphere)", spec, kBuiltinSmall));
     return parse(builtin_small_box_relation(), kBuiltinSmall);
   }
   std::ifstream in(spec);

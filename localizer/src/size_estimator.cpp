@@ -3,8 +3,8 @@
 // a window of detections, with a prior.
 #include "wingman/localizer/size_estimator.hpp"
 
-#include <Eigen/Cholesky>
 #include <fmt/format.h>
+#include <Eigen/Cholesky>
 #include <wingman/common/config.hpp>
 
 #include <algorithm>
@@ -16,7 +16,8 @@ namespace wingman::localizer {
 std::vector<std::string> SizeEstimatorOptions::validate() const {
   using common::problem;
   std::vector<std::string> p;
-  if (!(prior_rel > 0 && prior_rel <= 1)) p.push_back(problem("tracker.size_prior_rel", prior_rel, "must be in (0, 1]"));
+  if (!(prior_rel > 0 && prior_rel <= 1))
+    p.push_back(problem("tracker.size_prior_rel", prior_rel, "must be in (0, 1]"));
   if (!(window_s > 0 && std::isfinite(window_s)))
     p.push_back(problem("tracker.size_window_s", window_s, "must be finite and > 0"));
   if (min_detections < 3) p.push_back(problem("tracker.size_min_detections", min_detections, "must be >= 3"));
@@ -31,7 +32,8 @@ bool SizeEstimate::acceptable(double accept_rel) const {
 
 SizeEstimator::SizeEstimator(SizeEstimatorOptions options) : options_(std::move(options)) {
   const auto problems = options_.validate();
-  if (!problems.empty()) throw std::invalid_argument("invalid SizeEstimatorOptions: " + fmt::format("{}", fmt::join(problems, "; ")));
+  if (!problems.empty())
+    throw std::invalid_argument("invalid SizeEstimatorOptions: " + fmt::format("{}", fmt::join(problems, "; ")));
 }
 
 void SizeEstimator::add(int64_t utime, const Eigen::Vector3d& z_in_world, const Eigen::Matrix3d& R,
@@ -46,7 +48,8 @@ void SizeEstimator::add(int64_t utime, const Eigen::Vector3d& z_in_world, const 
 SizeEstimate SizeEstimator::estimate() const {
   const SizeEstimate prior{1.0, options_.prior_rel, false};
   if (!options_.enabled) return {1.0, 0.0, false};
-  const double span_s = samples_.empty() ? 0.0 : 1e-6 * static_cast<double>(samples_.back().utime - samples_.front().utime);
+  const double span_s =
+      samples_.empty() ? 0.0 : 1e-6 * static_cast<double>(samples_.back().utime - samples_.front().utime);
   if (static_cast<int>(samples_.size()) < options_.min_detections || span_s < 0.9 * options_.window_s) return prior;
 
   using Matrix10d = Eigen::Matrix<double, 10, 10>;
@@ -62,7 +65,8 @@ SizeEstimate SizeEstimator::estimate() const {
   for (size_t i = 0; i < samples_.size(); ++i) {
     const Sample& x = samples_[i];
     const double t = 1e-6 * static_cast<double>(x.utime - t_ref);
-    J[i] << Eigen::Matrix3d::Identity(), t * Eigen::Matrix3d::Identity(), 0.5 * t * t * Eigen::Matrix3d::Identity(), -x.c;
+    J[i] << Eigen::Matrix3d::Identity(), t * Eigen::Matrix3d::Identity(), 0.5 * t * t * Eigen::Matrix3d::Identity(),
+        -x.c;
     W[i] = x.R.ldlt().solve(Eigen::Matrix3d::Identity());
     A += J[i].transpose() * W[i] * J[i];
     b += J[i].transpose() * W[i] * x.r;

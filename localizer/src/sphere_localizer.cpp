@@ -353,8 +353,8 @@ LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, cons
   out.cov_p_in_cam = J * S * J.transpose();
   // The box relation's spread: a relative error of the whole scale, along the line of sight (p is proportional to the
   // edge radii).
-  out.cov_p_in_cam += scale.range_sigma_rel * scale.range_sigma_rel * out.p_target_in_cam *
-                      out.p_target_in_cam.transpose();
+  out.cov_p_in_cam +=
+      scale.range_sigma_rel * scale.range_sigma_rel * out.p_target_in_cam * out.p_target_in_cam.transpose();
   out.cov_p_in_cam = 0.5 * (out.cov_p_in_cam + out.cov_p_in_cam.transpose()).eval();
   result.ok = true;
   return result;

@@ -134,7 +134,8 @@ std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const s
   // The clip is 160x120: the localizer's built-in pinhole camera is told so. The test detector's boxes are the
   // square's own, not the shipped model's: ratio 1 (target.box_relation sphere).
   const std::string localizer_cfg = dir.file("localizer.yaml");
-  std::ofstream(localizer_cfg) << "camera: {width: 160, height: 120, focal_px: 100.0}\ntarget: {box_relation: sphere}\n";
+  std::ofstream(localizer_cfg)
+      << "camera: {width: 160, height: 120, focal_px: 100.0}\ntarget: {box_relation: sphere}\n";
   stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url,
                                                                     "--lockstep", "--config", localizer_cfg}));
   // The follower with its default configuration (it watches the localizer's heartbeat; issue 33, finding 7).
@@ -234,7 +235,8 @@ TEST(Replay, LockstepSettlesWithTheFollowerThatWatchesTheLocalizerHeartbeat) {
   wingman::testing::write_log(log, events);
   const std::string url = wingman::testing::netns_lcm_url();
   const std::string localizer_cfg = dir.file("localizer.yaml");
-  std::ofstream(localizer_cfg) << "camera: {width: 160, height: 120, focal_px: 100.0}\ntarget: {box_relation: sphere}\n";
+  std::ofstream(localizer_cfg)
+      << "camera: {width: 160, height: 120, focal_px: 100.0}\ntarget: {box_relation: sphere}\n";
   std::vector<std::unique_ptr<Child>> stages;
   stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url,
                                                                     "--lockstep", "--config", localizer_cfg}));

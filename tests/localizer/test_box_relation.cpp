@@ -80,8 +80,9 @@ TEST(BoxRelation, ABadFileIsOneErrorNamingTheFileAndKey) {
     return s;
   };
   EXPECT_NE(error_of(with("[0.6, 0.7, 0.8, 0.9]", "[0.6, 0.7, 0.8]")).find("bad.yaml"), std::string::npos);
-  EXPECT_NE(error_of(with("[0.6, 0.7, 0.8, 0.9]", "[0.6, 0.7, 0.8]")).find("box_relation.width_ratio: 3 values, expected 4"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with("[0.6, 0.7, 0.8, 0.9]", "[0.6, 0.7, 0.8]")).find("box_relation.width_ratio: 3 values, expected 4"),
+      std::string::npos);
   EXPECT_NE(error_of(with("[0.5, 0.55", "[0, 0.55")).find("box_relation.height_ratio"), std::string::npos);
   EXPECT_NE(error_of(with("[0.6, 0.7, 0.8, 0.9]", "[0.6, .nan, 0.8, 0.9]")).find("box_relation.width_ratio"),
             std::string::npos);

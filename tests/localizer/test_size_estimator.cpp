@@ -4,8 +4,8 @@
 #include <wingman/localizer/size_estimator.hpp>
 #include <wingman/localizer/tracker.hpp>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstdio>
@@ -61,7 +61,9 @@ std::pair<double, double> fly(const Path& target, const Path& camera, double tru
 // A leader flying straight at 1 m/s, 8 m ahead and to the side.
 const Path kStraightLeader = [](double t) { return Eigen::Vector3d(1.0 * t, 8.0, 10.0); };
 // A follower keeping pace but weaving +-2 m across the line of sight with a 6-s period.
-const Path kWeavingFollower = [](double t) { return Eigen::Vector3d(1.0 * t + 2.0 * std::sin(2 * M_PI * t / 6.0), 0.0, 10.0); };
+const Path kWeavingFollower = [](double t) {
+  return Eigen::Vector3d(1.0 * t + 2.0 * std::sin(2 * M_PI * t / 6.0), 0.0, 10.0);
+};
 // A follower in lock step: the same velocity, no weave.
 const Path kLockStepFollower = [](double t) { return Eigen::Vector3d(1.0 * t, 0.0, 10.0); };
 
@@ -122,7 +124,8 @@ TEST(SizeEstimator, OffByDefaultItIsTheConfiguredSizeAndTheTrackerIsUnchanged) {
   EXPECT_EQ(e.estimate().scale, 1.0);
   EXPECT_EQ(e.estimate().sigma, 0.0);
   std::mt19937 rng(6);
-  for (int k = 0; k < 30; ++k) a.update(kT0 + k * 100'000, {detect(kStraightLeader(k * kDt), kWeavingFollower(k * kDt), 1.3, rng)});
+  for (int k = 0; k < 30; ++k)
+    a.update(kT0 + k * 100'000, {detect(kStraightLeader(k * kDt), kWeavingFollower(k * kDt), 1.3, rng)});
   const auto out = a.confirmed(kT0 + 29 * 100'000);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].size_scale, 1.0);

@@ -85,7 +85,8 @@ std::optional<double> range_error(const Sample& s, const localizer::BoxRelation&
   o.box_relation = "sphere";
   o.min_range_m = s.radius_m * 1.01;
   o.max_range_m = 1e4;
-  const localizer::LocalizeResult r = localizer::localize_box(s.det, *s.camera, o, relation.at(s.det_w, s.det_h, s.image_w));
+  const localizer::LocalizeResult r =
+      localizer::localize_box(s.det, *s.camera, o, relation.at(s.det_w, s.det_h, s.image_w));
   if (!r.ok || !r.measurement.range_valid) return std::nullopt;
   return r.measurement.range / s.range_m - 1.0;
 }
@@ -109,7 +110,8 @@ localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std:
   const size_t n = t.size_edges.size() - 1, m = t.aspect_edges.size() - 1;
   const auto bin = [](const std::vector<double>& edges, double x) {
     const auto it = std::upper_bound(edges.begin(), edges.end(), x);
-    return static_cast<size_t>(std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
+    return static_cast<size_t>(
+        std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
   };
   std::vector<std::vector<double>> kw(n * m), kh(n * m), kw_size(n), kh_size(n);
   std::vector<double> kw_all, kh_all;
@@ -130,8 +132,10 @@ localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std:
       if (!enough(c)) {
         src = n * m;  // none yet
         for (size_t d = 1; d < n && src == n * m; ++d) {
-          if (i >= d && enough((i - d) * m + a)) src = (i - d) * m + a;
-          else if (i + d < n && enough((i + d) * m + a)) src = (i + d) * m + a;
+          if (i >= d && enough((i - d) * m + a))
+            src = (i - d) * m + a;
+          else if (i + d < n && enough((i + d) * m + a))
+            src = (i + d) * m + a;
         }
         if (!enough(c)) t.count[c] = 0;
       }
@@ -166,7 +170,8 @@ std::string BoxRelationSummary::markdown() const {
     const auto it = sphere_by_airframe.find(name);
     s += row(name, it == sphere_by_airframe.end() ? RangeErrorStats{} : it->second, st);
   }
-  s += "\nBy true range (" + relation_name + "):\n\n| range | n | median | MAD | |error| p90 |\n|---|---|---|---|---|\n";
+  s +=
+      "\nBy true range (" + relation_name + "):\n\n| range | n | median | MAD | |error| p90 |\n|---|---|---|---|---|\n";
   for (const auto& [name, st] : relation_by_range)
     s += fmt::format("| {} | {} | {:+.3f} | {:.3f} | {:.3f} |\n", name, st.n, st.median, st.mad, st.p90_abs);
   return s;
@@ -174,16 +179,20 @@ std::string BoxRelationSummary::markdown() const {
 
 BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& progress) {
   if (rq.data.empty()) throw std::invalid_argument("--data: a `wingman dataset synth` folder is required");
-  if (rq.check.empty() && rq.out.empty()) throw std::invalid_argument("--out FILE (fit) or --check RELATION is required");
-  if (rq.min_iou <= 0 || rq.min_iou > 1) throw std::invalid_argument(fmt::format("--min-iou {}: expected (0, 1]", rq.min_iou));
+  if (rq.check.empty() && rq.out.empty())
+    throw std::invalid_argument("--out FILE (fit) or --check RELATION is required");
+  if (rq.min_iou <= 0 || rq.min_iou > 1)
+    throw std::invalid_argument(fmt::format("--min-iou {}: expected (0, 1]", rq.min_iou));
   const fs::path meta_dir = fs::path(rq.data) / "meta" / rq.split;
   if (!fs::is_directory(meta_dir))
-    throw std::runtime_error(fmt::format("{}: no such folder (expected a `wingman dataset synth` set)", meta_dir.string()));
+    throw std::runtime_error(
+        fmt::format("{}: no such folder (expected a `wingman dataset synth` set)", meta_dir.string()));
   std::vector<fs::path> metas;
   for (const auto& e : fs::directory_iterator(meta_dir))
     if (e.path().extension() == ".json") metas.push_back(e.path());
   std::sort(metas.begin(), metas.end());
-  if (rq.max_images > 0 && metas.size() > static_cast<size_t>(rq.max_images)) metas.resize(static_cast<size_t>(rq.max_images));
+  if (rq.max_images > 0 && metas.size() > static_cast<size_t>(rq.max_images))
+    metas.resize(static_cast<size_t>(rq.max_images));
   if (metas.empty()) throw std::runtime_error(meta_dir.string() + ": no .json metadata");
 
   detector::DetectorOptions dopt;
@@ -226,7 +235,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
           W, H, cam["fx"].as<double>(), cam["fy"].as<double>(), cam["cx"].as<double>(), cam["cy"].as<double>(),
           distortion_of(cam["distortion_model"].as<std::string>(), file),
           cam["distortion_model"].as<std::string>() == "none" ? std::vector<double>{}
-                                                                : cam["coefficients"].as<std::vector<double>>());
+                                                              : cam["coefficients"].as<std::vector<double>>());
       const std::string image = (fs::path(rq.data) / meta["image"].as<std::string>()).string();
       const cv::Mat bgr = cv::imread(image, cv::IMREAD_COLOR);
       if (bgr.empty()) throw std::runtime_error(image + ": cannot read the image");
@@ -296,7 +305,8 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
         return static_cast<size_t>(
             std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
       };
-      residual_by_bin[bin(tb.size_edges, s.det_w / s.image_w) * m + bin(tb.aspect_edges, s.det_h / s.det_w)].push_back(*er);
+      residual_by_bin[bin(tb.size_edges, s.det_w / s.image_w) * m + bin(tb.aspect_edges, s.det_h / s.det_w)].push_back(
+          *er);
     }
   }
   summary.sphere_all = stats_of(e_sphere_all), summary.relation_all = stats_of(e_rel_all);
@@ -319,7 +329,8 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     relation = localizer::BoxRelation::from_table(table, rq.out);
     const std::string header = fmt::format(
         "How {} ({}) draws boxes relative to the target's bounding sphere, measured by `wingman model box-relation`\n"
-        "on {} targets found in {} rendered images (docs/localization.md, \"Box relation\"). The localizer reads it as\n"
+        "on {} targets found in {} rendered images (docs/localization.md, \"Box relation\"). The localizer reads it "
+        "as\n"
         "target.box_relation. Range error on these images with the airframe's true radius: ratio 1 median {:+.3f},\n"
         "this relation {:+.3f} (MAD {:.3f}).",
         rq.model_name, model_id, summary.matched, summary.images, summary.sphere_all.median,

@@ -72,8 +72,10 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.relation->add_option("--out", rq.out, "Fit: the relation file to write (beside the model's weights)");
   s.relation->add_option("--check", rq.check,
                          "Evaluate this relation instead of fitting: sphere, builtin:wingman-small or a file");
-  s.relation->add_option("--model-name", rq.model_name, "The model's name written into the file (default wingman-small)");
-  s.relation->add_option("--min-iou", rq.min_iou, "A detection is the target's at this IoU with its outline box (default 0.3)");
+  s.relation->add_option("--model-name", rq.model_name,
+                         "The model's name written into the file (default wingman-small)");
+  s.relation->add_option("--min-iou", rq.min_iou,
+                         "A detection is the target's at this IoU with its outline box (default 0.3)");
   s.relation->add_option("--max-images", rq.max_images, "At most this many images (default 0: all)");
   s.relation->add_option("--max-median-error", s.max_median_error,
                          "Exit 1 when |median range error| over all targets exceeds this (a guard; default: none)");

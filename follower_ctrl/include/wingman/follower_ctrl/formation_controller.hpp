@@ -44,13 +44,13 @@ struct FormationOptions {
   double yaw_kp = 1.0;           ///< yaw rate per radian between the optical axis and the target's bearing, 1/s
   /// Weave for the size: while the followed track's size is in doubt (target_t.radius_sigma_m / radius_m above
   /// weave_until_rel), the follower swings this far (metres, horizontally across the line of sight, positive to its
-  /// left, a sine of weave_period_s and message time) about its formation position, so that the localizer can see the target's size from the parallax
-  /// (docs/localization.md, "Online size"). In a straight formation the camera otherwise moves in lock step with the
-  /// target and the size is not observable. 0 (default) disables: with the shipped CNN the weave found a 30 % wrong
-  /// size within 12 % but, its sigma staying near 5 %, never stopped, and cost 1.6 m of formation error
-  /// (docs/localization.md, "Online size").
+  /// left, a sine of weave_period_s and message time) about its formation position, so that the localizer can see the
+  /// target's size from the parallax (docs/localization.md, "Online size"). In a straight formation the camera
+  /// otherwise moves in lock step with the target and the size is not observable. 0 (default) disables: with the
+  /// shipped CNN the weave found a 30 % wrong size within 12 % but, its sigma staying near 5 %, never stopped, and
+  /// cost 1.6 m of formation error (docs/localization.md, "Online size").
   double weave_m = 0.0;
-  double weave_period_s = 6.0;   ///< period of the weave, s
+  double weave_period_s = 6.0;    ///< period of the weave, s
   double weave_until_rel = 0.05;  ///< weave while the size's relative sigma is above this
 
   template <class V>

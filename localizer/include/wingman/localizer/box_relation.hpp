@@ -19,8 +19,8 @@ class BoxRelationError : public std::runtime_error {
 /// What one box of a model stands for, relative to the box of the target's bounding sphere (same centre):
 /// the sphere box is the model's box divided by the ratios. Ground-truth sphere boxes: ratios 1, spreads 0.
 struct BoxScale {
-  double width_ratio = 1.0;    ///< model box width / sphere box width (> 0)
-  double height_ratio = 1.0;   ///< model box height / sphere box height (> 0)
+  double width_ratio = 1.0;   ///< model box width / sphere box width (> 0)
+  double height_ratio = 1.0;  ///< model box height / sphere box height (> 0)
   /// Relative spread of the range this leaves (1.4826 x the median absolute deviation of range / true range, over
   /// the measured boxes like this one): the view's share of the range error, which one ratio per box cannot remove.
   /// Enters the measurement covariance along the line of sight (>= 0).
@@ -75,9 +75,9 @@ class BoxRelation {
   /// and tests. size_edges: n + 1 increasing box-width fractions of the image width; aspect_edges: m + 1 increasing
   /// h / w values; the tables n x m, row-major by size bin.
   struct Table {
-    std::string model;          ///< the model's name (informative)
-    std::string model_id;       ///< "sha256:<16 hex digits>" of the weights (detections_t.model_id)
-    std::string measured_with;  ///< the command that measured it (informative)
+    std::string model;            ///< the model's name (informative)
+    std::string model_id;         ///< "sha256:<16 hex digits>" of the weights (detections_t.model_id)
+    std::string measured_with;    ///< the command that measured it (informative)
     double edge_noise_rel = 0.0;  ///< BoxScale::edge_noise_rel for every box, >= 0
     std::vector<double> size_edges, aspect_edges;
     std::vector<double> width_ratio, height_ratio, range_sigma_rel;

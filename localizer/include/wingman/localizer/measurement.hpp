@@ -37,8 +37,8 @@ struct WorldMeasurement {
   /// The camera's optical centre at the exposure, world frame, metres: a target of another size than configured lies
   /// along the ray from here (size_estimator.hpp).
   Eigen::Vector3d p_cam_in_world = Eigen::Vector3d::Zero();
-  double range = 0;                                              ///< metres
-  double confidence = 1;                                         ///< 0..1
+  double range = 0;       ///< metres
+  double confidence = 1;  ///< 0..1
 };
 
 }  // namespace wingman::localizer

@@ -36,7 +36,8 @@ struct SizeEstimatorOptions {
   void visit(V& v) {
     v("tracker.size_estimation", enabled,
       "estimate each target's size (range scale) online from the camera's motion across the line of sight");
-    v("tracker.size_prior_rel", prior_rel, "standard deviation of the range scale before evidence (target.radius_m's doubt)");
+    v("tracker.size_prior_rel", prior_rel,
+      "standard deviation of the range scale before evidence (target.radius_m's doubt)");
     v("tracker.size_window_s", window_s, "detections of this many seconds are fitted (constant acceleration), s");
     v("tracker.size_min_detections", min_detections, "detections a scale needs (spanning 90 % of the window at least)");
     v("tracker.size_accept_rel", accept_rel,
@@ -48,8 +49,8 @@ struct SizeEstimatorOptions {
 
 /// The range scale of one track and its standard deviation.
 struct SizeEstimate {
-  double scale = 1.0;  ///< true bounding radius / configured one (1: the configuration is right)
-  double sigma = 0.0;  ///< standard deviation of scale; the prior's while there is no evidence
+  double scale = 1.0;      ///< true bounding radius / configured one (1: the configuration is right)
+  double sigma = 0.0;      ///< standard deviation of scale; the prior's while there is no evidence
   bool from_data = false;  ///< false: the prior (too few detections, or a camera that did not move relative to it)
   double chi2_dof = 0.0;   ///< the straight-path fit's chi-square per degree of freedom (from_data only)
 

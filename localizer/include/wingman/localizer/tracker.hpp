@@ -99,7 +99,7 @@ struct TrackOutput {
   Eigen::Matrix3d cov_p = Eigen::Matrix3d::Identity();          ///< covariance of p_target_in_world, m^2
   Eigen::Matrix3d cov_v = Eigen::Matrix3d::Identity();          ///< covariance of v_target_in_world, (m/s)^2
   Eigen::Vector3d p_target_in_cam = Eigen::Vector3d::Zero();    ///< the last detection's x size_scale, camera frame, m
-  double range = 0;  ///< the last detection's range, m, times size_scale
+  double range = 0;                                             ///< the last detection's range, m, times size_scale
   /// The track's range scale (true bounding radius / target.radius_m: SizeEstimator; 1 without size estimation) and
   /// its standard deviation (0 without). cov_p includes the scale's share along the line of sight.
   double size_scale = 1.0, size_scale_sigma = 0.0;

@@ -37,7 +37,7 @@ struct BoxRelationRequest {
   double edge_noise_rel = 0.1;
   /// A detection belongs to the target when its IoU with the target's outline box reaches this.
   double min_iou = 0.3;
-  int max_images = 0;  ///< 0: all
+  int max_images = 0;        ///< 0: all
   std::string command_line;  ///< written into the file as measured_with
 };
 
@@ -45,8 +45,8 @@ struct BoxRelationRequest {
 /// with the true camera and the airframe's true bounding radius).
 struct RangeErrorStats {
   int64_t n = 0;
-  double median = 0;  ///< median relative error
-  double mad = 0;     ///< 1.4826 x median absolute deviation
+  double median = 0;   ///< median relative error
+  double mad = 0;      ///< 1.4826 x median absolute deviation
   double p90_abs = 0;  ///< 90th percentile of |error|
 };
 
