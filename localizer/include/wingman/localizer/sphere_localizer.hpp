@@ -47,8 +47,9 @@ struct SphereLocalizerOptions {
   double edge_noise_px = 1.0;
   /// Plus this fraction of the box's width (left and right edges) or height (top and bottom), added to edge_noise_px
   /// in quadrature (>= 0). A CNN's box edges wander with the box's size (the shipped model: about 10-20 % of the
-  /// width frame to frame, config/flights/cnn.localizer.yaml); a covariance that ignores it makes the tracker's gate
-  /// reject the leader's own detections and split it into many tracks (docs/localizer.md).
+  /// width frame to frame, which its box relation's edge_noise_rel adds for its boxes; box_relation.hpp); a covariance
+  /// that ignores it makes the tracker's gate reject the leader's own detections and split it into many tracks
+  /// (docs/localization.md).
   double edge_noise_rel = 0.0;
   /// Standard deviation of the box centre (a shift of the whole box, common to its edges), pixels (>= 0).
   double centre_noise_px = 0.5;
