@@ -16,15 +16,15 @@
 #                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
 #                  max_range     the farthest range at which the detector still finds an F450-sized drone at 1280x720
 #                  suite         out of sample: 8 formation flights nothing was tuned on (seeds 1001-1008, used nowhere
-#                                else), drawn by `wingman scenario random`: the four shared airframes
-#                                (../shared/meshes; skipped with a message when absent) and procedural quad, hex and
-#                                octo, from behind and side-on, lighting A and B; the localizer at its defaults but
+#                                else), drawn by `wingman scenario random`: the four shared airframes (../shared/meshes
+#                                or WINGMAN_SHARED_MESHES; skipped with a message when absent) and procedural quad, hex
+#                                and octo, from behind and side-on, lighting A and B; the localizer at its defaults but
 #                                target.radius_m = the leader's true bounding radius. One table (RMS, by range, false
-#                                targets, ids, size estimate); --quick: the first 8 s of 2 of them (s1005, and s1001
-#                                or without the meshes s1008), exit 1 when one breaks the bounds: 3-D RMS <=
-#                                WINGMAN_SUITE_MAX_RMS m (default 2.5), false targets <= WINGMAN_SUITE_MAX_FALSE
-#                                (default 150). These guard against regressions (measured: 2.10 m / 108 and
-#                                1.71 m / 67, docs/results.md); they are far from issue 29's targets (0.3 m, 3 %, 0)
+#                                targets, ids, size estimate). --quick: the first 8 s of s1005 and s1001 (without the
+#                                meshes s1007), exit 1 when one breaks the bounds: 3-D RMS <= WINGMAN_SUITE_MAX_RMS m
+#                                (default 2.5), false targets <= WINGMAN_SUITE_MAX_FALSE (default 250), of them on
+#                                other track ids than the leader's <= WINGMAN_SUITE_MAX_FALSE_OTHER (default 0).
+#                                Regression guards (measured: docs/results.md), far from issue 29's targets
 #                  all           all of them but the suite, one after the other (the calibration after the static sweep)
 #   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
 #   --duration S   suite: fly only the first S seconds of each flight (default: each scenario's own 30-60 s)
@@ -165,7 +165,7 @@ max_range() {
 
 suite() {
   local out="$out_root/suite" dur="$suite_duration" meshes flights=()
-  meshes=$(realpath -m "$src/../shared/meshes")
+  meshes=$(realpath -m "${WINGMAN_SHARED_MESHES:-$src/../shared/meshes}")  # where the four shared airframes are
   $quick && { out="$out_root/suite-quick"; dur=8; }
   rm -rf "$out"; mkdir -p "$out/scenarios"
   # seed airframe view lighting. The seeds are used nowhere else: nothing (box relation, tracker, controller) was
@@ -179,7 +179,7 @@ suite() {
   flights+=("1005 quad side A" "1006 hex behind B" "1007 octo side B" "1008 quad behind A")
   if $quick; then
     flights=("1005 quad side A")
-    if [ -d "$meshes" ]; then flights+=("1001 $meshes/dji_f450.glb behind A"); else flights+=("1008 quad behind A"); fi
+    if [ -d "$meshes" ]; then flights+=("1001 $meshes/dji_f450.glb behind A"); else flights+=("1007 octo side B"); fi
   fi
   local evals=()
   for f in "${flights[@]}"; do
@@ -194,7 +194,8 @@ suite() {
     evals+=("$out/s$seed/eval.json")
   done
   local bounds=()
-  $quick && bounds=(--max-rms "${WINGMAN_SUITE_MAX_RMS:-2.5}" --max-false "${WINGMAN_SUITE_MAX_FALSE:-150}")
+  $quick && bounds=(--max-rms "${WINGMAN_SUITE_MAX_RMS:-2.5}" --max-false "${WINGMAN_SUITE_MAX_FALSE:-250}"
+                    --max-false-other "${WINGMAN_SUITE_MAX_FALSE_OTHER:-0}")
   py suite "$out" "${bounds[@]}" "${evals[@]}"
 }
 

@@ -5,7 +5,7 @@ results.md (a table with the thesis's figures beside ours) in the experiment's f
 
 Usage: experiment_summary.py KIND OUT_DIR EVAL_JSON...   (KIND: static_sweep, calibration, distance, follow_1d,
 formation_2d, max_range, suite; calibration takes the localizer's configured radius in metres before its EVAL_JSON;
-suite takes [--max-rms M] [--max-false N] before its EVAL_JSONs and reads OUT_DIR/scenarios/<flight>.json).
+suite takes [--max-rms M] [--max-false N] [--max-false-other K] before its EVAL_JSONs and reads OUT_DIR/scenarios/<flight>.json).
 The thesis's figures are quoted from its text (Fig. 13, Tables 3 and 4, sections 5.3 and 5.5)."""
 import json
 import math
@@ -277,10 +277,10 @@ def rms(values):
 
 def suite(out, *args):
     """The out-of-sample suite: one row per flight (EVAL_JSON of each; its targets.csv beside it and the scenario's
-    drawing, OUT_DIR/scenarios/<flight>.json, written by `wingman scenario random`). With --max-rms M and
-    --max-false N: exits 1 naming each flight whose 3-D RMS exceeds M metres, whose false targets exceed N, or that
-    has no target on the leader."""
-    args, max_rms, max_false = list(args), None, None
+    drawing, OUT_DIR/scenarios/<flight>.json, written by `wingman scenario random`). With --max-rms M, --max-false N
+    and --max-false-other K: exits 1 naming each flight whose 3-D RMS exceeds M metres (or that has no target on the
+    leader), whose false targets exceed N, or whose false targets on track ids other than the leader's exceed K."""
+    args, max_rms, max_false, max_other = list(args), None, None, None
     while args and args[0].startswith("--"):
         key = args.pop(0)
         if not args:
@@ -290,8 +290,11 @@ def suite(out, *args):
                 max_rms = float(args.pop(0))
             elif key == "--max-false":
                 max_false = int(args.pop(0))
+            elif key == "--max-false-other":
+                max_other = int(args.pop(0))
             else:
-                sys.exit(f"experiment_summary: suite: unknown option {key} (--max-rms M, --max-false N)")
+                sys.exit(f"experiment_summary: suite: unknown option {key} (--max-rms M, --max-false N, "
+                         "--max-false-other N)")
         except ValueError:
             sys.exit(f"experiment_summary: suite: {key}: expected a number")
     if not args:
@@ -320,6 +323,9 @@ def suite(out, *args):
                                                     f"{flight['rms_m']:.3f} m") + f" > {max_rms:g} m")
         if max_false is not None and flight["false_targets"] > max_false:
             failures.append(f"{name}: {flight['false_targets']} false targets > {max_false}")
+        other = flight["false_targets"] - flight["false_targets_on_leader_ids"]
+        if max_other is not None and other > max_other:
+            failures.append(f"{name}: {other} false targets on track ids other than the leader's > {max_other}")
     f = lambda v, fmt="{:.2f}": "—" if v is None else fmt.format(v)
     lines = ["| flight (seed) | airframe | view | light | offset (m) | flown (s) | RMS 3-D (m) | RMS < 10 m (m) | "
              "RMS 10–30 m (m) | RMS 10–30 m (% of range) | leader detected | false targets (on the leader's id) | track ids | "
@@ -341,10 +347,12 @@ def suite(out, *args):
               "farther than 3 m (`wingman eval --match-radius`) from every vehicle; in brackets those whose track id is "
               "the leader's (its own track, that far off: they are not in the RMS); size estimate: the leader's last "
               "published target_t.radius_m ± radius_sigma_m."]
-    if max_rms is not None or max_false is not None:
-        lines += ["", f"Bounds: 3-D RMS ≤ {max_rms:g} m, false targets ≤ {max_false}: " +
+    if max_rms is not None or max_false is not None or max_other is not None:
+        lines += ["", f"Bounds: 3-D RMS ≤ {max_rms} m, false targets ≤ {max_false}, of them on other track ids than "
+                  f"the leader's ≤ {max_other}: " +
                   ("all flights within them." if not failures else "BROKEN: " + "; ".join(failures))]
-    write(out, "suite", {"flights": flights, "bounds": {"max_rms_m": max_rms, "max_false_targets": max_false},
+    write(out, "suite", {"flights": flights, "bounds": {"max_rms_m": max_rms, "max_false_targets": max_false,
+                                                        "max_false_targets_other_ids": max_other},
                          "failures": failures}, lines)
     if failures:
         sys.exit(1)
