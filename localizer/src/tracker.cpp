@@ -90,7 +90,8 @@ void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeas
       // Against the detection the track predicts at its size: c + (p - c) / s (s = 1 without size estimation).
       const double s = tracks[i]->scale.scale;
       const Eigen::Vector3d c = z[j].p_cam_in_world;
-      const Eigen::Vector3d y = z[j].p_target_in_world - (c + (tracks[i]->sc.p() - c) / s);
+      const Eigen::Vector3d y =
+          z[j].p_target_in_world - (s == 1.0 ? tracks[i]->sc.p() : c + (tracks[i]->sc.p() - c) / s);
       const Eigen::Matrix3d S = tracks[i]->sc.P.topLeftCorner<3, 3>() / (s * s) + z[j].cov_p_in_world;
       const double d2 = y.dot(S.ldlt().solve(y));
       if (d2 <= options_.gate_chi2) cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = d2;
@@ -137,7 +138,9 @@ void Tracker::hit(Track& t, const WorldMeasurement& z) {
   }
   const double s = t.scale.scale;
   // The filter, not Tracker::update: the detection at the track's size.
-  t.sc = localizer::update(t.sc, c + s * (z.p_target_in_world - c), s * s * z.cov_p_in_world);
+  // (s = 1 exactly: the detection as it is, so that the numbers without size estimation are bit for bit the same.)
+  t.sc = s == 1.0 ? localizer::update(t.sc, z.p_target_in_world, z.cov_p_in_world)
+                  : localizer::update(t.sc, c + s * (z.p_target_in_world - c), s * s * z.cov_p_in_world);
   t.last_hit_utime = z.utime;
   t.last = z;
   t.window.push_back({z.utime, z.p_target_in_world, z.cov_p_in_world});
