@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -103,6 +104,12 @@ BoxRelation BoxRelation::load(const std::string& spec) {
           fmt::format("target.box_relation = '{}': unknown built-in (known: {}, sphere)", spec, kBuiltinSmall));
     return parse(builtin_small_box_relation(), kBuiltinSmall);
   }
+  // A regular file of at most 1 MiB (a relation is a few kB): a device, FIFO or huge file is refused before reading.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(spec, ec))
+    throw BoxRelationError(fmt::format("{}: not a readable regular file (target.box_relation)", spec));
+  if (const auto size = std::filesystem::file_size(spec, ec); ec || size > (1u << 20))
+    throw BoxRelationError(fmt::format("{}: larger than 1 MiB, not a box relation file (target.box_relation)", spec));
   std::ifstream in(spec);
   if (!in) throw BoxRelationError(fmt::format("{}: cannot read the box relation file (target.box_relation)", spec));
   std::stringstream text;

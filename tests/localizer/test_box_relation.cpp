@@ -107,6 +107,14 @@ TEST(BoxRelation, AMissingFileOrUnknownBuiltInIsNamed) {
   } catch (const BoxRelationError& e) {
     EXPECT_NE(std::string(e.what()).find("builtin:wingman-small"), std::string::npos);
   }
+  for (const char* not_a_file : {"/dev/zero", "/tmp"}) {  // a device that never ends, a folder
+    try {
+      BoxRelation::load(not_a_file);
+      ADD_FAILURE() << not_a_file;
+    } catch (const BoxRelationError& e) {
+      EXPECT_NE(std::string(e.what()).find(not_a_file), std::string::npos);
+    }
+  }
   SphereLocalizerOptions o;
   o.box_relation = "/nonexistent/x.boxes.yaml";
   const auto p = o.validate();
