@@ -66,6 +66,9 @@ std::vector<std::string> BoxRelation::Table::validate() const {
   return p;
 }
 
+size_t BoxRelation::Table::size_bin(double width_fraction) const { return bin_of(size_edges, width_fraction); }
+size_t BoxRelation::Table::aspect_bin(double aspect) const { return bin_of(aspect_edges, aspect); }
+
 BoxRelation BoxRelation::sphere() { return BoxRelation{}; }
 
 BoxRelation BoxRelation::from_table(Table table, const std::string& name) {
@@ -130,7 +133,7 @@ BoxScale BoxRelation::at(double box_width_px, double box_height_px, double image
   if (is_sphere() || !(box_width_px > 0 && box_height_px > 0 && image_width_px > 0)) return s;
   const Table& t = table_;
   const size_t m = t.aspect_edges.size() - 1;
-  const size_t a = bin_of(t.aspect_edges, box_height_px / box_width_px);
+  const size_t a = t.aspect_bin(box_height_px / box_width_px);
   // Linear in log(width fraction) between the size bins' centres (geometric means), held beyond the outer ones.
   const double x = std::log(box_width_px / image_width_px);
   const size_t n = t.size_edges.size() - 1;

@@ -3,6 +3,7 @@
 #include "wingman/tools/box_relation_fit.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/detector/box.hpp>
 #include <wingman/detector/detector_options.hpp>
 #include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
@@ -66,14 +67,6 @@ RangeErrorStats stats_of(const std::vector<double>& e) {
   return s;
 }
 
-double iou(const localizer::PixelBox& a, const localizer::PixelBox& b) {
-  const double x0 = std::max(a.cx - a.w / 2, b.cx - b.w / 2), x1 = std::min(a.cx + a.w / 2, b.cx + b.w / 2);
-  const double y0 = std::max(a.cy - a.h / 2, b.cy - b.h / 2), y1 = std::min(a.cy + a.h / 2, b.cy + b.h / 2);
-  const double inter = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0);
-  const double uni = a.w * a.h + b.w * b.h - inter;
-  return uni > 0 ? inter / uni : 0;
-}
-
 localizer::PixelBox read_box(const YAML::Node& n) {
   return {n["cx"].as<double>(), n["cy"].as<double>(), n["w"].as<double>(), n["h"].as<double>()};
 }
@@ -108,16 +101,11 @@ localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std:
   t.size_edges = rq.size_edges;
   t.aspect_edges = rq.aspect_edges;
   const size_t n = t.size_edges.size() - 1, m = t.aspect_edges.size() - 1;
-  const auto bin = [](const std::vector<double>& edges, double x) {
-    const auto it = std::upper_bound(edges.begin(), edges.end(), x);
-    return static_cast<size_t>(
-        std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
-  };
   std::vector<std::vector<double>> kw(n * m), kh(n * m), kw_size(n), kh_size(n);
   std::vector<double> kw_all, kh_all;
   for (const Sample& s : samples) {
-    const size_t i = bin(t.size_edges, s.det_w / s.image_w), a = bin(t.aspect_edges, s.det_h / s.det_w);
-    kw[i * m + a].push_back(s.width_ratio), kh[i * m + a].push_back(s.height_ratio);
+    const size_t i = t.size_bin(s.det_w / s.image_w), c = t.cell(s.det_w / s.image_w, s.det_h / s.det_w);
+    kw[c].push_back(s.width_ratio), kh[c].push_back(s.height_ratio);
     kw_size[i].push_back(s.width_ratio), kh_size[i].push_back(s.height_ratio);
     kw_all.push_back(s.width_ratio), kh_all.push_back(s.height_ratio);
   }
@@ -241,10 +229,12 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       if (bgr.empty()) throw std::runtime_error(image + ": cannot read the image");
       double best = 0;
       localizer::PixelBox det;
+      detector::Box truth;
+      truth.cx = static_cast<float>(outline.cx), truth.cy = static_cast<float>(outline.cy);
+      truth.w = static_cast<float>(outline.w), truth.h = static_cast<float>(outline.h);
       for (const detector::Box& b : pipeline.detect(bgr)) {
         if (b.class_id != 0) continue;
-        const localizer::PixelBox pb{b.cx, b.cy, b.w, b.h};
-        if (const double o = iou(pb, outline); o > best) best = o, det = pb;
+        if (const double o = detector::iou(b, truth); o > best) best = o, det = {b.cx, b.cy, b.w, b.h};
       }
       if (best < rq.min_iou) {
         ++summary.unmatched;
@@ -299,15 +289,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     if (!es || !er) continue;
     e_sphere_all.push_back(*es), e_sphere_af[s.airframe].push_back(*es);
     e_rel_all.push_back(*er), e_rel_af[s.airframe].push_back(*er), e_rel_range[range_bin(s.range_m)].push_back(*er);
-    if (!residual_by_bin.empty()) {
-      const auto bin = [](const std::vector<double>& edges, double x) {
-        const auto it = std::upper_bound(edges.begin(), edges.end(), x);
-        return static_cast<size_t>(
-            std::clamp<ptrdiff_t>((it - edges.begin()) - 1, 0, static_cast<ptrdiff_t>(edges.size()) - 2));
-      };
-      residual_by_bin[bin(tb.size_edges, s.det_w / s.image_w) * m + bin(tb.aspect_edges, s.det_h / s.det_w)].push_back(
-          *er);
-    }
+    if (!residual_by_bin.empty()) residual_by_bin[tb.cell(s.det_w / s.image_w, s.det_h / s.det_w)].push_back(*er);
   }
   summary.sphere_all = stats_of(e_sphere_all), summary.relation_all = stats_of(e_rel_all);
   for (const auto& [k, v] : e_sphere_af) summary.sphere_by_airframe[k] = stats_of(v);

@@ -100,6 +100,14 @@ class BoxRelation {
     }
     /// One "key = value: rule" line per problem; empty when consistent.
     std::vector<std::string> validate() const;
+    /// The size bin of a box width fraction and the aspect bin of an aspect (h / w), each clamped to the table
+    /// (values beyond the outer edges fall into the outer bins). Precondition: validate() is empty.
+    size_t size_bin(double width_fraction) const;
+    size_t aspect_bin(double aspect) const;
+    /// The row-major index of that cell in the n x m tables.
+    size_t cell(double width_fraction, double aspect) const {
+      return size_bin(width_fraction) * (aspect_edges.size() - 1) + aspect_bin(aspect);
+    }
   };
   /// Builds a relation from a table; throws BoxRelationError (source `name`) when it is inconsistent.
   static BoxRelation from_table(Table table, const std::string& name);
