@@ -100,8 +100,7 @@ TEST(SizeEstimator, AStillCameraCannotTellWhateverTheTargetDoes) {
 
 TEST(SizeEstimator, AFollowerLaggingATurningLeaderAdoptsNoWrongSize) {
   // The leader turns (2 m/s^2) and the follower repeats its path 0.7 s later, 8 m behind: the relative path bends
-  // against the fit's model, whose chi-square then refuses it. The track keeps the configured size (a wrong size
-  // adopted here was 2.3 times off with a constant-velocity model).
+  // against the fit's model, whose chi-square then refuses it. The track keeps the configured size.
   const Path circling = [](double t) {
     return Eigen::Vector3d(8.0 * std::cos(0.5 * t), 12.0 + 8.0 * std::sin(0.5 * t), 10.0);
   };
