@@ -143,7 +143,7 @@ std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const s
       std::vector<std::string>{bin_path("wingman-follower-ctrl"), "--lcm-url", url, "--lockstep"}));
   const std::string record = dir.file("record" + std::to_string(run_index) + ".lcmlog");
   const auto r = run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for",
-                      "blob_stage,detector,localizer,follower_ctrl", "--record", record, "--start-timeout", "20",
+                      "blob_stage,detector,localizer,follower_ctrl", "--record", record, "--start-timeout", "90",
                       "--step-timeout", "10"},
                      120s);
   *replay_err = r.err;
@@ -244,7 +244,7 @@ TEST(Replay, LockstepSettlesWithTheFollowerThatWatchesTheLocalizerHeartbeat) {
       std::vector<std::string>{bin_path("wingman-follower-ctrl"), "--lcm-url", url, "--lockstep"}));
   const std::string record = dir.file("record.lcmlog");
   const auto r = run({bin_path("wingman"), "replay", log, "--lcm-url", url, "--wait-for", "localizer,follower_ctrl",
-                      "--record", record, "--start-timeout", "20", "--step-timeout", "10"},
+                      "--record", record, "--start-timeout", "90", "--step-timeout", "10"},
                      120s);
   for (auto& s : stages) {
     s->signal(SIGTERM);
