@@ -454,6 +454,65 @@ TEST(RunSequenceEval, LocalizerConfigChangesTheBirthRule) {
   EXPECT_NEAR(r.clips[0].time_to_confirm_s, 4.0 / 30.0, 1e-3);
 }
 
+TEST(RunSequenceEval, BoxesCacheGivesTheSameResultWithoutTheDetectorOrTheVideo) {
+  Fixture fx;
+  REQUIRE_VIDEO(fx);
+  SequenceEvalOptions o = fx.options();
+  o.boxes_cache = fx.dir.file("boxes");
+  int calls = 0;
+  const FrameDetector counted = [&](const cv::Mat& bgr) {
+    ++calls;
+    std::vector<detector::Box> b = bright_square(bgr);
+    // Scores and a second class that must come back exactly.
+    if (!b.empty()) b[0].confidence = b[0].drone_score = 0.123456789f + 1e-3f * static_cast<float>(calls % 7);
+    b.push_back(box(100.25f, 90.5f, 3.0f, 2.0f, 2));
+    return b;
+  };
+  const SequenceEvalResult live = run_sequence_eval(o, counted);
+  EXPECT_EQ(calls, 80);
+  ASSERT_TRUE(fs::exists(o.boxes_cache + "/V_DRONE_001.boxes"));
+  // The videos are gone: the cache alone gives the same result, and the detector is not called.
+  fs::remove(fx.root + "/videos/V_DRONE_001.mp4");
+  fs::remove(fx.root + "/videos/V_BIRD_001.mp4");
+  const SequenceEvalResult cached = run_sequence_eval(o, counted);
+  EXPECT_EQ(calls, 80);
+  EXPECT_EQ(cached.json(), live.json());
+  EXPECT_EQ(cached.clips[1].other_class_boxes, 40);
+  const ClipBoxes b = read_clip_boxes(o.boxes_cache + "/V_DRONE_001.boxes");
+  EXPECT_EQ(b.settings, "custom detector");
+  EXPECT_EQ(b.frames, 40);
+  EXPECT_EQ(b.width, 160);
+  EXPECT_EQ(b.height, 128);
+  ASSERT_EQ(b.boxes.size(), 40u);
+  EXPECT_FLOAT_EQ(b.boxes.at(0)[1].cx, 100.25f);
+
+  // Other settings: one error naming the file and both settings.
+  o.frame_step = 2;
+  std::string e = error_of([&] { run_sequence_eval(o, counted); });
+  EXPECT_NE(e.find("V_BIRD_001.boxes: made with frame_step 1, this run 2"), std::string::npos) << e;
+  const std::string path = o.boxes_cache + "/V_BIRD_001.boxes";
+  ClipBoxes other = read_clip_boxes(path);
+  other.settings = "cfg=x";
+  write_clip_boxes(path, other);
+  o.frame_step = 1;
+  e = error_of([&] { run_sequence_eval(o, counted); });
+  EXPECT_NE(e.find(path + ": made with other detection settings: the file has 'cfg=x', this run 'custom detector'"),
+            std::string::npos)
+      << e;
+  // A damaged file names its line.
+  std::ofstream(path, std::ios::app) << "3 0 0.5 0.5 1 1 -4 4 0\n";
+  e = error_of([&] { read_clip_boxes(path); });
+  EXPECT_NE(e.find(path + ":"), std::string::npos) << e;
+  EXPECT_NE(e.find("a box needs"), std::string::npos) << e;
+  std::ofstream(path, std::ios::trunc) << "something else\n";
+  e = error_of([&] { read_clip_boxes(path); });
+  EXPECT_NE(e.find(path + ":1: not a boxes cache file"), std::string::npos) << e;
+  std::ofstream(path, std::ios::trunc) << "# wingman val --sequences boxes v1\nsettings s\nvideo 30 10 160 128 1\n12 0 "
+                                          "0.5 0.5 1 1 2 2 0\n";
+  e = error_of([&] { read_clip_boxes(path); });
+  EXPECT_NE(e.find(path + ":4: frame 12: not a tracked frame of 10"), std::string::npos) << e;
+}
+
 // ---- the `wingman` binary ----
 
 testing::RunResult wingman(const std::vector<std::string>& args, int timeout_s = 120) {

@@ -243,6 +243,10 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                 "--sequences: horizontal field of view of the static camera's nominal pinhole, degrees (default 24)");
   v->add_option("--frame-step", so.frame_step, "--sequences: track every n-th frame (default 1: every frame)");
   v->add_option("--clips", so.clips, "--sequences: only these clips of the split (comma-separated)")->delimiter(',');
+  v->add_option("--boxes-cache", so.boxes_cache,
+                "--sequences: folder of each clip's detector boxes: a clip whose <clip>.boxes is there is tracked "
+                "from it without the detector, the others are detected and written (a file made with other "
+                "detection settings is an error)");
   v->add_option("--confirm-within", so.scoring.confirm_within_s,
                 "--sequences: a drone confirmed this long after its first label counts as in time, s (default 1)");
   v->add_option("--on-target-fraction", so.scoring.on_target_fraction,

@@ -451,6 +451,85 @@ std::string SequenceEvalResult::json() const {
 // ---------------------------------------------------------------------------------------------------------------------
 // The run
 
+namespace {
+constexpr const char* kBoxesMagic = "# wingman val --sequences boxes v1";
+}  // namespace
+
+void write_clip_boxes(const std::string& path, const ClipBoxes& b) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::trunc);
+    if (!f) throw std::runtime_error(fmt::format("{}: cannot write the boxes cache file", tmp));
+    f << kBoxesMagic << "\n"
+      << "settings " << b.settings << "\n"
+      << fmt::format("video {:.17g} {} {} {} {}\n", b.fps, b.frames, b.width, b.height, b.frame_step);
+    for (const auto& [frame, boxes] : b.boxes)
+      for (const detector::Box& x : boxes)
+        f << fmt::format("{} {} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {}\n", frame, x.class_id, x.confidence,
+                         x.drone_score, x.cx, x.cy, x.w, x.h, x.zoom_refined ? 1 : 0);
+    if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write the boxes cache file", tmp));
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw std::runtime_error(fmt::format("{}: cannot rename to {}: {}", tmp, path, ec.message()));
+}
+
+ClipBoxes read_clip_boxes(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw DatasetError(fmt::format("{}: cannot open the boxes cache file", path));
+  std::string line;
+  int n = 0;
+  auto fail = [&](const std::string& why) { throw DatasetError(fmt::format("{}:{}: {}", path, n, why)); };
+  ClipBoxes b;
+  if (!std::getline(f, line) || (++n, line != kBoxesMagic))
+    fail(fmt::format("not a boxes cache file (the first line must be '{}')", kBoxesMagic));
+  if (!std::getline(f, line) || (++n, line.rfind("settings ", 0) != 0)) fail("expected 'settings <what made them>'");
+  b.settings = line.substr(9);
+  if (!std::getline(f, line)) fail("expected 'video <fps> <frames> <width> <height> <frame_step>'");
+  ++n;
+  {
+    std::istringstream in(line);
+    std::string word;
+    if (!(in >> word >> b.fps >> b.frames >> b.width >> b.height >> b.frame_step) || word != "video" ||
+        !(in >> std::ws).eof())
+      fail("expected 'video <fps> <frames> <width> <height> <frame_step>'");
+    if (!(b.fps > 0.0) || !std::isfinite(b.fps) || b.frames < 0 || b.frame_step < 1 ||
+        (b.frames > 0 && (b.width <= 0 || b.height <= 0)))
+      fail(fmt::format("video {} {} {} {} {}: needs fps > 0, frames >= 0, a positive size, frame_step >= 1", b.fps,
+                       b.frames, b.width, b.height, b.frame_step));
+  }
+  while (std::getline(f, line)) {
+    ++n;
+    if (blank(line)) continue;
+    std::istringstream in(line);
+    int frame = 0, zoom = 0;
+    detector::Box x;
+    if (!(in >> frame >> x.class_id >> x.confidence >> x.drone_score >> x.cx >> x.cy >> x.w >> x.h >> zoom) ||
+        !(in >> std::ws).eof())
+      fail("expected '<frame> <class> <confidence> <drone_score> <cx> <cy> <w> <h> <zoom 0|1>'");
+    if (frame < 0 || frame >= b.frames || frame % b.frame_step != 0)
+      fail(fmt::format("frame {}: not a tracked frame of {} (frame_step {})", frame, b.frames, b.frame_step));
+    if (x.class_id < 0 || !(x.w >= 0.0f) || !(x.h >= 0.0f) || !std::isfinite(x.cx) || !std::isfinite(x.cy) ||
+        !(x.confidence >= 0.0f && x.confidence <= 1.0f) || !(x.drone_score >= 0.0f && x.drone_score <= 1.0f) ||
+        (zoom != 0 && zoom != 1))
+      fail("a box needs class >= 0, scores in [0, 1], finite centre, w, h >= 0 and zoom 0 or 1");
+    x.zoom_refined = zoom == 1;
+    b.boxes[frame].push_back(x);
+  }
+  return b;
+}
+
+std::string detection_settings(const SequenceEvalOptions& o) {
+  const detector::DetectorPipelineOptions& d = o.detection;
+  return fmt::format(
+      "cfg={} weights_sha256={} backend={} input_size={} p_thresh={} o_thresh={} subsquare={} zoom_in={} "
+      "zoom_max_fraction={} flip_fusion={} fusion_iou={} coarse_pass={} coarse_scale={} coarse_min_size={} "
+      "drone_first={} policy={} max_detections={}",
+      o.cfg, detector::weights_model_id(o.weights), o.backend, o.input_size, d.p_thresh, d.o_thresh, d.subsquare,
+      d.zoom_in, d.zoom_max_fraction, d.flip_fusion, d.fusion_iou, d.coarse_pass, d.coarse_scale, d.coarse_min_size,
+      d.drone_first, d.policy, d.max_detections);
+}
+
 SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDetector& detect_in,
                                      const std::function<void(const std::string&)>& log) {
   const std::vector<std::string> problems = o.validate();
@@ -492,19 +571,31 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
   localizer::LocalizerOptions loc_options;
   if (!o.localizer_config.empty()) loc_options = common::load_options<localizer::LocalizerOptions>(o.localizer_config);
 
-  // The detector, as `wingman val` builds it, unless one is given.
+  // The detector, as `wingman val` builds it, unless one is given; built on the first clip that needs it (a run
+  // wholly from the boxes cache never loads it).
   FrameDetector detect = detect_in;
   std::shared_ptr<detector::SizedDetector> pipeline;
-  if (!detect) {
-    auto make_backend = [&](const detector::DarknetModel& sized) {
-      std::string why;
-      auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why);
-      if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
-      return backend;
-    };
-    pipeline = std::make_shared<detector::SizedDetector>(o.detection, detector::load_model(o.cfg, o.weights),
-                                                         *detector::InputSize::parse(o.input_size), make_backend);
-    detect = [pipeline](const cv::Mat& bgr) { return pipeline->detect(bgr); };
+  auto detector_for_frames = [&]() -> FrameDetector& {
+    if (!detect) {
+      auto make_backend = [&](const detector::DarknetModel& sized) {
+        std::string why;
+        auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why);
+        if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
+        return backend;
+      };
+      pipeline = std::make_shared<detector::SizedDetector>(o.detection, detector::load_model(o.cfg, o.weights),
+                                                           *detector::InputSize::parse(o.input_size), make_backend);
+      detect = [pipeline](const cv::Mat& bgr) { return pipeline->detect(bgr); };
+    }
+    return detect;
+  };
+  std::string settings;
+  if (!o.boxes_cache.empty()) {
+    settings = detect_in ? std::string("custom detector") : detection_settings(o);
+    std::error_code ec;
+    fs::create_directories(o.boxes_cache, ec);
+    if (!fs::is_directory(o.boxes_cache))
+      throw std::runtime_error(fmt::format("{}: cannot create the boxes cache folder", o.boxes_cache));
   }
 
   SequenceEvalResult result;
@@ -521,51 +612,91 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
     c.first_label_frame = truths.empty() ? -1 : truths.begin()->first;
 
     const std::string video = (root / "videos" / (sc.name + ".mp4")).string();
-    cv::VideoCapture cap;
-    // FFmpeg only: the Halmstad clips are MP4 files it reads; OpenCV's fallback to GStreamer on an unreadable file
-    // adds nothing here (and leaks in GStreamer's device probing, libusb).
-    if (fs::is_regular_file(video)) cap.open(video, cv::CAP_FFMPEG);
-    if (!cap.isOpened()) {
-      c.skipped = fmt::format("{}: cannot open the video", video);
-    } else {
-      c.fps = cap.get(cv::CAP_PROP_FPS);
-      if (!(c.fps > 0.0) || !std::isfinite(c.fps) || c.fps > 1000.0)
-        c.skipped = fmt::format("{}: the video gives no usable frame rate ({})", video, c.fps);
-    }
-    if (c.skipped.empty()) {
-      std::unique_ptr<ClipTracker> tracker;
-      cv::Mat frame;
-      static const std::vector<cv::Rect2d> kNone;
-      for (int k = 0;; ++k) {
-        if (k % o.frame_step != 0) {
-          if (!cap.grab()) break;
-          ++c.frames;
-          continue;
-        }
-        if (!cap.read(frame) || frame.empty()) break;
-        ++c.frames;
+    const std::string cache_path =
+        o.boxes_cache.empty() ? std::string() : (fs::path(o.boxes_cache) / (sc.name + ".boxes")).string();
+    std::unique_ptr<ClipTracker> tracker;
+    static const std::vector<cv::Rect2d> kNone;
+    auto truths_at = [&](int k) -> const std::vector<cv::Rect2d>& {
+      const auto it = truths.find(k);
+      return it == truths.end() ? kNone : it->second;
+    };
+    if (!cache_path.empty() && fs::exists(cache_path)) {
+      // Tracked from the cache: the same boxes the detector gave when the file was written.
+      const ClipBoxes cached = read_clip_boxes(cache_path);
+      if (cached.settings != settings)
+        throw DatasetError(fmt::format("{}: made with other detection settings: the file has '{}', this run '{}' "
+                                       "(remove the file or use another --boxes-cache)",
+                                       cache_path, cached.settings, settings));
+      if (cached.frame_step != o.frame_step)
+        throw DatasetError(fmt::format("{}: made with frame_step {}, this run {}", cache_path, cached.frame_step,
+                                       o.frame_step));
+      c.fps = cached.fps;
+      c.frames = cached.frames;
+      if (c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
+      static const std::vector<detector::Box> kNoBoxes;
+      for (int k = 0; k < c.frames && c.skipped.empty(); k += o.frame_step) {
         if (!tracker) {
-          const localizer::CameraModel camera = nominal_pinhole(frame.cols, frame.rows, o.hfov_deg);
+          const localizer::CameraModel camera = nominal_pinhole(cached.width, cached.height, o.hfov_deg);
           if (result.focal_px == 0) result.focal_px = camera.fx();
           tracker = std::make_unique<ClipTracker>(loc_options, camera, c.fps);
-        } else if (frame.cols != tracker->camera().width() || frame.rows != tracker->camera().height()) {
-          c.skipped = fmt::format("{}: frame {} is {}x{}, the first {}x{}", video, k, frame.cols, frame.rows,
-                                  tracker->camera().width(), tracker->camera().height());
-          break;
         }
-        const auto it = truths.find(k);
-        tracker->add_frame(k, detect(frame), it == truths.end() ? kNone : it->second);
+        const auto it = cached.boxes.find(k);
+        tracker->add_frame(k, it == cached.boxes.end() ? kNoBoxes : it->second, truths_at(k));
       }
-      if (c.skipped.empty() && c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
-      if (tracker) {
-        c.frames_tracked = tracker->frames();
-        c.tracks = tracker->tracks();
-        c.drone_boxes = tracker->drone_boxes();
-        c.other_class_boxes = tracker->other_class_boxes();
-        c.rejected_boxes = tracker->rejected_boxes();
+    } else {
+      cv::VideoCapture cap;
+      // FFmpeg only: the Halmstad clips are MP4 files it reads; OpenCV's fallback to GStreamer on an unreadable file
+      // adds nothing here (and leaks in GStreamer's device probing, libusb).
+      if (fs::is_regular_file(video)) cap.open(video, cv::CAP_FFMPEG);
+      if (!cap.isOpened()) {
+        c.skipped = fmt::format("{}: cannot open the video", video);
+      } else {
+        c.fps = cap.get(cv::CAP_PROP_FPS);
+        if (!(c.fps > 0.0) || !std::isfinite(c.fps) || c.fps > 1000.0)
+          c.skipped = fmt::format("{}: the video gives no usable frame rate ({})", video, c.fps);
       }
-      c.duration_s = c.fps > 0 ? c.frames / c.fps : 0.0;
+      if (c.skipped.empty()) {
+        ClipBoxes record;
+        record.settings = settings;
+        record.fps = c.fps;
+        record.frame_step = o.frame_step;
+        cv::Mat frame;
+        for (int k = 0;; ++k) {
+          if (k % o.frame_step != 0) {
+            if (!cap.grab()) break;
+            ++c.frames;
+            continue;
+          }
+          if (!cap.read(frame) || frame.empty()) break;
+          ++c.frames;
+          if (!tracker) {
+            const localizer::CameraModel camera = nominal_pinhole(frame.cols, frame.rows, o.hfov_deg);
+            if (result.focal_px == 0) result.focal_px = camera.fx();
+            tracker = std::make_unique<ClipTracker>(loc_options, camera, c.fps);
+            record.width = frame.cols, record.height = frame.rows;
+          } else if (frame.cols != tracker->camera().width() || frame.rows != tracker->camera().height()) {
+            c.skipped = fmt::format("{}: frame {} is {}x{}, the first {}x{}", video, k, frame.cols, frame.rows,
+                                    tracker->camera().width(), tracker->camera().height());
+            break;
+          }
+          std::vector<detector::Box> boxes = detector_for_frames()(frame);
+          tracker->add_frame(k, boxes, truths_at(k));
+          if (!boxes.empty()) record.boxes[k] = std::move(boxes);
+        }
+        if (c.skipped.empty() && c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
+        record.frames = c.frames;
+        // Only a whole clip is cached (a skipped one is tried again next time).
+        if (!cache_path.empty() && c.skipped.empty()) write_clip_boxes(cache_path, record);
+      }
     }
+    if (tracker) {
+      c.frames_tracked = tracker->frames();
+      c.tracks = tracker->tracks();
+      c.drone_boxes = tracker->drone_boxes();
+      c.other_class_boxes = tracker->other_class_boxes();
+      c.rejected_boxes = tracker->rejected_boxes();
+    }
+    c.duration_s = c.fps > 0 ? c.frames / c.fps : 0.0;
     if (c.skipped.empty()) {
       score_clip(c, o.scoring);
     } else {

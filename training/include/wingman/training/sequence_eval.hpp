@@ -150,6 +150,12 @@ struct SequenceEvalOptions {
   double hfov_deg = 24.0;
   int frame_step = 1;  ///< track every frame_step-th frame (0, step, 2 step, ...); time stays frame / fps. >= 1
   TrackScoringOptions scoring;
+  /// A folder for the detector's boxes of every tracked frame, one `<clip>.boxes` file per clip ("" = none). A clip
+  /// whose file is there is tracked from it instead of running the detector (the video is not read), so the tracker's
+  /// settings can be compared on the same boxes in seconds; a clip whose file is missing is detected and its file
+  /// written. A file made with other detection settings (model, weights' SHA-256, backend, input size, Algorithm 2's
+  /// options, frame_step) is an error naming the file and both settings, never silently reused.
+  std::string boxes_cache;
 
   /// One "field = value: rule" line per invalid field; empty when valid.
   std::vector<std::string> validate() const;
@@ -193,6 +199,28 @@ struct SequenceEvalResult {
 
 /// Detects in one video frame (BGR): the boxes of every class in pixels of the frame.
 using FrameDetector = std::function<std::vector<detector::Box>(const cv::Mat& bgr)>;
+
+/// One clip's detector output as SequenceEvalOptions::boxes_cache stores it.
+struct ClipBoxes {
+  std::string settings;  ///< what made them (detection_settings()); compared before reuse
+  double fps = 0;        ///< the video's frame rate, frames/s (> 0)
+  int frames = 0;        ///< frames the video gave (>= 0)
+  int width = 0, height = 0;  ///< frame size, pixels (> 0 when frames > 0)
+  int frame_step = 1;         ///< every frame_step-th frame was detected (>= 1)
+  std::map<int, std::vector<detector::Box>> boxes;  ///< tracked frame index -> its boxes (frames without boxes absent)
+};
+
+/// Writes `b` to `path` (a text file: a header, then one line per box with every float in round-trip precision),
+/// through a temporary file renamed into place. Throws std::runtime_error naming the path when it cannot be written.
+void write_clip_boxes(const std::string& path, const ClipBoxes& b);
+
+/// Reads a file write_clip_boxes wrote. Throws DatasetError naming the file and line for anything else (a missing or
+/// unknown header, a bad number, a frame outside the clip or not a multiple of frame_step, a negative size).
+ClipBoxes read_clip_boxes(const std::string& path);
+
+/// The settings string a boxes cache is keyed by: cfg, the weights' SHA-256 (detector::weights_model_id), backend,
+/// input size and every DetectorPipelineOptions field. "custom detector" when run_sequence_eval is given one.
+std::string detection_settings(const SequenceEvalOptions& o);
 
 /// Reads the labelled boxes of one Halmstad label CSV (`frame,class,x,y,w,h`; MATLAB pixels, so 0.5 px is
 /// subtracted from x and y): frame -> boxes of class DRONE. Boxes of the other known classes (AIRPLANE, BIRD,
