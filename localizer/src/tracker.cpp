@@ -38,6 +38,10 @@ std::vector<std::string> TrackerOptions::validate() const {
   if (birth_window < birth_hits)
     p.push_back(
         problem("tracker.birth_window", birth_window, fmt::format("must be >= tracker.birth_hits ({})", birth_hits)));
+  if (!(birth_min_confidence >= 0 && birth_min_confidence <= 1))
+    p.push_back(problem("tracker.birth_min_confidence", birth_min_confidence, "must be in [0, 1]"));
+  if (!(confirm_min_confidence >= 0 && confirm_min_confidence <= 1))
+    p.push_back(problem("tracker.confirm_min_confidence", confirm_min_confidence, "must be in [0, 1]"));
   if (!(death_timeout_s > 0)) p.push_back(problem("tracker.death_timeout_s", death_timeout_s, "must be > 0"));
   if (window_size < 1) p.push_back(problem("tracker.window_size", window_size, "must be >= 1"));
   if (!(initial_velocity_std > 0) || !std::isfinite(initial_velocity_std))
@@ -102,6 +106,8 @@ void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeas
 }
 
 void Tracker::hit(Track& t, const WorldMeasurement& z) {
+  t.recent_confidence.push_back(z.confidence);
+  while (static_cast<int>(t.recent_confidence.size()) > options_.birth_window) t.recent_confidence.pop_front();
   const Eigen::Vector3d c = z.p_cam_in_world;
   t.size.add(z.utime, z.p_target_in_world, z.cov_p_in_world, c);
   const SizeEstimate e = t.size.estimate();
@@ -229,9 +235,15 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
   }
   tracks_ = std::move(kept);
 
-  // Confirmation (M of N), unless the track only duplicates a confirmed one; then merges.
+  // Confirmation (M of N and the track-level confidence), unless the track only duplicates a confirmed one; then
+  // merges.
   for (Track& t : tracks_) {
     if (t.id != 0 || t.hits < options_.birth_hits) continue;
+    if (!confident_enough(t)) {
+      if (!t.held) ++stats_.confirmations_held;
+      t.held = true;
+      continue;
+    }
     if (duplicates_a_confirmed_track(t)) {
       t.id = -1;  // removed by merge_duplicates()
       ++stats_.merges;
@@ -245,6 +257,10 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
   // Detections no track took start tentative tracks.
   for (size_t j = 0; j < z.size(); ++j) {
     if (z_used[j] || static_cast<int>(tracks_.size()) >= options_.max_tracks) continue;
+    if (z[j].confidence < options_.birth_min_confidence) {
+      ++stats_.births_refused;
+      continue;
+    }
     Track t;
     t.sc = cv_initialize(z[j].p_target_in_world, z[j].cov_p_in_world, options_.initial_velocity_std);
     t.state_utime = utime;
@@ -253,13 +269,14 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
     t.frames = 1;
     t.hits = 1;
     t.recent.push_back(true);
+    t.recent_confidence.push_back(z[j].confidence);
     t.last = z[j];
     t.window.push_back({utime, z[j].p_target_in_world, z[j].cov_p_in_world});
     t.size = SizeEstimator(options_.size);
     t.size.add(utime, z[j].p_target_in_world, z[j].cov_p_in_world, z[j].p_cam_in_world);
     t.scale = t.size.estimate();  // the prior: 1 +- prior_rel (1 +- 0 when off)
     ++stats_.births;
-    if (t.hits >= options_.birth_hits) {
+    if (t.hits >= options_.birth_hits && confident_enough(t)) {
       t.id = next_id_++;
       ++stats_.confirmations;
     }
@@ -269,6 +286,14 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
   have_frame_ = true;
   last_frame_utime_ = utime;
   return true;
+}
+
+bool Tracker::confident_enough(const Track& t) const {
+  if (options_.confirm_min_confidence <= 0.0) return true;
+  if (t.recent_confidence.empty()) return false;
+  double sum = 0.0;
+  for (const double c : t.recent_confidence) sum += c;
+  return sum / static_cast<double>(t.recent_confidence.size()) >= options_.confirm_min_confidence;
 }
 
 bool Tracker::same_target(const Track& a, const Track& b) const {

@@ -130,6 +130,73 @@ TEST(Tracker, DropsATentativeTrackThatCannotReachMHits) {
   EXPECT_TRUE(t.confirmed(frame_utime(4)).empty());
 }
 
+TEST(Tracker, ALowConfidenceDetectionContinuesATrackButStartsNone) {
+  TrackerOptions o;
+  o.birth_min_confidence = 0.5;
+  o.birth_hits = 2;
+  o.birth_window = 2;
+  Tracker t(o);
+  const Eigen::Vector3d p(15, 2, 3), q(-10, 4, 2);
+  t.update(frame_utime(0), {meas(p, 0.2, 0.3)});  // below: no track
+  EXPECT_EQ(t.num_tentative(), 0u);
+  EXPECT_EQ(t.stats().births_refused, 1);
+  t.update(frame_utime(1), {meas(p, 0.2, 0.6)});  // at or above: a tentative track
+  EXPECT_EQ(t.num_tentative(), 1u);
+  t.update(frame_utime(2), {meas(p, 0.2, 0.3), meas(q, 0.2, 0.3)});  // p's low box continues it; q's starts nothing
+  ASSERT_EQ(t.confirmed(frame_utime(2)).size(), 1u);
+  EXPECT_EQ(t.num_tentative(), 0u);
+  EXPECT_EQ(t.stats().births_refused, 2);
+  EXPECT_EQ(t.stats().births, 1);
+}
+
+TEST(Tracker, ATrackIsConfirmedOnlyOnceTheMeanConfidenceOfItsLastNHitsReachesTheBar) {
+  TrackerOptions o;
+  o.confirm_min_confidence = 0.5;  // M = 3 of N = 5
+  Tracker t(o);
+  const Eigen::Vector3d p(15, 2, 3);
+  // Three hits at 0.3, 0.4, 0.5 (mean 0.4): M of N is reached, the mean is not; the track stays tentative.
+  t.update(frame_utime(0), {meas(p, 0.2, 0.3)});
+  t.update(frame_utime(1), {meas(p, 0.2, 0.4)});
+  t.update(frame_utime(2), {meas(p, 0.2, 0.5)});
+  EXPECT_TRUE(t.confirmed(frame_utime(2)).empty());
+  EXPECT_EQ(t.num_tentative(), 1u);
+  EXPECT_EQ(t.stats().confirmations_held, 1);
+  // 0.3 0.4 0.5 0.6: mean 0.45, still held (and counted once).
+  t.update(frame_utime(3), {meas(p, 0.2, 0.6)});
+  EXPECT_TRUE(t.confirmed(frame_utime(3)).empty());
+  // A miss leaves the window of hits as it is; then 0.3 0.4 0.5 0.6 0.7: mean 0.5, confirmed.
+  t.update(frame_utime(4), {});
+  EXPECT_TRUE(t.confirmed(frame_utime(4)).empty());
+  t.update(frame_utime(5), {meas(p, 0.2, 0.7)});
+  const auto out = t.confirmed(frame_utime(5));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 1);
+  EXPECT_EQ(t.stats().confirmations_held, 1);
+  EXPECT_EQ(t.stats().confirmations, 1);
+  // The mean is over the last N hits only: after two hits at 0.2, hits at 0.55 confirm the track once both low ones
+  // have left the window (0.2 0.2 0.55 0.55 0.55: mean 0.41; 0.2 and four 0.55: 0.48; five 0.55: confirmed).
+  Tracker u(o);
+  const Eigen::Vector3d r(-10, 4, 2);
+  int k = 10;
+  u.update(frame_utime(k++), {meas(r, 0.2, 0.2)});
+  u.update(frame_utime(k++), {meas(r, 0.2, 0.2)});
+  for (int i = 0; i < 4; ++i) {
+    u.update(frame_utime(k), {meas(r, 0.2, 0.55)});
+    EXPECT_TRUE(u.confirmed(frame_utime(k)).empty()) << i;
+    ++k;
+  }
+  u.update(frame_utime(k), {meas(r, 0.2, 0.55)});
+  EXPECT_EQ(u.confirmed(frame_utime(k)).size(), 1u);
+  // Out of range values are named.
+  TrackerOptions bad;
+  bad.birth_min_confidence = 1.5;
+  bad.confirm_min_confidence = -0.1;
+  const auto problems = bad.validate();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("tracker.birth_min_confidence = 1.5"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("tracker.confirm_min_confidence = -0.1"), std::string::npos) << problems[1];
+}
+
 TEST(Tracker, DeletesAfterTheTimeoutAndNeverReusesIds) {
   TrackerOptions o;
   o.death_timeout_s = 0.5;

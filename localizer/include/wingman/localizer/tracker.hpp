@@ -45,6 +45,13 @@ struct TrackerOptions {
   /// N of the M-of-N birth rule, frames (calls of update()); a tentative track that can no longer
   /// reach M hits within N frames is dropped. >= birth_hits.
   int birth_window = 5;
+  /// Two-level birth (as ByteTrack): a detection below this confidence updates a track it is associated with but
+  /// never starts one. 0 = every detection may start a track. [0, 1].
+  double birth_min_confidence = 0.0;
+  /// Track-level evidence: a tentative track is confirmed only once the mean detection confidence of its last
+  /// birth_window hits also reaches this (and stays tentative, not dropped, while it falls short and keeps being
+  /// hit). 0 = the M-of-N rule alone. [0, 1].
+  double confirm_min_confidence = 0.0;
   /// A track without a hit for longer than this (image time) is deleted. Seconds, > 0.
   double death_timeout_s = 1.0;
   /// n_f of the sliding-window mode: measurements averaged (thesis: 5). >= 1.
@@ -72,6 +79,10 @@ struct TrackerOptions {
     v("tracker.gate_chi2", gate_chi2, "gate on squared Mahalanobis distance (3 dof: 16.27 = 99.9 %, 11.34 = 99 %)");
     v("tracker.birth_hits", birth_hits, "M: hits a tentative track needs within its first N frames");
     v("tracker.birth_window", birth_window, "N: frames a tentative track has to collect M hits");
+    v("tracker.birth_min_confidence", birth_min_confidence,
+      "a detection below this confidence continues a track but starts none, 0..1 (0 = any)");
+    v("tracker.confirm_min_confidence", confirm_min_confidence,
+      "a tentative track is confirmed once the mean confidence of its last N hits reaches this, 0..1 (0 = off)");
     v("tracker.death_timeout_s", death_timeout_s, "a track without a hit for this long is deleted, s");
     v("tracker.window_size", window_size, "n_f: measurements averaged in sliding_window mode");
     v("tracker.initial_velocity_std", initial_velocity_std, "velocity standard deviation of a new track, m/s");
@@ -118,6 +129,10 @@ struct TrackerStats {
   int64_t associated = 0;             ///< measurements that updated a track
   int64_t births = 0;                 ///< tentative tracks started
   int64_t confirmations = 0;          ///< tentative tracks confirmed
+  /// tentative tracks held back at least once by confirm_min_confidence (M of N reached, the mean confidence not)
+  int64_t confirmations_held = 0;
+  /// detections that started no track because they were below birth_min_confidence
+  int64_t births_refused = 0;
   int64_t tentative_dropped = 0;      ///< tentative tracks that failed the M-of-N rule or timed out
   int64_t deaths = 0;                 ///< confirmed tracks deleted after death_timeout_s
   int64_t merges = 0;                 ///< duplicates merged into an older confirmed track (or not confirmed)
@@ -174,6 +189,8 @@ class Tracker {
     int frames = 0;                  // frames since birth, the birth frame included
     int hits = 0;                    // hits since birth
     std::deque<bool> recent;         // hit or miss of the last birth_window frames
+    std::deque<double> recent_confidence;  // detection confidence of the last birth_window hits
+    bool held = false;                     // once held back by confirm_min_confidence (counted once)
     std::deque<WindowEntry> window;  // last window_size detections
     WorldMeasurement last;           // newest detection (as detected: the configured size)
     SizeEstimator size;              // the track's detections for its range scale
@@ -187,6 +204,8 @@ class Tracker {
   void hit(Track& t, const WorldMeasurement& z);
   TrackOutput output(const Track& t, int64_t predict_to_utime) const;
   bool same_target(const Track& a, const Track& b) const;
+  /// The mean confidence of t's last birth_window hits reaches confirm_min_confidence (always true when it is 0).
+  bool confident_enough(const Track& t) const;
   bool duplicates_a_confirmed_track(const Track& t) const;
   void merge_duplicates();  // also removes tracks marked id = -1
 
