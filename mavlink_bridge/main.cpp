@@ -61,6 +61,9 @@ int run(common::Runtime& rt, const BridgeOptions& o) {
   for (;;) {
     chunks.clear();
     link.take(chunks);
+    // LCM before the link's reads: a SETPOINT that was on the bus before a read arrived is handled first, so an
+    // answer to that read (TIMESYNC) comes after what the setpoint made us send (wingman-sim's lockstep barrier).
+    rt.drain();
     for (const LinkChunk& c : chunks) {
       // Frames are handled with the clocks of the read that brought them (TIMESYNC round trips end there).
       auto on_frame = [&](const mavlink::Frame& f) {

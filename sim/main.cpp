@@ -2,6 +2,7 @@
 // wingman-sim: flies a scenario and publishes what the camera vehicle's camera and autopilot would (images, own pose)
 // plus ground truth; takes the follower's setpoints; advances simulated time by messages (lockstep), freely or in
 // real time.
+#include "wingman/sim/mavlink_vehicle.hpp"
 #include "wingman/sim/renderer.hpp"
 #include "wingman/sim/scenario.hpp"
 #include "wingman/sim/sim_options.hpp"
@@ -10,6 +11,9 @@
 
 #include <wingman/common/runtime.hpp>
 #include <wingman/localizer/calibration.hpp>
+#include <wingman/mavlink/parser.hpp>
+#include <wingman/mavlink_bridge/link.hpp>
+#include <wingman/mavlink_bridge/link_reader.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -18,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -75,6 +80,116 @@ void wait_for_processes(common::Runtime& rt, const std::vector<std::string>& nam
   }
 }
 
+/// The status channel entry of the MAVLink link (autopilot: mavlink).
+const std::string kLinkChannel = "MAVLINK";
+
+/// The camera vehicle's autopilot as a MAVLink vehicle (autopilot: mavlink): the link, its parser and the vehicle's
+/// rules. service() handles what has arrived, at the simulator's present time, and gives the resulting commands to the
+/// simulator; the link's own reads wake the runtime.
+class MavlinkSide {
+ public:
+  MavlinkSide(common::Runtime& rt, const sim::MavlinkVehicleOptions& o, sim::Simulator& simulator)
+      : rt_(rt),
+        o_(o),
+        simulator_(simulator),
+        vehicle_(o, simulator.scenario().start_utime),
+        link_(mavlink_bridge::make_link(o.url, 0), 1.0, 4096, [&rt] { rt.wake(); }) {
+    rt.status().declare_input(kLinkChannel);
+  }
+
+  sim::MavlinkVehicle& vehicle() { return vehicle_; }
+
+  /// Handles the link's waiting reads and sends what is due (our HEARTBEAT on the wall clock).
+  void service() {
+    chunks_.clear();
+    link_.take(chunks_);
+    for (const auto& c : chunks_) {
+      auto on_frame = [&](const mavlink::Frame& f) {
+        rt_.status().input(kLinkChannel, 0);
+        vehicle_.on_frame(f, simulator_.now_utime(), out_);
+      };
+      if (!c.event.empty()) {
+        if (c.lost) parser_.end_of_datagram(on_frame);
+        if (c.event.rfind("link open", 0) == 0) {
+          spdlog::info("{}", c.event);
+        } else {
+          rt_.status().input_dropped(kLinkChannel, c.event);
+          spdlog::warn("{}", c.event);
+        }
+        continue;
+      }
+      parser_.feed(c.bytes.data(), c.bytes.size(), on_frame);
+      if (c.datagram) parser_.end_of_datagram(on_frame);
+    }
+    for (const int64_t n = parser_.stats().bad_crc + parser_.stats().truncated + parser_.stats().bad_length +
+                           parser_.stats().signed_refused + parser_.stats().incompatible_flags;
+         parser_drops_ < n; ++parser_drops_)
+      rt_.status().input_dropped(kLinkChannel, "MAVLink: a bad frame (checksum, length, signed or unknown flags)");
+    const auto now = Clock::now();
+    if (!last_heartbeat_ || now - *last_heartbeat_ >= std::chrono::duration<double>(o_.heartbeat_period_s)) {
+      vehicle_.heartbeat(out_);
+      last_heartbeat_ = now;
+    }
+    flush();
+  }
+
+  /// The frame's time: timeouts, the pilot, telemetry of the camera vehicle.
+  void on_frame_time() {
+    vehicle_.on_frame_time(simulator_.now_utime(), simulator_.vehicle_state(0), out_);
+    flush();
+  }
+
+  /// Sends a TIMESYNC request: its answer (pong()) comes after the companion handled everything before it.
+  int64_t ping() {
+    const int64_t ts1 = vehicle_.ping(simulator_.now_utime(), out_);
+    flush();
+    return ts1;
+  }
+  std::optional<int64_t> pong() const { return pong_; }
+  int64_t write_failures() const { return write_failures_; }
+  int64_t command_errors() const { return command_errors_; }
+
+ private:
+  void flush() {
+    for (const auto& f : out_.frames)
+      if (!link_.write(f)) ++write_failures_;
+    for (const auto& c : out_.commands) {
+      try {
+        simulator_.on_setpoint(c);
+      } catch (const std::invalid_argument& e) {
+        ++command_errors_;
+        rt_.status().input_dropped(kLinkChannel, std::string("MAVLink setpoint not flown: ") + e.what());
+      }
+    }
+    if (out_.pong_ts1) pong_ = out_.pong_ts1;
+    out_ = sim::VehicleOutput{};
+  }
+
+  common::Runtime& rt_;
+  sim::MavlinkVehicleOptions o_;
+  sim::Simulator& simulator_;
+  sim::MavlinkVehicle vehicle_;
+  mavlink_bridge::LinkReader link_;
+  mavlink::Parser parser_;
+  int64_t parser_drops_ = 0;
+  std::vector<mavlink_bridge::LinkChunk> chunks_;
+  sim::VehicleOutput out_;
+  std::optional<Clock::time_point> last_heartbeat_;
+  std::optional<int64_t> pong_;
+  int64_t write_failures_ = 0;
+  int64_t command_errors_ = 0;
+};
+
+/// One line on the MAVLink vehicle for the status and the last log line.
+std::string mavlink_detail(MavlinkSide& mav, int64_t own_pose_timeouts, int64_t barrier_timeouts) {
+  const auto& n = mav.vehicle().counts();
+  return fmt::format(
+      "autopilot {}: mavlink setpoints {} flown, {} ignored (not engaged), {} refused; offboard lost {}, guided "
+      "timeouts {}, engage refused {}; own-pose timeouts {}, barrier timeouts {}, write failures {}",
+      mav.vehicle().mode_name(), n.setpoints_applied, n.setpoints_ignored, n.setpoints_refused, n.offboard_lost,
+      n.guided_timeouts, n.mode_refusals, own_pose_timeouts, barrier_timeouts, mav.write_failures());
+}
+
 int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scenario) {
   common::StatusTracker& status = rt.status();
   sim::SimCamera camera{make_camera(o.camera), localizer::Extrinsics::from_options(o.extrinsics), o.camera.rate_hz,
@@ -92,7 +207,18 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   sim::Simulator simulator(scenario, camera, renderer.get());
 
   if (o.render) status.declare_output(o.image_channel);
-  status.declare_output(o.own_pose_channel);
+  const bool via_mavlink = o.autopilot == "mavlink";
+  if (via_mavlink && rt.input_is_file())
+    throw std::runtime_error(
+        "autopilot: mavlink needs a live bus (the companion publishes OWN_POSE), not a file input");
+  if (!via_mavlink) status.declare_output(o.own_pose_channel);
+  std::unique_ptr<MavlinkSide> mav;
+  if (via_mavlink) {
+    if (!simulator.takes_setpoints())
+      throw std::runtime_error(
+          "autopilot: mavlink: the scenario's camera vehicle is scripted (control: setpoints needed)");
+    mav = std::make_unique<MavlinkSide>(rt, o.mavlink, simulator);
+  }
   status.declare_output(o.ground_truth_channel);
   if (o.detections.from_ground_truth) {
     status.declare_output(o.detections_channel);
@@ -106,13 +232,44 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   const bool realtime = o.sync.mode == "realtime";
   int64_t newest_setpoint_utime = -1;
   bool input_ended = false;
+  // With autopilot: mavlink the follower's SETPOINT only paces the lockstep (the pipeline has answered a frame): the
+  // vehicle flies what comes over MAVLink, and the companion publishes OWN_POSE.
   rt.subscribe<setpoint_t>(o.setpoint_channel, [&](const setpoint_t& sp) {
-    simulator.on_setpoint(sp);
+    if (!via_mavlink) simulator.on_setpoint(sp);
     newest_setpoint_utime = std::max(newest_setpoint_utime, sp.utime);
   });
+  int64_t newest_own_pose_utime = -1;
+  if (via_mavlink) {
+    rt.subscribe<own_pose_t>(o.own_pose_channel, [&](const own_pose_t& p) {
+      newest_own_pose_utime = std::max(newest_own_pose_utime, p.utime);
+    });
+  }
+  // Waits (wall clock, bounded) until done() or the deadline, handling LCM and the MAVLink link meanwhile. False when
+  // it timed out or stop was requested.
+  auto wait_until = [&](const std::function<bool()>& done, double timeout_s) {
+    const auto deadline =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+    for (;;) {
+      if (mav) mav->service();
+      if (done()) return true;
+      if (rt.stop_requested() || Clock::now() >= deadline) return false;
+      rt.spin_once(remaining_ms(deadline, 50));
+    }
+  };
 
   wait_for_processes(rt, o.sync.wait_for, o.sync.startup_timeout_s);
   if (rt.stop_requested()) return rt.shutdown();
+  if (mav) {
+    // The companion must have our clock before the first frame (it publishes no own pose without it).
+    spdlog::info("autopilot: MAVLink vehicle ({}) on {}, waiting up to {} s for the companion's TIMESYNC",
+                 o.mavlink.firmware, o.mavlink.url, o.sync.startup_timeout_s);
+    if (!wait_until([&] { return mav->vehicle().counts().timesync_answered > 0; }, o.sync.startup_timeout_s)) {
+      if (rt.stop_requested()) return rt.shutdown();
+      throw std::runtime_error(
+          fmt::format("autopilot: mavlink: no TIMESYNC request from the companion on {} within {} s", o.mavlink.url,
+                      o.sync.startup_timeout_s));
+    }
+  }
 
   spdlog::info("scenario '{}' ({}): {} frames at {} Hz from utime {}, {} vehicles; sync {}{}", scenario.name,
                scenario.source, simulator.frame_count(), o.camera.rate_hz, scenario.start_utime,
@@ -123,6 +280,8 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   rt.publish_heartbeat();
 
   int64_t lockstep_timeouts = 0;
+  int64_t own_pose_timeouts = 0;
+  int64_t barrier_timeouts = 0;
   const auto wall_start = Clock::now();
   std::string stop_reason = "end of scenario";
   while (!simulator.done()) {
@@ -138,9 +297,10 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
       const auto due = wall_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
                                         simulator.clock().seconds_since_start(t_k) / pace));
       while (Clock::now() < due && !rt.stop_requested()) {
+        if (mav) mav->service();
         if (input_ended || rt.input_is_file()) {
           std::this_thread::sleep_for(std::chrono::milliseconds(remaining_ms(due, 100)));
-        } else if (!rt.spin_once(remaining_ms(due, 100)) && !rt.stop_requested()) {
+        } else if (!rt.spin_once(remaining_ms(due, mav ? 20 : 100)) && !rt.stop_requested()) {
           input_ended = true;
         }
       }
@@ -149,8 +309,22 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
 
     const auto t0 = Clock::now();
     const sim::SimFrame frame = simulator.step();
-    rt.publish(o.own_pose_channel, frame.own_pose);
+    if (mav) {
+      mav->on_frame_time();  // the autopilot's telemetry of this frame goes to the companion
+    } else {
+      rt.publish(o.own_pose_channel, frame.own_pose);
+    }
     rt.publish(o.ground_truth_channel, frame.truth);
+    if (mav && lockstep) {
+      // The companion's OWN_POSE of this frame comes before the frame's images and detections, as ours would.
+      const int64_t earliest = frame.utime - static_cast<int64_t>(std::llround(0.5e6 / o.camera.rate_hz));
+      if (!wait_until([&] { return newest_own_pose_utime >= earliest; }, o.sync.timeout_s)) {
+        if (rt.stop_requested()) continue;
+        ++own_pose_timeouts;
+        status.set_error(
+            fmt::format("autopilot: mavlink: no OWN_POSE for frame {} within {} s", frame.index, o.sync.timeout_s));
+      }
+    }
     if (!frame.bgr.empty()) {
       rt.publish(o.image_channel, sim::to_image_message(frame.bgr, frame.utime, frame.index, camera.camera_id));
     }
@@ -175,21 +349,37 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
               fmt::format("lockstep: no setpoint for frame {} within {} s", frame.index, o.sync.timeout_s));
           break;
         }
-        if (!rt.spin_once(remaining_ms(deadline, 100)) && !rt.stop_requested()) {
+        if (mav) mav->service();
+        if (newest_setpoint_utime >= frame.utime) break;
+        if (!rt.spin_once(remaining_ms(deadline, mav ? 20 : 100)) && !rt.stop_requested()) {
           input_ended = true;  // end of a file input: no more setpoints will come
           break;
         }
       }
+      if (mav && !rt.stop_requested()) {
+        // The barrier: the companion answers our TIMESYNC after it handled the follower's SETPOINT, so what it sent
+        // the vehicle for this frame has arrived (UDP on loopback keeps the order) and is flown from this frame on.
+        const int64_t ts1 = mav->ping();
+        if (!wait_until([&] { return mav->pong() == ts1; }, o.sync.timeout_s) && !rt.stop_requested()) {
+          ++barrier_timeouts;
+          status.set_error(
+              fmt::format("autopilot: mavlink: no TIMESYNC answer from the companion for frame {} within {} s",
+                          frame.index, o.sync.timeout_s));
+        }
+      }
     } else if (!realtime && !rt.input_is_file()) {
       rt.drain();  // free: take whatever setpoints have arrived, never wait
+      if (mav) mav->service();
     }
 
     const auto& c = simulator.setpoint_counts();
-    const std::string detail = fmt::format(
+    std::string detail = fmt::format(
         "scenario {}: frame {}/{} at {:.3f} s; {} lockstep timeouts; setpoints {} on time, {} late, {} ignored{}",
         scenario.name, frame.index + 1, simulator.frame_count(), simulator.clock().seconds_since_start(frame.utime),
         lockstep_timeouts, c.queued, c.late, c.ignored, gt_note);
-    status.set_state(lockstep_timeouts > 0 ? status_t::STATE_DEGRADED : status_t::STATE_OK, detail);
+    if (mav) detail += "; " + mavlink_detail(*mav, own_pose_timeouts, barrier_timeouts);
+    const bool degraded = lockstep_timeouts > 0 || own_pose_timeouts > 0 || barrier_timeouts > 0;
+    status.set_state(degraded ? status_t::STATE_DEGRADED : status_t::STATE_OK, detail);
     rt.heartbeat_if_due();
   }
 
@@ -201,6 +391,7 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
       frames, wall_s, wall_s > 0 ? frames / wall_s : 0.0,
       wall_s > 0 ? simulator.clock().seconds_since_start(simulator.now_utime()) / wall_s : 0.0, lockstep_timeouts,
       simulator.setpoint_counts().queued, simulator.setpoint_counts().late, simulator.setpoint_counts().ignored);
+  if (mav) spdlog::info("{}", mavlink_detail(*mav, own_pose_timeouts, barrier_timeouts));
   return rt.shutdown(stop_reason);
 }
 

@@ -9,14 +9,15 @@ add_library(wingman_sim_world
   src/world/scenario.cpp
   src/world/sim_options.cpp
   src/world/simulator.cpp
+  src/world/mavlink_vehicle.cpp
   src/world/truth_detections.cpp)
 add_library(wingman::sim_world ALIAS wingman_sim_world)
 target_include_directories(wingman_sim_world PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 target_link_libraries(wingman_sim_world
-  PUBLIC wingman::sim_render wingman::localizer wingman::common wingman::lcmtypes Eigen3::Eigen opencv_core
+  PUBLIC wingman::sim_render wingman::localizer wingman::common wingman::mavlink wingman::lcmtypes Eigen3::Eigen opencv_core
   PRIVATE yaml-cpp fmt::fmt)
 wingman_warnings(wingman_sim_world)
 
 add_executable(wingman-sim main.cpp)
-target_link_libraries(wingman-sim PRIVATE wingman::sim_world wingman::common spdlog::spdlog fmt::fmt)
+target_link_libraries(wingman-sim PRIVATE wingman::sim_world wingman::mavlink_bridge wingman::common spdlog::spdlog fmt::fmt)
 wingman_warnings(wingman-sim)

@@ -6,6 +6,11 @@ wingman_add_test(test_sim_world
   SOURCES test_multirotor.cpp test_scenario.cpp test_simulator.cpp
   LIBS wingman::sim_world wingman::test_support)
 
+# The simulated autopilot's MAVLink rules (autopilot: mavlink): PX4 OFFBOARD, ArduPilot GUIDED, TIMESYNC, telemetry.
+wingman_add_test(test_sim_mavlink_vehicle
+  SOURCES test_mavlink_vehicle.cpp
+  LIBS wingman::sim_world)
+
 # wingman-sim as a process: file to file, lockstep on the bus of a private network namespace, errors.
 wingman_add_test(test_sim_process
   SOURCES test_sim_process.cpp

@@ -64,8 +64,10 @@ std::vector<std::string> SimOptions::validate() const {
   channel("output.own_pose_channel", own_pose_channel);
   channel("output.ground_truth_channel", ground_truth_channel);
   channel("output.detections_channel", detections_channel);
-  for (const auto& part :
-       {camera.validate(), extrinsics.validate(), detections.validate(), sync.validate(), render_options.validate()}) {
+  if (autopilot != "lcm" && autopilot != "mavlink")
+    p.push_back(problem("autopilot", autopilot, "must be lcm or mavlink"));
+  for (const auto& part : {camera.validate(), extrinsics.validate(), detections.validate(), sync.validate(),
+                           render_options.validate(), mavlink.validate()}) {
     p.insert(p.end(), part.begin(), part.end());
   }
   return p;

@@ -2,6 +2,7 @@
 // Options of wingman-sim (config/sim.yaml).
 #pragma once
 
+#include "wingman/sim/mavlink_vehicle.hpp"
 #include "wingman/sim/render_options.hpp"
 
 #include <wingman/localizer/extrinsics.hpp>
@@ -103,6 +104,11 @@ struct SimOptions {
   std::string own_pose_channel = "OWN_POSE";           ///< own_pose_t output channel (camera vehicle)
   std::string ground_truth_channel = "GROUND_TRUTH";   ///< ground_truth_t output channel
   std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t output (detections.from_ground_truth)
+  /// Who stands in for the camera vehicle's autopilot: lcm (the simulator takes SETPOINT and publishes OWN_POSE
+  /// itself) or mavlink (it is a MAVLink vehicle on `mavlink.url`: wingman-mavlink publishes OWN_POSE from its
+  /// telemetry and sends it the setpoints; docs/autopilot.md, "Try it against the simulator").
+  std::string autopilot = "lcm";
+  MavlinkVehicleOptions mavlink;
   /// Render and publish images. Off: no image is published, no EGL is needed, and truth boxes are projected from
   /// the drone models (no occlusion).
   bool render = true;
@@ -120,6 +126,9 @@ struct SimOptions {
     v("output.own_pose_channel", own_pose_channel, "own_pose_t channel: the camera vehicle's pose at each frame");
     v("output.ground_truth_channel", ground_truth_channel, "ground_truth_t channel: every vehicle and its box");
     v("output.detections_channel", detections_channel, "detections_t channel for detections.from_ground_truth");
+    v("autopilot", autopilot,
+      "lcm (take SETPOINT, publish OWN_POSE) or mavlink (a MAVLink vehicle for wingman-mavlink, keys mavlink.*)");
+    mavlink.visit(v);
     camera.visit(v);
     extrinsics.visit(v);
     detections.visit(v);
