@@ -98,6 +98,7 @@ int run(common::Runtime& rt, const BridgeOptions& o) {
     // Woken by the link's reads and by LCM; otherwise at least every tick period for the stream and heartbeats.
     if (!rt.spin_once(kTickMs)) break;
   }
+  spdlog::info("{}", bridge.detail());
   return rt.shutdown();
 }
 

@@ -163,6 +163,7 @@ std::optional<SetPositionTargetLocalNed> OffboardStreamer::tick(int64_t mono_us,
       state_ == StreamState::kStreaming || state_ == StreamState::kHover || state_ == StreamState::kReady;
   if (!sending) {
     last_v_ned_.setZero();
+    last_follower_utime_ = -1;
     return std::nullopt;
   }
   const bool due = last_sent_us_ < 0 || mono_us - last_sent_us_ >= period_us_ || state_ != before;
@@ -178,6 +179,7 @@ SetPositionTargetLocalNed OffboardStreamer::hover_target() {
   t.coordinate_frame = mavlink::kMavFrameLocalNed;
   t.type_mask = mavlink::kTypemaskPositionIgnore | mavlink::kTypemaskAccelerationIgnore | mavlink::kTypemaskYawIgnore;
   last_v_ned_.setZero();
+  last_follower_utime_ = -1;
   return t;  // zero velocity, zero yaw rate
 }
 
@@ -200,6 +202,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
     t.type_mask =
         mavlink::kTypemaskVelocityIgnore | mavlink::kTypemaskAccelerationIgnore | mavlink::kTypemaskYawRateIgnore;
     last_v_ned_.setZero();
+    last_follower_utime_ = -1;
     return t;
   }
   Eigen::Vector3d v(sp.velocity[0], sp.velocity[1], sp.velocity[2]);
@@ -215,8 +218,13 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
     v.z() = std::copysign(o_.max_vertical_speed_mps, v.z());
     refuse("speed_clamped", "a vertical speed above limits.max_vertical_speed_mps was clamped");
   }
-  // Acceleration: the commanded velocity moves towards v by at most max_acceleration * dt per sent setpoint.
-  const double dt_s = last_sent_us_ < 0 ? period_us_ * 1e-6 : std::min(mono_us - last_sent_us_, 2 * period_us_) * 1e-6;
+  // Acceleration: the commanded velocity moves towards v by at most max_acceleration * dt per sent setpoint, dt on the
+  // setpoints' message times (the follower's clock, not the arrival: a burst of late setpoints is not an acceleration,
+  // and a simulation runs the same at any speed); a resend of the same setpoint moves it no further. After a send that
+  // was not the follower's (hover, ready), one stream period.
+  const int64_t dt_us =
+      last_follower_utime_ < 0 ? period_us_ : std::clamp<int64_t>(sp.utime - last_follower_utime_, 0, 2 * period_us_);
+  const double dt_s = dt_us * 1e-6;
   const Eigen::Vector3d dv = v - last_v_ned_;
   const double max_dv = o_.max_acceleration_mps2 * dt_s;
   if (dv.norm() > max_dv + 1e-9) {
@@ -231,6 +239,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
     refuse("altitude_clamped", "a vertical speed out of limits.min_altitude_m..max_altitude_m was set to 0");
   }
   last_v_ned_ = v;
+  last_follower_utime_ = std::max(last_follower_utime_, sp.utime);
   t.vx = static_cast<float>(v.x());
   t.vy = static_cast<float>(v.y());
   t.vz = static_cast<float>(v.z());

@@ -69,7 +69,9 @@ std::vector<std::pair<int64_t, mav::SetPositionTargetLocalNed>> run(OffboardStre
   for (int64_t t = from_ms; t < to_ms; ++t) {
     bool force = false;
     if (sp && every_ms > 0 && (t - from_ms) % every_ms == 0) {
-      s.on_setpoint(*sp, t * kMs, 0);
+      setpoint_t now = *sp;  // the follower stamps each setpoint with its own (here: the test's) time
+      now.utime = sp->utime + t * kMs;
+      s.on_setpoint(now, t * kMs, 0);
       force = true;
     }
     if (auto out = s.tick(t * kMs, force)) sent.emplace_back(t, *out);
@@ -217,6 +219,30 @@ TEST(OffboardStreamer, SpeedsAccelerationAndTheAltitudeBandAreClamped) {
   EXPECT_FLOAT_EQ(low.back().second.vz, 0.0f);
   for (const char* r : {"speed_clamped", "acceleration_clamped", "altitude_clamped"})
     EXPECT_GT(s.refusals().count_of(r), 0) << r;
+}
+
+TEST(OffboardStreamer, TheAccelerationClampCountsTheSetpointsMessageTimeNotTheirArrival) {
+  BridgeOptions o = options();
+  o.max_acceleration_mps2 = 3;
+  OffboardStreamer s(o, nullptr);
+  s.on_autopilot(ardupilot(true));
+  s.on_altitude(10);
+  // A burst: ten setpoints 100 ms apart in the follower's time arrive within 10 ms (a stalled link, a simulation
+  // faster than real time). Each may move the command by 3 m/s^2 x 0.1 s (the first, after no follower setpoint,
+  // by one stream period, 50 ms).
+  std::vector<double> east;
+  for (int i = 0; i < 10; ++i) {
+    s.on_setpoint(velocity(5, 0, 0, 0, 1000000 + i * 100000), 1000 * kMs + i * kMs, 0);
+    auto out = s.tick(1000 * kMs + i * kMs, true);
+    ASSERT_TRUE(out.has_value()) << i;
+    east.push_back(out->vy);  // NED: east is y
+  }
+  EXPECT_NEAR(east[0], 0.15, 1e-5);
+  for (size_t i = 1; i < east.size(); ++i) EXPECT_NEAR(east[i] - east[i - 1], 0.3, 1e-5) << i;
+  // The same setpoint sent again (the stream's rate) moves it no further, however long after it arrived.
+  auto again = s.tick(1100 * kMs);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_FLOAT_EQ(again->vy, static_cast<float>(east.back()));
 }
 
 TEST(OffboardStreamer, PositionSetpointsAreConvertedAndKeptInTheAltitudeBand) {

@@ -57,7 +57,7 @@ struct BridgeOptions {
   // limits applied again here
   double max_horizontal_speed_mps = 5.0;  ///< commanded horizontal speed at most
   double max_vertical_speed_mps = 2.0;    ///< commanded vertical speed at most
-  double max_acceleration_mps2 = 3.0;     ///< commanded velocity changes at most this fast between sent setpoints
+  double max_acceleration_mps2 = 3.0;     ///< commanded velocity changes at most this fast (setpoints' message times)
   double min_altitude_m = 2.0;   ///< altitude band: never commanded below (position) or further down (velocity)
   double max_altitude_m = 50.0;  ///< altitude band: never commanded above or further up
 
@@ -104,7 +104,7 @@ struct BridgeOptions {
     v("limits.max_horizontal_speed_mps", max_horizontal_speed_mps, "commanded horizontal speed at most, m/s");
     v("limits.max_vertical_speed_mps", max_vertical_speed_mps, "commanded vertical speed at most, m/s");
     v("limits.max_acceleration_mps2", max_acceleration_mps2,
-      "commanded velocity changes at most this fast between sent setpoints, m/s^2");
+      "commanded velocity changes at most this fast over the setpoints' message times, m/s^2");
     v("limits.min_altitude_m", min_altitude_m, "lowest altitude commanded (metres up from the local origin)");
     v("limits.max_altitude_m", max_altitude_m, "highest altitude commanded (metres up from the local origin)");
   }

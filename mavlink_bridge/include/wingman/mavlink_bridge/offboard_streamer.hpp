@@ -43,7 +43,8 @@ const char* to_string(StreamState s);
 /// - a MODE_HOLD setpoint, or no setpoint for setpoint_timeout_s, while streaming: zero velocity for hover_s, then
 ///   nothing (kStopped) until the pilot leaves and re-engages the mode (or at once with resume_after_stop);
 /// - leaving the mode stops the stream at once (the pilot has taken over);
-/// - speeds, acceleration (change of commanded velocity between sent setpoints) and the altitude band are clamped;
+/// - speeds, acceleration (change of commanded velocity between sent setpoints, over the setpoints' message times) and
+///   the altitude band are clamped;
 /// - every refusal or change is counted by reason (refusals()) and `log` is called the first time of each reason.
 /// Clocks: `mono_us` (a monotonic clock, microseconds) paces the stream and judges liveness; setpoint ages are judged
 /// on message times (setpoint_t.utime against the newest own pose's utime).
@@ -90,6 +91,7 @@ class OffboardStreamer {
   bool left_mode_since_stop_ = false;
   int64_t last_sent_us_ = -1;
   Eigen::Vector3d last_v_ned_ = Eigen::Vector3d::Zero();  ///< velocity of the last sent setpoint (0 for position/hover)
+  int64_t last_follower_utime_ = -1;  ///< utime of the follower's setpoint behind the last send; -1: not the follower's
   int64_t sent_ = 0;
   Refusals refusals_;
 };
