@@ -8,7 +8,7 @@
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
 #                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE] [--follower-config FILE]
-#                     [--render-config FILE]
+#                     [--render-config FILE] [--autopilot lcm|mavlink] [--firmware px4|ardupilot]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -30,6 +30,10 @@
 #                    defaults); its formation.offset_m is also the offset the formation error is measured against
 #   --render-config  the simulator's render.* keys (lighting, scene) from this file (wingman-sim --render-config),
 #                    e.g. FILE.render.yaml written by `wingman scenario random` beside its scenario
+#   --autopilot      lcm: the simulator takes SETPOINT and publishes OWN_POSE itself (default); mavlink: the
+#                    simulator is a MAVLink vehicle on UDP loopback (inside the namespace) and wingman-mavlink bridges
+#                    it (config/mavlink_bridge.sim.yaml): OWN_POSE from its telemetry, setpoints through OFFBOARD/GUIDED
+#   --firmware       with --autopilot mavlink: the simulated autopilot's rules, px4 (OFFBOARD, default) or ardupilot
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -37,6 +41,7 @@ bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
 zoom_in=false flip_fusion=false coarse_pass=false localizer_config="" follower_config="" render_config=""
+autopilot=lcm firmware=px4
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -49,6 +54,8 @@ while [ $# -gt 0 ]; do
     --localizer-config) localizer_config=$(realpath "$2"); shift 2 ;;
     --follower-config) follower_config=$(realpath "$2"); shift 2 ;;
     --render-config) render_config=$(realpath "$2"); shift 2 ;;
+    --autopilot) autopilot="$2"; shift 2 ;;
+    --firmware) firmware="$2"; shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
     --record-images) record_images=true; shift ;;
@@ -61,14 +68,19 @@ if [ -f "$scenario" ]; then scenario_file=$(realpath "$scenario"); name=$(basena
 else scenario_file="$src/config/scenarios/$scenario.yaml"; name="$scenario"; fi
 case "$truth_box" in sphere|silhouette) ;; *) echo "fly: --truth-box '$truth_box': expected sphere or silhouette" >&2; exit 2 ;; esac
 case "$detections" in cnn|truth) ;; *) echo "fly: --detections '$detections': expected cnn or truth" >&2; exit 2 ;; esac
+case "$autopilot" in lcm|mavlink) ;; *) echo "fly: --autopilot '$autopilot': expected lcm or mavlink" >&2; exit 2 ;; esac
+case "$firmware" in px4|ardupilot) ;; *) echo "fly: --firmware '$firmware': expected px4 or ardupilot" >&2; exit 2 ;; esac
 [ -r "$scenario_file" ] || { echo "fly: no scenario '$scenario' (looked for $scenario_file)" >&2; exit 2; }
 out="${out:-$src/build/flights/$name}"
-for exe in wingman-sim wingman-detector wingman-localizer wingman-follower-ctrl wingman; do
+exes=(wingman-sim wingman-detector wingman-localizer wingman-follower-ctrl wingman)
+[ "$autopilot" = lcm ] || exes+=(wingman-mavlink)
+for exe in "${exes[@]}"; do
   [ -x "$bin/$exe" ] || { echo "fly: $bin/$exe is missing: build first (tools/build.sh)" >&2; exit 2; }
 done
 
 if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
-  again=(--scenario "$scenario_file" --out "$out" --detections "$detections" --truth-box "$truth_box")
+  again=(--scenario "$scenario_file" --out "$out" --detections "$detections" --truth-box "$truth_box"
+         --autopilot "$autopilot" --firmware "$firmware")
   [ -z "$duration" ] || again+=(--duration "$duration")
   [ "$render" != true ] || again+=(--render)
   [ "$render" != false ] || again+=(--no-render)
@@ -122,12 +134,16 @@ if [ -n "$follower_config" ]; then follower_args=(--config "$follower_config"); 
 # Lockstep, paced at most 5x real time: the logger is outside the loop. Unpaced, a truth-mode flight ran ~2600
 # frames/s and a loaded machine's logger recorded 383 of 600 ground-truth frames; at 10x, 505-600 of 600 with six
 # busy loops beside it; at 5x, 600 of 600 in each of 10 such runs. Slower flights (rendering, the CNN) are not affected.
+wait_for="detector, localizer, follower_ctrl"
+[ "$autopilot" = lcm ] || wait_for="$wait_for, mavlink_bridge"
 cat > "$out/sim.yaml" <<YAML
 # Written by tools/fly.sh for this flight.
 scenario: {file: "$scenario_file"}
-sync: {mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: [detector, localizer, follower_ctrl], startup_timeout_s: 60.0}
+sync: {mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: [$wait_for], startup_timeout_s: 60.0}
 detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0, seed: $scenario_seed}
 render: {enabled: $render}
+autopilot: $autopilot
+mavlink: {firmware: $firmware, streams: [odometry, attitude_quaternion, local_position_ned]}
 YAML
 if [ "$detections" = cnn ]; then
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s, flip_fusion: %s, coarse_pass: %s}\n' \
@@ -152,6 +168,10 @@ lcm-logger "${logger_args[@]}" "$log" & logger_pid=$!
 "$bin/wingman-detector" --lcm-url "$url" --config "$out/detector.yaml" --log-level warn & pids+=($!)
 "$bin/wingman-localizer" --lcm-url "$url" "${localizer_args[@]}" --log-level warn & pids+=($!)
 "$bin/wingman-follower-ctrl" --lcm-url "$url" "${follower_args[@]}" --log-level warn & pids+=($!)
+if [ "$autopilot" = mavlink ]; then
+  echo "fly: the autopilot is the simulator as a MAVLink vehicle ($firmware rules) through wingman-mavlink over UDP on loopback"
+  "$bin/wingman-mavlink" --lcm-url "$url" --config "$src/config/mavlink_bridge.sim.yaml" --log-level info & pids+=($!)
+fi
 
 sim_args=(--lcm-url "$url" --config "$out/sim.yaml")
 [ -n "$duration" ] && sim_args+=(--duration "$duration")
