@@ -7,6 +7,7 @@
 #include <wingman/mavlink/parser.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/sim/mavlink_vehicle.hpp>
+#include <wingman/sim/sim_options.hpp>
 
 #include <cmath>
 #include <vector>
@@ -98,6 +99,18 @@ TEST(MavlinkVehicleOptions, DefaultsAreValidAndBadValuesNameTheKey) {
   EXPECT_NE(p[2].find("mavlink.px4_offboard_loss_timeout_s"), std::string::npos) << p[2];
   EXPECT_NE(p[3].find("mavlink.streams = 'gps_raw_int'"), std::string::npos) << p[3];
   EXPECT_THROW(MavlinkVehicle(o, kStart), std::invalid_argument);
+}
+
+TEST(MavlinkVehicleOptions, TheSimulatorsAutopilotKeyIsLcmOrMavlinkAndItsMavlinkKeysAreChecked) {
+  wingman::sim::SimOptions o;
+  EXPECT_EQ(o.autopilot, "lcm") << "the default stays LCM";
+  EXPECT_TRUE(o.validate().empty());
+  o.autopilot = "px4";
+  o.mavlink.system_id = 0;
+  const auto p = o.validate();
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NE(p[0].find("autopilot = 'px4'"), std::string::npos) << p[0];
+  EXPECT_NE(p[1].find("mavlink.system_id"), std::string::npos) << p[1];
 }
 
 TEST(MavlinkVehiclePx4, OffboardIsRefusedWithoutASetpointStreamAndAcceptedWithOne) {
