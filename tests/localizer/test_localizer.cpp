@@ -36,7 +36,7 @@ TEST(Localizer, BoxesOfOtherClassesAreNotTrackedAndAreCountedPerClassNotRejected
   Localizer loc(LocalizerOptions{}, camera());
   const Eigen::Vector3d p_drone(10.0, 1.0, 0.5), p_bird(8.0, -2.0, 1.0), p_airplane(20.0, 3.0, 2.0);
   LocalizerOutput out;
-  for (int k = 0; k < 6; ++k) {
+  for (int k = 0; k < 12; ++k) {  // tracker.birth_hits (10) and more
     const int64_t t = kT0 + 33333 * k;
     loc.on_own_pose(own_pose(t));
     out = loc.on_detections(detections(
@@ -53,9 +53,9 @@ TEST(Localizer, BoxesOfOtherClassesAreNotTrackedAndAreCountedPerClassNotRejected
   const Eigen::Vector3d est(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);
   EXPECT_LT((est - p_drone).norm(), 0.05) << est.transpose();  // exact boxes of a still target: no noise
   const NonDroneCounts& total = loc.non_drone_boxes();
-  EXPECT_EQ(total.total, 12);
-  EXPECT_EQ(total.by_class, (std::map<int, int64_t>{{kAirplane, 6}, {kBird, 6}}));
-  EXPECT_EQ(total.summary(), "non-drone boxes not tracked: 12 (airplane 6, bird 6)");
+  EXPECT_EQ(total.total, 24);
+  EXPECT_EQ(total.by_class, (std::map<int, int64_t>{{kAirplane, 12}, {kBird, 12}}));
+  EXPECT_EQ(total.summary(), "non-drone boxes not tracked: 24 (airplane 12, bird 12)");
 }
 
 TEST(Localizer, OnlyNonDroneBoxesGiveNoTargetEvenInTheCameraFrame) {

@@ -61,6 +61,16 @@ class Detections {
   std::normal_distribution<double> g_{0, 1};
 };
 
+// The 3-of-5 birth rule without a confidence bar (the defaults before the Halmstad track-level operating point): the
+// frame counts these tests compute by hand. The defaults have their own test.
+TrackerOptions three_of_five() {
+  TrackerOptions o;
+  o.birth_hits = 3;
+  o.birth_window = 5;
+  o.confirm_min_confidence = 0.0;
+  return o;
+}
+
 // A target on a horizontal circle of radius 10 m around (20, 0, 5) at constant speed (m/s).
 Eigen::Vector3d circle(double t, double speed) {
   const double r = 10, a = speed * t / r;
@@ -86,8 +96,20 @@ TEST(TrackerOptions, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_EQ(y.window_size, 7);
 }
 
+TEST(Tracker, TheDefaultsConfirmAtTheTenthHitOfFifteenFramesOnlyWithAMeanConfidenceOfAtLeast0p4) {
+  const Eigen::Vector3d p(15, 2, 3);
+  for (const double confidence : {0.45, 0.35}) {
+    Tracker t;
+    for (int k = 0; k < 9; ++k) t.update(frame_utime(k), {meas(p, 0.2, confidence)});
+    EXPECT_TRUE(t.confirmed(frame_utime(8)).empty()) << confidence;
+    t.update(frame_utime(9), {meas(p, 0.2, confidence)});  // the tenth hit
+    EXPECT_EQ(t.confirmed(frame_utime(9)).size(), confidence >= 0.4 ? 1u : 0u) << confidence;
+    EXPECT_EQ(t.num_tentative(), confidence >= 0.4 ? 0u : 1u) << confidence;
+  }
+}
+
 TEST(Tracker, RefusesFramesThatAreNotLaterWithAReason) {
-  Tracker t;
+  Tracker t(three_of_five());
   std::string why;
   ASSERT_TRUE(t.update(frame_utime(5), {meas({10, 0, 0})}, &why));
   EXPECT_FALSE(t.update(frame_utime(5), {meas({10, 0, 0})}, &why));
@@ -99,7 +121,7 @@ TEST(Tracker, RefusesFramesThatAreNotLaterWithAReason) {
 }
 
 TEST(Tracker, ConfirmsAfterMHitsInNFramesAndIdsStartAtOne) {
-  Tracker t;  // M = 3, N = 5
+  Tracker t(three_of_five());  // M = 3, N = 5
   const Eigen::Vector3d p(15, 2, 3);
   t.update(frame_utime(0), {meas(p)});
   t.update(frame_utime(1), {});
@@ -117,7 +139,7 @@ TEST(Tracker, ConfirmsAfterMHitsInNFramesAndIdsStartAtOne) {
 }
 
 TEST(Tracker, DropsATentativeTrackThatCannotReachMHits) {
-  Tracker t;
+  Tracker t(three_of_five());
   const Eigen::Vector3d p(15, 2, 3);
   t.update(frame_utime(0), {meas(p)});
   t.update(frame_utime(1), {});
@@ -131,7 +153,7 @@ TEST(Tracker, DropsATentativeTrackThatCannotReachMHits) {
 }
 
 TEST(Tracker, ALowConfidenceDetectionContinuesATrackButStartsNone) {
-  TrackerOptions o;
+  TrackerOptions o = three_of_five();
   o.birth_min_confidence = 0.5;
   o.birth_hits = 2;
   o.birth_window = 2;
@@ -150,7 +172,7 @@ TEST(Tracker, ALowConfidenceDetectionContinuesATrackButStartsNone) {
 }
 
 TEST(Tracker, ATrackIsConfirmedOnlyOnceTheMeanConfidenceOfItsLastNHitsReachesTheBar) {
-  TrackerOptions o;
+  TrackerOptions o = three_of_five();
   o.confirm_min_confidence = 0.5;  // M = 3 of N = 5
   Tracker t(o);
   const Eigen::Vector3d p(15, 2, 3);
@@ -198,7 +220,7 @@ TEST(Tracker, ATrackIsConfirmedOnlyOnceTheMeanConfidenceOfItsLastNHitsReachesThe
 }
 
 TEST(Tracker, DeletesAfterTheTimeoutAndNeverReusesIds) {
-  TrackerOptions o;
+  TrackerOptions o = three_of_five();
   o.death_timeout_s = 0.5;
   Tracker t(o);
   for (int k = 0; k < 5; ++k) t.update(frame_utime(k), {meas({15, 0, 3})});
@@ -215,7 +237,7 @@ TEST(Tracker, DeletesAfterTheTimeoutAndNeverReusesIds) {
 }
 
 TEST(Tracker, GatesOutADetectionFarFromTheTrack) {
-  Tracker t;
+  Tracker t(three_of_five());
   for (int k = 0; k < 5; ++k) t.update(frame_utime(k), {meas({15, 0, 3}, 0.1)});
   // 3 m away with sigma 0.1 m: far outside the 99 % gate; it starts a tentative track instead.
   t.update(frame_utime(5), {meas({15, 3, 3}, 0.1)});
@@ -231,7 +253,7 @@ TEST(Tracker, ABurstOfFalsePositivesCreatesNoConfirmedTrack) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-30, 30);
   Detections det(12);
-  Tracker t;
+  Tracker t(three_of_five());
   int max_confirmed = 0;
   for (int k = 0; k < 40; ++k) {
     std::vector<WorldMeasurement> z{det(circle(k * 0.1, 2.0))};
@@ -257,7 +279,7 @@ TEST(Tracker, TwoCrossingTargetsKeepTheirIds) {
   // between compilers' rounding), so there only two confirmed tracks are required; the ids after the
   // crossing must be those before it.
   Detections det(5);
-  Tracker t;
+  Tracker t(three_of_five());
   const Eigen::Vector3d v_a(3, 0, 0), v_b(0, 3, 0);
   auto a = [&](double s) -> Eigen::Vector3d { return Eigen::Vector3d(20, 0, 5) + v_a * (s - 4); };
   auto b = [&](double s) -> Eigen::Vector3d { return Eigen::Vector3d(20, 0, 5) + v_b * (s - 4); };
@@ -291,7 +313,7 @@ TEST(Tracker, TwoCrossingTargetsKeepTheirIds) {
 TEST(Tracker, DuplicateDetectionsOfOneTargetGiveOneTrack) {
   // Every frame the same target is detected twice, 5 cm apart (two overlapping boxes): the spare
   // detection keeps starting tentative tracks, which are never confirmed as a second target.
-  Tracker t;
+  Tracker t(three_of_five());
   for (int k = 0; k < 30; ++k) {
     const Eigen::Vector3d p(15 + 0.2 * k, 0, 3);
     ASSERT_TRUE(t.update(frame_utime(k), {meas(p, 0.2), meas(p + Eigen::Vector3d(0, 0.05, 0), 0.2)}));
@@ -307,9 +329,9 @@ TEST(Tracker, DuplicateDetectionsOfOneTargetGiveOneTrack) {
 TEST(Tracker, TwoConfirmedTracksOfOneTargetMergeIntoTheOlderId) {
   // Merging off: two targets 0.3 m apart with the same velocity become tracks 1 and 2. When merging
   // is turned on (a fresh tracker with the same input), they are one target and keep id 1.
-  TrackerOptions off;
+  TrackerOptions off = three_of_five();
   off.merge_chi2 = 0;
-  Tracker separate(off), merged;
+  Tracker separate(off), merged(three_of_five());
   for (int k = 0; k < 10; ++k) {
     const Eigen::Vector3d p(15 + 0.2 * k, 0, 3);
     const std::vector<WorldMeasurement> z{meas(p, 0.2), meas(p + Eigen::Vector3d(0, 0.3, 0), 0.2)};
@@ -330,8 +352,8 @@ struct Rms {
 // each frame's exposure time, after 3 s of settling, over 60 s.
 Rms rms_on_circle(double speed, unsigned seed) {
   Detections det(seed);
-  TrackerOptions ko;
-  TrackerOptions wo;
+  TrackerOptions ko = three_of_five();
+  TrackerOptions wo = three_of_five();
   wo.mode = "sliding_window";
   Tracker kalman(ko), window(wo);
   double se_raw = 0, se_window = 0, se_kalman = 0;
@@ -374,7 +396,7 @@ TEST(TrackerAccuracy, LagCompensationRemovesTheVelocityTimesLatencyBias) {
   const int64_t latency_us = 300'000;
   for (const double speed : {0.5, 2.0, 5.0}) {
     Detections det(77);
-    Tracker t;
+    Tracker t(three_of_five());
     const Eigen::Vector3d dir = Eigen::Vector3d(1, 1, 0).normalized();
     auto truth = [&](int64_t utime) -> Eigen::Vector3d {
       return Eigen::Vector3d(20, 0, 5) + dir * speed * (seconds(utime) - 10);
@@ -419,7 +441,7 @@ TEST(TrackerAccuracy, LagCompensationRemovesTheVelocityTimesLatencyBias) {
 }
 
 TEST(Tracker, PredictionIsLimitedToTheHorizonAndNeverGoesBack) {
-  TrackerOptions o;
+  TrackerOptions o = three_of_five();
   o.max_prediction_s = 0.5;
   Tracker t(o);
   for (int k = 0; k < 10; ++k) t.update(frame_utime(k), {meas({10 + 0.2 * k, 0, 0}, 0.01)});
@@ -432,7 +454,7 @@ TEST(Tracker, PredictionIsLimitedToTheHorizonAndNeverGoesBack) {
 }
 
 TEST(Tracker, SlidingWindowPublishesTheMeanOfTheLastNfMeasurements) {
-  TrackerOptions o;
+  TrackerOptions o = three_of_five();
   o.mode = "sliding_window";
   Tracker t(o);
   for (int k = 0; k < 8; ++k) t.update(frame_utime(k), {meas({10 + 0.01 * k * k, 1, 2}, 0.1)});
@@ -449,7 +471,7 @@ TEST(Tracker, SlidingWindowPublishesTheMeanOfTheLastNfMeasurements) {
 TEST(Tracker, MostConfidentModeFollowsTheBestDetectionAndPublishesOneTarget) {
   // Each frame: the target (confidence 0.9) and a random false positive (0.5); twice a false
   // positive with confidence 0.95 far away. Seed 9.
-  TrackerOptions o;
+  TrackerOptions o = three_of_five();
   o.mode = "most_confident";
   Tracker t(o);
   Detections det(9);

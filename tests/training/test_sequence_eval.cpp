@@ -36,6 +36,16 @@ detector::Box box(float cx, float cy, float w, float h, int class_id = 0) {
   return b;
 }
 
+/// The localizer with the 3-of-5 birth rule and no confidence bar: the frame counts the ClipTracker tests compute by
+/// hand (the end-to-end test below uses the defaults).
+localizer::LocalizerOptions three_of_five() {
+  localizer::LocalizerOptions o;
+  o.tracker.birth_hits = 3;
+  o.tracker.birth_window = 5;
+  o.tracker.confirm_min_confidence = 0.0;
+  return o;
+}
+
 template <class F>
 std::string error_of(F&& f) {
   try {
@@ -88,7 +98,7 @@ TEST(NominalPinhole, FocalLengthFromTheFieldOfView) {
 // - a class-1 box every frame: not tracked;
 // - a 1x1-px class-0 box at frames 50..54: its range (about 1000 m) is beyond range.max_m, the localizer rejects it.
 TEST(ClipTracker, SyntheticSequenceGivesTheHandComputedTracks) {
-  ClipTracker tracker(localizer::LocalizerOptions{}, nominal_pinhole(640, 512, 24.0), kFps);
+  ClipTracker tracker(three_of_five(), nominal_pinhole(640, 512, 24.0), kFps);
   const cv::Rect2d label(185, 140, 30, 20);  // contains the drone box's centre (200, 150)
   for (int f = 0; f < 60; ++f) {
     std::vector<detector::Box> boxes;
@@ -137,7 +147,7 @@ TEST(ClipTracker, SyntheticSequenceGivesTheHandComputedTracks) {
 TEST(ClipTracker, TimeComesFromTheFrameIndexNotTheCallCount) {
   // Every second frame (frame_step 2): hits at frames 0, 2, 4 confirm at frame 4 = 0.133 s, not at the third call's
   // 2 / 30 s.
-  ClipTracker tracker(localizer::LocalizerOptions{}, nominal_pinhole(640, 512, 24.0), kFps);
+  ClipTracker tracker(three_of_five(), nominal_pinhole(640, 512, 24.0), kFps);
   for (int f = 0; f <= 10; f += 2) tracker.add_frame(f, {box(200, 150, 20, 16)}, {cv::Rect2d(185, 140, 30, 20)});
   ClipTrackResult clip;
   clip.cls = "DRONE";
@@ -339,8 +349,8 @@ TEST(RunSequenceEval, GeneratedClipsGiveOneDroneTrackAndOneFalseTrack) {
     EXPECT_EQ(c->drone_boxes, 40);
     EXPECT_NEAR(c->duration_s, 40.0 / 30.0, 1e-3);
     ASSERT_EQ(c->tracks.size(), 1u);
-    EXPECT_EQ(c->tracks[0].confirmed_frame, 2);  // the third hit
-    EXPECT_EQ(c->tracks[0].hits, 38);            // frames 2..39
+    EXPECT_EQ(c->tracks[0].confirmed_frame, 9);  // the tenth hit (the defaults: 10 of 15, confidence 0.9 >= 0.4)
+    EXPECT_EQ(c->tracks[0].hits, 31);            // frames 9..39
   }
   // The bird's labels are not drone boxes: its one track is false; the drone's is on the drone.
   EXPECT_EQ(bird.first_label_frame, -1);
@@ -348,14 +358,15 @@ TEST(RunSequenceEval, GeneratedClipsGiveOneDroneTrackAndOneFalseTrack) {
   EXPECT_EQ(drone.first_label_frame, 0);
   EXPECT_EQ(drone.false_tracks, 0);
   EXPECT_TRUE(drone.drone_confirmed);
-  EXPECT_NEAR(drone.time_to_confirm_s, 2.0 / 30.0, 1e-3);
+  EXPECT_NEAR(drone.time_to_confirm_s, 9.0 / 30.0, 1e-3);
   const std::vector<TrackGroupSummary> g = r.groups();
   ASSERT_EQ(g.size(), 4u);  // DRONE MEDIUM, DRONE, BIRD, distractors
   EXPECT_EQ(g[3].name, "distractors");
   EXPECT_EQ(g[3].false_tracks, 1);
   EXPECT_NEAR(g[3].false_per_hour, 3600.0 / (40.0 / 30.0), 0.1);  // 1 in 1.33 s of video: 2700 per hour
 
-  // Every 4th frame: the tracker sees frames 0, 4, 8 and confirms at frame 8; the video time is unchanged.
+  // Every 4th frame: the tracker sees frames 0, 4, ..., 36 and confirms at the tenth, frame 36; the video time is
+  // unchanged.
   SequenceEvalOptions o = fx.options();
   o.frame_step = 4;
   o.clips = {"V_DRONE_001"};
@@ -363,7 +374,7 @@ TEST(RunSequenceEval, GeneratedClipsGiveOneDroneTrackAndOneFalseTrack) {
   ASSERT_EQ(every4.clips.size(), 1u);
   EXPECT_EQ(every4.clips[0].frames, 40);
   EXPECT_EQ(every4.clips[0].frames_tracked, 10);
-  EXPECT_NEAR(every4.clips[0].time_to_confirm_s, 8.0 / 30.0, 1e-3);
+  EXPECT_NEAR(every4.clips[0].time_to_confirm_s, 36.0 / 30.0, 1e-3);
 
   // The same input twice gives the same JSON (deterministic).
   EXPECT_EQ(run_sequence_eval(fx.options(), bright_square).json(), r.json());
@@ -444,7 +455,7 @@ TEST(RunSequenceEval, BadInputIsOneErrorNamingTheFile) {
 TEST(RunSequenceEval, LocalizerConfigChangesTheBirthRule) {
   Fixture fx;
   REQUIRE_VIDEO(fx);
-  // M = 5 of N = 5: the drone is confirmed at its fifth hit, frame 4.
+  // M = 5 (of N = 15): the drone is confirmed at its fifth hit, frame 4.
   std::ofstream(fx.dir.file("loc.yaml")) << "tracker:\n  birth_hits: 5\n";
   SequenceEvalOptions o = fx.options();
   o.localizer_config = fx.dir.file("loc.yaml");
@@ -452,6 +463,12 @@ TEST(RunSequenceEval, LocalizerConfigChangesTheBirthRule) {
   const SequenceEvalResult r = run_sequence_eval(o, bright_square);
   ASSERT_EQ(r.clips.size(), 1u);
   EXPECT_NEAR(r.clips[0].time_to_confirm_s, 4.0 / 30.0, 1e-3);
+  // A confidence bar above the boxes' 0.9: never confirmed.
+  std::ofstream(fx.dir.file("loc.yaml"), std::ios::trunc) << "tracker:\n  confirm_min_confidence: 0.95\n";
+  const SequenceEvalResult barred = run_sequence_eval(o, bright_square);
+  ASSERT_EQ(barred.clips.size(), 1u);
+  EXPECT_TRUE(barred.clips[0].tracks.empty());
+  EXPECT_FALSE(barred.clips[0].drone_confirmed);
 }
 
 TEST(RunSequenceEval, BoxesCacheGivesTheSameResultWithoutTheDetectorOrTheVideo) {

@@ -624,12 +624,13 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
       // Tracked from the cache: the same boxes the detector gave when the file was written.
       const ClipBoxes cached = read_clip_boxes(cache_path);
       if (cached.settings != settings)
-        throw DatasetError(fmt::format("{}: made with other detection settings: the file has '{}', this run '{}' "
-                                       "(remove the file or use another --boxes-cache)",
-                                       cache_path, cached.settings, settings));
+        throw DatasetError(
+            fmt::format("{}: made with other detection settings: the file has '{}', this run '{}' "
+                        "(remove the file or use another --boxes-cache)",
+                        cache_path, cached.settings, settings));
       if (cached.frame_step != o.frame_step)
-        throw DatasetError(fmt::format("{}: made with frame_step {}, this run {}", cache_path, cached.frame_step,
-                                       o.frame_step));
+        throw DatasetError(
+            fmt::format("{}: made with frame_step {}, this run {}", cache_path, cached.frame_step, o.frame_step));
       c.fps = cached.fps;
       c.frames = cached.frames;
       if (c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);

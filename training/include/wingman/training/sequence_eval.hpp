@@ -202,11 +202,11 @@ using FrameDetector = std::function<std::vector<detector::Box>(const cv::Mat& bg
 
 /// One clip's detector output as SequenceEvalOptions::boxes_cache stores it.
 struct ClipBoxes {
-  std::string settings;  ///< what made them (detection_settings()); compared before reuse
-  double fps = 0;        ///< the video's frame rate, frames/s (> 0)
-  int frames = 0;        ///< frames the video gave (>= 0)
-  int width = 0, height = 0;  ///< frame size, pixels (> 0 when frames > 0)
-  int frame_step = 1;         ///< every frame_step-th frame was detected (>= 1)
+  std::string settings;                             ///< what made them (detection_settings()); compared before reuse
+  double fps = 0;                                   ///< the video's frame rate, frames/s (> 0)
+  int frames = 0;                                   ///< frames the video gave (>= 0)
+  int width = 0, height = 0;                        ///< frame size, pixels (> 0 when frames > 0)
+  int frame_step = 1;                               ///< every frame_step-th frame was detected (>= 1)
   std::map<int, std::vector<detector::Box>> boxes;  ///< tracked frame index -> its boxes (frames without boxes absent)
 };
 
