@@ -27,12 +27,14 @@ int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
     rt.status().set_last_processed_seq(d.seq);
     for (const auto& why : out.rejections) rt.status().item_dropped(o.detections_channel, why);
     // Boxes of other classes than drone are expected, not drops: their counts since start are in the detail.
-    const std::string non_drone = loc.non_drone_boxes().summary();
+    // So are tracks the confidence bar holds back (a model scoring below it confirms nothing: the detail says why).
+    std::string detail = loc.non_drone_boxes().summary();
+    if (const std::string held = loc.tracker_summary(); !held.empty()) detail += (detail.empty() ? "" : "; ") + held;
     if (out.camera_frame_only) {
       rt.status().set_state(status_t::STATE_DEGRADED,
-                            "camera frame only: no fresh own pose" + (non_drone.empty() ? "" : "; " + non_drone));
+                            "camera frame only: no fresh own pose" + (detail.empty() ? "" : "; " + detail));
     } else {
-      rt.status().set_state(status_t::STATE_OK, non_drone);
+      rt.status().set_state(status_t::STATE_OK, detail);
     }
     if (out.targets) rt.publish(o.output_channel, *out.targets);
   });

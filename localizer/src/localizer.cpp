@@ -177,4 +177,13 @@ wingman::targets_t Localizer::camera_frame_targets(const wingman::detections_t& 
   return out;
 }
 
+std::string Localizer::tracker_summary() const {
+  const size_t held = tracker_.num_held();
+  if (held == 0) return "";
+  return fmt::format(
+      "{} tentative track(s) with {} hits held back: mean confidence of the last {} below "
+      "tracker.confirm_min_confidence {}",
+      held, options_.tracker.birth_hits, options_.tracker.birth_window, options_.tracker.confirm_min_confidence);
+}
+
 }  // namespace wingman::localizer

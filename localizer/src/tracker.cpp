@@ -80,6 +80,12 @@ size_t Tracker::num_tentative() const {
   return static_cast<size_t>(std::count_if(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.id == 0; }));
 }
 
+size_t Tracker::num_held() const {
+  return static_cast<size_t>(std::count_if(tracks_.begin(), tracks_.end(), [&](const Track& t) {
+    return t.id == 0 && t.held && t.hits >= options_.birth_hits;
+  }));
+}
+
 size_t Tracker::num_confirmed() const { return tracks_.size() - num_tentative(); }
 
 void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,

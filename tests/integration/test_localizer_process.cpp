@@ -196,6 +196,26 @@ TEST(LocalizerProcess, BirdsAreNotTrackedButCountedInTheStatusAndABadDroneScoreI
       << r.last_status.last_error;
 }
 
+TEST(LocalizerProcess, BoxesScoredBelowTheConfidenceBarConfirmNothingAndTheStatusSaysWhy) {
+  TempDir dir;
+  // A model whose scores sit below tracker.confirm_min_confidence (0.4): the drone is seen in every image at 0.3.
+  const std::vector<LogEvent> events = scripted_flight_with(
+      [](wingman::detections_t& d) {
+        for (auto& b : d.detections) b.confidence = b.drone_score = 0.3f;
+      },
+      nullptr);
+  const LocalizerRun r = run_localizer(dir, events, /*lockstep=*/true);
+  ASSERT_FALSE(r.targets.empty()) << r.err;
+  for (const auto& t : r.targets) EXPECT_EQ(t.num_targets, 0);
+  ASSERT_GE(r.statuses.size(), 2u);
+  const wingman::status_t& running = r.statuses[r.statuses.size() - 2];
+  EXPECT_EQ(running.state, int{wingman::status_t::STATE_OK}) << running.detail;
+  EXPECT_EQ(running.detail,
+            "1 tentative track(s) with 10 hits held back: mean confidence of the last 15 below "
+            "tracker.confirm_min_confidence 0.4");
+  EXPECT_EQ(r.last_status.drops_total, 0) << r.last_status.last_error;
+}
+
 TEST(LocalizerProcess, WithoutOwnPosesItPublishesCameraFrameTargetsFlaggedAsSuch) {
   TempDir dir;
   std::vector<LogEvent> events;

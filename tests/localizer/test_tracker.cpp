@@ -183,6 +183,7 @@ TEST(Tracker, ATrackIsConfirmedOnlyOnceTheMeanConfidenceOfItsLastNHitsReachesThe
   EXPECT_TRUE(t.confirmed(frame_utime(2)).empty());
   EXPECT_EQ(t.num_tentative(), 1u);
   EXPECT_EQ(t.stats().confirmations_held, 1);
+  EXPECT_EQ(t.num_held(), 1u);
   // 0.3 0.4 0.5 0.6: mean 0.45, still held (and counted once).
   t.update(frame_utime(3), {meas(p, 0.2, 0.6)});
   EXPECT_TRUE(t.confirmed(frame_utime(3)).empty());
@@ -195,6 +196,7 @@ TEST(Tracker, ATrackIsConfirmedOnlyOnceTheMeanConfidenceOfItsLastNHitsReachesThe
   EXPECT_EQ(out[0].track_id, 1);
   EXPECT_EQ(t.stats().confirmations_held, 1);
   EXPECT_EQ(t.stats().confirmations, 1);
+  EXPECT_EQ(t.num_held(), 0u);
   // The mean is over the last N hits only: after two hits at 0.2, hits at 0.55 confirm the track once both low ones
   // have left the window (0.2 0.2 0.55 0.55 0.55: mean 0.41; 0.2 and four 0.55: 0.48; five 0.55: confirmed).
   Tracker u(o);

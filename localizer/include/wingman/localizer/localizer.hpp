@@ -72,6 +72,10 @@ class Localizer {
   /// The non-drone boxes of every message since construction that passed the camera, image size and order checks.
   const NonDroneCounts& non_drone_boxes() const { return non_drone_boxes_; }
 
+  /// What the status says about the tracker, "" when nothing needs saying: the tentative tracks held back now by
+  /// tracker.confirm_min_confidence (a model whose scores sit below the bar confirms nothing; this says why).
+  std::string tracker_summary() const;
+
  private:
   wingman::targets_t camera_frame_targets(const wingman::detections_t& d,
                                           const std::vector<CameraMeasurement>& measurements) const;

@@ -170,6 +170,8 @@ class Tracker {
   /// newest hit.
   std::vector<TrackOutput> confirmed(int64_t predict_to_utime) const;
 
+  /// Tentative tracks that have their M hits but are held back by confirm_min_confidence right now.
+  size_t num_held() const;
   /// Tentative (not yet confirmed) tracks held.
   size_t num_tentative() const;
   /// Confirmed tracks held.
