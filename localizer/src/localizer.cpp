@@ -32,14 +32,14 @@ std::string NonDroneCounts::summary() const {
   return fmt::format("non-drone boxes not tracked: {} ({})", total, by_class_text);
 }
 
-Localizer::Localizer(const LocalizerOptions& options, CameraModel camera, const common::TimeSanityOptions& time)
+Localizer::Localizer(const LocalizerOptions& options, CameraModel camera)
     : options_(options),
       cnn_relation_(BoxRelation::load(options.sphere.box_relation)),
       camera_(std::move(camera)),
       extrinsics_(Extrinsics::from_options(options.extrinsics)),
       poses_(options.pose),
       tracker_(options.tracker),
-      clock_(time),
+      clock_(options.time),
       own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)),
       detections_input_(clock_.add_input("detections_t.utime", "detections_t", true)) {}
 

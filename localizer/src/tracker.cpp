@@ -42,7 +42,8 @@ std::vector<std::string> TrackerOptions::validate() const {
     p.push_back(problem("tracker.birth_min_confidence", birth_min_confidence, "must be in [0, 1]"));
   if (!(confirm_min_confidence >= 0 && confirm_min_confidence <= 1))
     p.push_back(problem("tracker.confirm_min_confidence", confirm_min_confidence, "must be in [0, 1]"));
-  if (!(death_timeout_s > 0)) p.push_back(problem("tracker.death_timeout_s", death_timeout_s, "must be > 0"));
+  if (!(death_timeout_s > 0 && death_timeout_s <= 3600))
+    p.push_back(problem("tracker.death_timeout_s", death_timeout_s, "must be in (0, 3600] s"));
   if (window_size < 1) p.push_back(problem("tracker.window_size", window_size, "must be >= 1"));
   if (!(initial_velocity_std > 0) || !std::isfinite(initial_velocity_std))
     p.push_back(problem("tracker.initial_velocity_std", initial_velocity_std, "must be finite and > 0"));

@@ -26,7 +26,12 @@ void put_be(std::vector<uint8_t>& out, uint64_t v, int bytes) {
   for (int i = bytes - 1; i >= 0; --i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
 }
 
-std::regex compile(const std::string& pattern) { return std::regex(pattern, std::regex::ECMAScript); }
+ChannelPattern compile(const std::string& pattern) {
+  std::string why;
+  auto p = ChannelPattern::compile(pattern, &why);
+  if (!p) throw std::invalid_argument(fmt::format("channel pattern '{}': {}", pattern, why));
+  return std::move(*p);
+}
 
 /// Bytes an event holds in the queue (what max_queue_mib bounds).
 int64_t queued_size(const std::string& channel, size_t size) {
@@ -44,8 +49,9 @@ bool ChannelFilter::wants(const std::string& channel) {
   const auto it = cache_.find(channel);
   if (it != cache_.end()) return it->second;
   bool wanted = false;
-  for (const auto& re : include_) wanted = wanted || std::regex_match(channel, re);
-  for (const auto& re : exclude_) wanted = wanted && !std::regex_match(channel, re);
+  for (const auto& p : include_) wanted = wanted || p.matches(channel);
+  for (const auto& p : exclude_) wanted = wanted && !p.matches(channel);
+  if (cache_.size() >= kMaxCached) cache_.clear();
   cache_.emplace(channel, wanted);
   return wanted;
 }

@@ -2,20 +2,18 @@
 // Validation of RecorderOptions.
 #include "wingman/recorder/recorder_options.hpp"
 
-#include <wingman/common/config.hpp>
+#include "wingman/recorder/channel_pattern.hpp"
 
-#include <regex>
+#include <wingman/common/config.hpp>
 
 namespace wingman::recorder {
 namespace {
 
 void check_patterns(const std::string& key, const std::vector<std::string>& patterns, std::vector<std::string>& p) {
   for (const auto& pattern : patterns) {
-    try {
-      std::regex re(pattern);
-    } catch (const std::regex_error& e) {
-      p.push_back(common::problem(key, pattern, std::string("not a regular expression: ") + e.what()));
-    }
+    if (std::string why; !ChannelPattern::compile(pattern, &why))
+      p.push_back(
+          common::problem(key, pattern, "not a usable channel pattern (POSIX extended regular expression): " + why));
   }
 }
 

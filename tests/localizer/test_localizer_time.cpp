@@ -3,6 +3,8 @@
 // input order nor blinds the localizer; a bad first message is forgotten within time.resync_after_s.
 #include "wingman/localizer/localizer.hpp"
 
+#include <wingman/common/config.hpp>
+
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -117,6 +119,38 @@ TEST(LocalizerTime, AFutureFirstMessageIsForgottenWithinTheResyncTime) {
   EXPECT_GT(r.dropped_after, 0) << "the real detections are refused until the resync";
   EXPECT_EQ(r.late_after, 0) << "of " << r.detections_after << " (dropped " << r.dropped_after << ", blind "
                              << r.blind_after << "): still refused after time.resync_after_s";
+}
+
+}  // namespace
+
+namespace {
+
+TEST(LocalizerTime, TheTimeKeysComeFromTheLocalizersConfiguration) {
+  // time.max_ahead_s 5: a detections message 2 s ahead of the newest accepted time is taken; with the default 1 s it
+  // is dropped.
+  for (const double max_ahead_s : {1.0, 5.0}) {
+    const auto o = wingman::common::load_options_from_string<LocalizerOptions>(
+        "time: {max_ahead_s: " + std::to_string(max_ahead_s) + "}\n", "localizer.yaml");
+    EXPECT_EQ(o.time.max_ahead_s, max_ahead_s);
+    Localizer loc(o, camera());
+    loc.on_own_pose(pose_at(kT0));
+    (void)loc.on_detections(detections_at(kT0));
+    if (max_ahead_s < 2.0) {
+      EXPECT_THROW(loc.on_detections(detections_at(kT0 + 2 * kS)), std::invalid_argument);
+    } else {
+      EXPECT_NO_THROW(loc.on_detections(detections_at(kT0 + 2 * kS)));
+    }
+  }
+  // Bad values are named with their key, as every other key (issue 33, finding 6: .inf never gave a target).
+  std::string all;
+  try {
+    (void)wingman::common::load_options_from_string<LocalizerOptions>(
+        "time: {max_ahead_s: -1}\ntracker: {death_timeout_s: .inf}\n", "localizer.yaml");
+  } catch (const std::exception& e) {
+    all = e.what();
+  }
+  EXPECT_NE(all.find("time.max_ahead_s"), std::string::npos) << all;
+  EXPECT_NE(all.find("tracker.death_timeout_s = inf: must be in (0, 3600] s"), std::string::npos) << all;
 }
 
 }  // namespace

@@ -156,6 +156,63 @@ TEST(RecorderTest, OptionsRejectBadExpressionsAndSizesNamingTheKey) {
   EXPECT_TRUE(RecorderOptions().validate().empty());
 }
 
+// Issue 33, finding 6: a pattern 20 k parentheses deep crashed the recorder at load (std::regex's recursive
+// compiler), and a backtracking one hung it on a 60-character channel name.
+TEST(ChannelPatternTest, HostilePatternsAreOneErrorAtLoadAndMatchingNeverBacktracks) {
+  using wingman::recorder::ChannelPattern;
+  std::string why;
+  const std::string deep = std::string(20000, '(') + "a" + std::string(20000, ')');
+  EXPECT_FALSE(ChannelPattern::compile(deep, &why));
+  EXPECT_NE(why.find("characters: at most 256"), std::string::npos) << why;
+  const std::string deep17 = std::string(17, '(') + "a" + std::string(17, ')');
+  EXPECT_FALSE(ChannelPattern::compile(deep17, &why));
+  EXPECT_EQ(why, "parentheses nested deeper than 16 at character 17");
+  EXPECT_TRUE(ChannelPattern::compile(std::string(16, '(') + "a" + std::string(16, ')')));
+  EXPECT_FALSE(ChannelPattern::compile("(A)\\1", &why));
+  EXPECT_EQ(why, "a back-reference (\\1) at character 4: not supported");
+  EXPECT_FALSE(ChannelPattern::compile("(A{1000}){1000}", &why));
+  EXPECT_EQ(why, "counted repetition ('{') at character 3: not supported");
+  EXPECT_FALSE(ChannelPattern::compile("IMAGE[(", &why));
+  EXPECT_FALSE(why.empty());
+  // Parentheses inside a bracket expression are literals, not nesting.
+  const auto bracket = ChannelPattern::compile("[(((((((((((((((((((]X");
+  ASSERT_TRUE(bracket);
+  EXPECT_TRUE(bracket->matches("(X"));
+  // Catastrophic for a backtracking matcher (2^60 paths): glibc's matcher answers at once.
+  const std::string name(60, 'a');
+  for (const std::string p : {"(a+)+b", "(a|a)*b", "(a*)*b", "(a|aa)+b"}) {
+    const auto pattern = ChannelPattern::compile(p, &why);
+    ASSERT_TRUE(pattern) << p << ": " << why;
+    EXPECT_FALSE(pattern->matches(name)) << p;
+    EXPECT_TRUE(pattern->matches(name + "b")) << p;
+  }
+  // Whole-name matching, alternation, classes.
+  const auto status = ChannelPattern::compile("STATUS_[[:upper:]]+|TARGETS");
+  ASSERT_TRUE(status);
+  EXPECT_TRUE(status->matches("STATUS_LOCALIZER"));
+  EXPECT_TRUE(status->matches("TARGETS"));
+  EXPECT_FALSE(status->matches("TARGETS_2"));
+  EXPECT_FALSE(status->matches("MY_STATUS_X"));
+  EXPECT_FALSE(status->matches(std::string("TARGETS\0X", 9)));
+  // Through the options: the key is named.
+  RecorderOptions o;
+  o.include = {deep17};
+  const auto problems = o.validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("channels.include"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[0].find("parentheses nested deeper than 16"), std::string::npos) << problems[0];
+}
+
+TEST(RecorderTest, TheFilterCacheIsBoundedAndKeepsAnswering) {
+  ChannelFilter f({"CH_.*"}, {"CH_1.*"});
+  for (int i = 0; i < 3 * static_cast<int>(ChannelFilter::kMaxCached); ++i) {
+    const std::string name = "CH_" + std::to_string(i);
+    ASSERT_EQ(f.wants(name), name[3] != '1') << name;
+  }
+  EXPECT_TRUE(f.wants("CH_0"));
+  EXPECT_FALSE(f.wants("CH_1"));
+}
+
 TEST(RecorderTest, EventsBeyondTheQueueBoundAreDroppedAndCountedPerChannel) {
   TempDir dir;
   RecorderOptions o = options_in(dir.path());

@@ -50,13 +50,13 @@ struct LocalizerOutput {
 /// frames, then the tracker). Uses message utimes only: the same inputs give the same outputs.
 class Localizer {
  public:
-  /// `camera` must match the detections' image size (checked per message). `time`: the time sanity of the two
+  /// `camera` must match the detections' image size (checked per message). options.time: the time sanity of the two
   /// inputs (common::StageClock): an own pose or detections_t dated more than time.max_ahead_s after the newest
   /// message time accepted is dropped; when one input's messages have all been refused for time.resync_after_s of
   /// their own time (a bad first message latched the order), the clock re-anchors on them: an own-pose resync
   /// empties the pose buffer, a detections resync restarts the tracker (new tracks, as after a restart).
   /// Throws std::invalid_argument for invalid options.
-  Localizer(const LocalizerOptions& options, CameraModel camera, const common::TimeSanityOptions& time = {});
+  Localizer(const LocalizerOptions& options, CameraModel camera);
 
   /// Adds an own pose. Throws std::invalid_argument naming the field when it cannot be used
   /// (out of order, duplicate, dated too far ahead); the caller drops and counts it.

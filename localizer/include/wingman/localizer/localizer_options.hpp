@@ -7,6 +7,8 @@
 #include "wingman/localizer/sphere_localizer.hpp"
 #include "wingman/localizer/tracker.hpp"
 
+#include <wingman/common/time_sanity.hpp>
+
 #include <string>
 #include <vector>
 
@@ -56,6 +58,9 @@ struct LocalizerOptions {
   ExtrinsicsOptions extrinsics;
   PoseBufferOptions pose;
   TrackerOptions tracker;
+  /// Time sanity of the inputs (time.*): how far ahead of the newest accepted time a message may be dated, and when
+  /// the clock re-anchors (common/time_sanity.hpp).
+  common::TimeSanityOptions time;
 
   template <class V>
   void visit(V& v) {
@@ -71,6 +76,7 @@ struct LocalizerOptions {
     extrinsics.visit(v);
     pose.visit(v);
     tracker.visit(v);
+    time.visit(v);
   }
   std::vector<std::string> validate() const;
 };

@@ -2,6 +2,7 @@
 // Recording LCM events into size-rotated LCM log files on a writer thread that never blocks the caller.
 #pragma once
 
+#include "wingman/recorder/channel_pattern.hpp"
 #include "wingman/recorder/recorder_options.hpp"
 
 #include <condition_variable>
@@ -9,7 +10,6 @@
 #include <deque>
 #include <map>
 #include <mutex>
-#include <regex>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -17,15 +17,17 @@
 
 namespace wingman::recorder {
 
-/// Which channels are recorded: include/exclude regular expressions, answers cached per channel.
+/// Which channels are recorded: include/exclude patterns (ChannelPattern), answers cached per channel (at most
+/// kMaxCached names: the cache starts over beyond, so a flood of new names costs time, never unbounded memory).
 class ChannelFilter {
  public:
-  /// Throws std::regex_error for a bad expression (RecorderOptions::validate() reports it first).
+  static constexpr size_t kMaxCached = 4096;
+  /// Throws std::invalid_argument naming the pattern for a bad one (RecorderOptions::validate() reports it first).
   ChannelFilter(const std::vector<std::string>& include, const std::vector<std::string>& exclude);
   bool wants(const std::string& channel);
 
  private:
-  std::vector<std::regex> include_, exclude_;
+  std::vector<ChannelPattern> include_, exclude_;
   std::unordered_map<std::string, bool> cache_;
 };
 

@@ -14,8 +14,8 @@ struct RecorderOptions {
   std::string directory = "recordings";
   /// Segment file names: `<prefix>-<UTC date>-<UTC time>-<segment number>.lcmlog`.
   std::string file_prefix = "wingman";
-  /// ECMAScript regular expressions (whole channel name); a channel is recorded when it matches one of `include`
-  /// and none of `exclude`.
+  /// Channel patterns (ChannelPattern: bounded POSIX extended regular expressions, whole channel name); a channel is
+  /// recorded when it matches one of `include` and none of `exclude`.
   std::vector<std::string> include = {".*"};
   std::vector<std::string> exclude = {"IMAGE.*"};  ///< images are large: left out unless asked for
   /// A segment is closed and the next one opened before it would grow past this size, MiB.
