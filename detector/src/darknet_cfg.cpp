@@ -366,11 +366,17 @@ namespace {
 /// and counts would overflow (a fuzzed .cfg found it), and no network that runs here comes near.
 constexpr int64_t kMaxLayerValues = (int64_t{1} << 31) - 1;
 constexpr int64_t kMaxLayerWeights = (int64_t{1} << 31) - 1;
+/// Largest network accepted, over all layers: output values (the activations a backend allocates, float32) and
+/// weights. 2^28 values = 1 GiB each; the shipped 640x352 network has about 1.3 x 10^7 output values and 6.7 x 10^5
+/// weights. A 1 KB .cfg must not make a process allocate many GB (issue 33, finding 5).
+constexpr int64_t kMaxNetworkValues = int64_t{1} << 28;
+constexpr int64_t kMaxNetworkWeights = int64_t{1} << 28;
 
 }  // namespace
 
 void compute_shapes(DarknetModel& model) {
   Shape current{model.net.channels, model.net.height, model.net.width};
+  int64_t total_values = 0, total_weights = 0;
   for (size_t i = 0; i < model.layers.size(); ++i) {
     Layer& l = model.layers[i];
     // Computed in 64 bits and checked before they become the layer's int shape.
@@ -446,6 +452,18 @@ void compute_shapes(DarknetModel& model) {
     l.output = {static_cast<int>(c), static_cast<int>(h), static_cast<int>(w)};
     if (l.type == LayerType::kRoute) l.input = l.output;
     current = l.output;
+    total_values += l.output.size();
+    if (l.type == LayerType::kConvolutional)
+      total_weights += int64_t{l.filters} * l.input.c * l.size * l.size + int64_t{l.filters} * 4;
+    if (total_values > kMaxNetworkValues)
+      shape_error(model, l, i,
+                  fmt::format("the layers up to this one output {} values in all: more than {} (1 GiB of float32; "
+                              "network input {}x{}x{})",
+                              total_values, kMaxNetworkValues, model.net.width, model.net.height, model.net.channels));
+    if (total_weights > kMaxNetworkWeights)
+      shape_error(model, l, i,
+                  fmt::format("the layers up to this one hold {} weights in all: more than {} (1 GiB of float32)",
+                              total_weights, kMaxNetworkWeights));
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -133,7 +134,23 @@ int load_layers(DarknetModel& model, const std::vector<char>& bytes, const std::
   return layers;
 }
 
-std::vector<char> read_all(const std::string& path) {
+/// The file's bytes, refused before reading when it is not a regular file or is far larger than a .weights file of
+/// `model` can be (header + every float32): a huge or endless file is one error, not an allocation of its size.
+std::vector<char> read_all(const std::string& path, const DarknetModel& model) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status))
+    throw DarknetFormatError(fmt::format("{}: cannot open the .weights file", path));
+  if (!std::filesystem::is_regular_file(status))
+    throw DarknetFormatError(fmt::format("{}: not a regular file (a .weights file is one)", path));
+  const auto size = std::filesystem::file_size(path, ec);
+  const int64_t largest = 20 + 4 * model.weight_count();  // the 64-bit "seen" header is the longer one
+  // Refused unread only when far larger (1 MiB beyond): a near miss gets load_layers's message, which says which
+  // layers the bytes would fill.
+  if (!ec && static_cast<int64_t>(size) > largest + (int64_t{1} << 20))
+    throw DarknetFormatError(fmt::format(
+        "{}: {} bytes: larger than any .weights file of {} can be ({} bytes: a 20-byte header + {} float32 values)",
+        path, size, model.cfg_path, largest, model.weight_count()));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw DarknetFormatError(fmt::format("{}: cannot open the .weights file", path));
   return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -147,11 +164,11 @@ void load_darknet_weights_from_buffer(DarknetModel& model, const std::vector<cha
 }
 
 void load_darknet_weights(DarknetModel& model, const std::string& path) {
-  load_layers(model, read_all(path), path, false);
+  load_layers(model, read_all(path, model), path, false);
 }
 
 int load_darknet_weights_prefix(DarknetModel& model, const std::string& path) {
-  return load_layers(model, read_all(path), path, true);
+  return load_layers(model, read_all(path, model), path, true);
 }
 
 std::vector<char> serialize_darknet_weights(const DarknetModel& model) {

@@ -293,6 +293,40 @@ TEST(DarknetWeights, WrongLengthNamesExpectedAndActualSize) {
   EXPECT_NE(msg.find("got " + std::to_string(expected - 8) + " bytes"), std::string::npos) << msg;
 }
 
+// Issue 33, finding 5: a 1 KB .cfg with 11 KB of weights allocated many GB; a .weights file was read whole before its
+// length was compared.
+TEST(DarknetBounds, ANetworkNeedingMoreThanAGibibyteIsRefusedAtParseNamingTheLayer) {
+  // 16 x 8192 x 8192 = 2^30 values in the first layer's output: over the 2^28 bound, under the per-layer one.
+  const std::string huge = "[net]\nwidth=8192\nheight=8192\n[convolutional]\nfilters=16\nsize=1\n";
+  const std::string msg = message_of([&] { parse_darknet_cfg_string(huge, "huge.cfg"); });
+  EXPECT_NE(msg.find("huge.cfg:4: [convolutional] (layer 0) the layers up to this one output 1073741824 values in "
+                     "all: more than 268435456"),
+            std::string::npos)
+      << msg;
+  // The shipped size of network parses.
+  EXPECT_NO_THROW(
+      parse_darknet_cfg_string("[net]\nwidth=640\nheight=352\n[convolutional]\nfilters=16\nsize=3\n", "ok.cfg"));
+}
+
+TEST(DarknetBounds, AWeightsFileLargerThanTheNetworkCanHoldIsRefusedBeforeItIsRead) {
+  testing::TempDir dir;
+  DarknetModel m = parse_darknet_cfg_string(
+      "[net]\nwidth=16\nheight=16\n[convolutional]\nbatch_normalize=1\nfilters=4\nsize=3\n", "small.cfg");
+  {
+    std::ofstream out(dir.file("big.weights"), std::ios::binary);
+    out.seekp(64 * 1024 * 1024 - 1);  // 64 MiB, sparse: nothing is allocated by the test either
+    out.put('\0');
+  }
+  std::string msg = message_of([&] { load_darknet_weights(m, dir.file("big.weights")); });
+  EXPECT_NE(msg.find("big.weights: 67108864 bytes: larger than any .weights file of small.cfg can be (516 bytes"),
+            std::string::npos)
+      << msg;
+  msg = message_of([&] { load_darknet_weights(m, dir.path()); });
+  EXPECT_NE(msg.find(": not a regular file"), std::string::npos) << msg;
+  msg = message_of([&] { load_darknet_weights(m, "/dev/zero"); });
+  EXPECT_NE(msg.find("/dev/zero: not a regular file"), std::string::npos) << msg;
+}
+
 /// A two-layer network and the same with two layers appended (a [maxpool] and a second [convolutional]).
 const char* kBase =
     "[net]\nwidth=16\nheight=16\n[convolutional]\nbatch_normalize=1\nfilters=4\nsize=3\n"
