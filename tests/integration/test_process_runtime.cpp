@@ -8,8 +8,17 @@
 #include <wingman/image_t.hpp>
 #include <wingman/status_t.hpp>
 
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <csignal>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <thread>
 
@@ -186,6 +195,61 @@ TEST(ProcessWatchdog, AStuckHandlerEndsTheProcessWithExitOneWithinTheBound) {
   const auto bad = run({wingman::testing::test_bin_path("wingman-test-blob-stage"), "--watchdog", "0.01"}, 10s);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--watchdog = 0.01: must be 0 (off) or in [0.1, 3600] seconds"), std::string::npos) << bad.err;
+}
+
+/// The datagrams a unix socket receives within `for_time` (each as text), read until `enough` says so.
+std::vector<std::string> notifications(int fd, std::chrono::milliseconds for_time,
+                                       const std::function<bool(const std::vector<std::string>&)>& enough) {
+  std::vector<std::string> got;
+  const auto end = std::chrono::steady_clock::now() + for_time;
+  while (std::chrono::steady_clock::now() < end && !enough(got)) {
+    pollfd p{fd, POLLIN, 0};
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+    if (poll(&p, 1, static_cast<int>(std::max<int64_t>(0, left.count()))) <= 0) continue;
+    char buf[512];
+    const ssize_t n = recv(fd, buf, sizeof buf, 0);
+    if (n > 0) got.emplace_back(buf, static_cast<size_t>(n));
+  }
+  return got;
+}
+
+// The systemd side of the watchdog (units with Type=notify and WatchdogSec=): the runtime speaks sd_notify's
+// datagram protocol itself. A unix datagram socket stands in for systemd's $NOTIFY_SOCKET (no systemd runs here):
+// READY=1 once start-up is over, then WATCHDOG=1 while the loop progresses, none while the process is stopped
+// (SIGSTOP: what systemd's watchdog then kills and restarts), again after SIGCONT.
+TEST(ProcessWatchdog, SdNotifyReadyThenPingsThatStopWhileTheProcessIsStopped) {
+  TempDir dir;
+  const std::string path = dir.file("notify.sock");
+  const int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  ASSERT_LT(path.size(), sizeof addr.sun_path);
+  std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  ASSERT_EQ(bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr), 0) << std::strerror(errno);
+  setenv("NOTIFY_SOCKET", path.c_str(), 1);
+  setenv("WATCHDOG_USEC", "400000", 1);  // 0.4 s: pings every 0.2 s
+  // memq://: an in-process LCM bus, no network; the stage idles in its loop.
+  Child c({wingman::testing::test_bin_path("wingman-test-blob-stage"), "--lcm-url", "memq://"});
+  unsetenv("NOTIFY_SOCKET");
+  unsetenv("WATCHDOG_USEC");
+  const auto count = [](const std::vector<std::string>& v, const std::string& what) {
+    return std::count(v.begin(), v.end(), what);
+  };
+  const auto started = notifications(fd, 10s, [&](const auto& v) { return count(v, "WATCHDOG=1") >= 3; });
+  ASSERT_FALSE(started.empty()) << c.err();
+  EXPECT_EQ(started.front(), "READY=1");
+  EXPECT_GE(count(started, "WATCHDOG=1"), 3);
+  c.signal(SIGSTOP);
+  (void)notifications(fd, 300ms, [](const auto&) { return false; });  // one already on its way
+  const auto stopped = notifications(fd, 1500ms, [](const auto&) { return false; });
+  EXPECT_EQ(count(stopped, "WATCHDOG=1"), 0) << "pings while stopped";
+  c.signal(SIGCONT);
+  const auto resumed = notifications(fd, 5s, [&](const auto& v) { return count(v, "WATCHDOG=1") >= 2; });
+  EXPECT_GE(count(resumed, "WATCHDOG=1"), 2);
+  c.signal(SIGTERM);
+  EXPECT_EQ(c.wait(5s), 0) << c.err();
+  close(fd);
 }
 
 TEST(ProcessFileIo, DetectorCountsFramesMissingFromTheSequenceAsDropsButNotThoseThatArrivedBroken) {

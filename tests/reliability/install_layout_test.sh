@@ -20,13 +20,17 @@ rm -f "$prefix.log"
 commands=$( (grep -h '^command=' "$src/config/supervisor/wingman.conf" | sed 's/^command=//'
              grep -h '^ExecStart=' "$src"/config/systemd/*.service | sed 's/^ExecStart=//') | sort -u)
 n=0
-while read -r exe flag cfg; do
+while read -r exe flag cfg rest; do
   [ -n "$exe" ] || continue
   exe=${exe/#\/usr\/local/$prefix} cfg=${cfg/#\/usr\/local/$prefix}
   [ "$flag" = --config ] || { fail "$exe: expected '--config FILE' in the command, got '$flag'"; continue; }
   [ -x "$exe" ] || { fail "$exe: not installed"; continue; }
   [ -r "$cfg" ] || { fail "$cfg: not installed"; continue; }
-  if ! out=$("$exe" --config "$cfg" --print-config 2>&1); then fail "$exe --config $cfg --print-config: $out"; fi
+  # The rest of the command line (supervisord: --watchdog 5) must be accepted too.
+  read -r -a more <<< "${rest:-}"
+  if ! out=$("$exe" --config "$cfg" "${more[@]}" --print-config 2>&1); then
+    fail "$exe --config $cfg ${rest:-} --print-config: $out"
+  fi
   n=$((n + 1))
 done <<< "$commands"
 [ "$n" -ge 5 ] || fail "expected the commands of 5 processes, checked $n"

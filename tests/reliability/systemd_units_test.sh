@@ -22,7 +22,7 @@ for exe in "${!cfg[@]}"; do
   u="$src/config/systemd/$exe.service"
   [ -r "$u" ] || { fail "no unit $u"; continue; }
   grep -qx "ExecStart=/usr/local/bin/$exe --config /usr/local/etc/wingman/${cfg[$exe]}.yaml" "$u" || fail "$u: ExecStart"
-  for key in Type=simple Restart=always KillSignal=SIGTERM TimeoutStopSec=2 RestartSec=0.5 WantedBy=wingman.target \
+  for key in Type=notify NotifyAccess=main WatchdogSec=5 Restart=always KillSignal=SIGTERM TimeoutStopSec=2 RestartSec=0.5 WantedBy=wingman.target \
              PartOf=wingman.target; do
     grep -qx "$key" "$u" || fail "$u: no $key"
   done
