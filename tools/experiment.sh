@@ -25,6 +25,11 @@
 #                                (default 2.5), false targets <= WINGMAN_SUITE_MAX_FALSE (default 250), of them on
 #                                other track ids than the leader's <= WINGMAN_SUITE_MAX_FALSE_OTHER (default 0).
 #                                Regression guards (measured: docs/results.md), far from issue 29's targets
+#                                Then the range sweeps (`wingman scenario sweep`, seeds 2001-2010): each shared
+#                                airframe from behind and side-on plus a procedural hex and octo, hovering, the camera
+#                                3-30 m away in 0.5 m steps; a second table (OUT/suite/sweeps/results.md) by range bin.
+#                                --quick: one sweep (F450 from behind, 3-12 m), 3-D RMS <= WINGMAN_SWEEP_MAX_RMS m
+#                                (default 1.5).
 #                  all           all of them but the suite, one after the other (the calibration after the static sweep)
 #   --quick        shorter flights and sparser sweeps (a check that the commands work, not results)
 #   --duration S   suite: fly only the first S seconds of each flight (default: each scenario's own 30-60 s)
@@ -197,6 +202,38 @@ suite() {
   $quick && bounds=(--max-rms "${WINGMAN_SUITE_MAX_RMS:-2.5}" --max-false "${WINGMAN_SUITE_MAX_FALSE:-250}"
                     --max-false-other "${WINGMAN_SUITE_MAX_FALSE_OTHER:-0}")
   py suite "$out" "${bounds[@]}" "${evals[@]}"
+  sweeps "$out" "$meshes"
+}
+
+# The suite's range sweeps (`wingman scenario sweep`): each airframe hovering, the camera stepping away from it from
+# 3 to 30 m in 0.5 m steps, 8 frames each, from behind and side-on (--quick: the F450, or a procedural quad without
+# ../shared/meshes, from behind, 3-12 m in 1.5 m steps, 4 frames each). Seeds 2001-2010 are used nowhere else.
+sweeps() {  # suite-out meshes
+  local out="$1/sweeps" meshes="$2" runs=() evals=()
+  mkdir -p "$out/scenarios"
+  if [ -d "$meshes" ]; then
+    runs+=("2001 $meshes/dji_f450.glb behind" "2002 $meshes/dji_f450.glb side"
+           "2003 $meshes/holybro_x500v2.glb behind" "2004 $meshes/holybro_x500v2.glb side"
+           "2005 $meshes/tarot_t650.glb behind" "2006 $meshes/tarot_t650.glb side"
+           "2007 $meshes/3dr_iris.glb behind" "2008 $meshes/3dr_iris.glb side")
+  fi
+  runs+=("2009 hex behind" "2010 octo side")
+  local range=(--from 3 --to 30 --step 0.5 --frames-per-step 8)
+  if $quick; then
+    range=(--from 3 --to 12 --step 1.5 --frames-per-step 4)
+    if [ -d "$meshes" ]; then runs=("2001 $meshes/dji_f450.glb behind"); else runs=("2011 quad behind"); fi
+  fi
+  for r in "${runs[@]}"; do
+    read -r seed airframe view <<< "$r"
+    local scn="$out/scenarios/w$seed.yaml"
+    "$bin/wingman" scenario sweep --seed "$seed" --airframe "$airframe" --view "$view" "${range[@]}" --out "$scn" >&2
+    fly "$out/w$seed" --scenario "$scn" --localizer-config "${scn%.yaml}.localizer.yaml" \
+      --render-config "${scn%.yaml}.render.yaml"
+    evals+=("$out/w$seed/eval.json")
+  done
+  local bounds=()
+  $quick && bounds=(--max-rms "${WINGMAN_SWEEP_MAX_RMS:-1.5}")
+  py sweeps "$out" "${bounds[@]}" "${evals[@]}"
 }
 
 case "$name" in

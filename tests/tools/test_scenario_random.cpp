@@ -2,6 +2,7 @@
 // `wingman scenario random`: the written scenarios load with the simulator's reader and stay in the stated ranges.
 #include "test_support.hpp"
 
+#include <wingman/common/config.hpp>
 #include <wingman/follower_ctrl/follower_options.hpp>
 #include <wingman/localizer/localizer_options.hpp>
 #include <wingman/sim/drone_model.hpp>
@@ -176,6 +177,64 @@ TEST(ScenarioRandom, BadOptionsAreOneErrorNamingTheOption) {
   o.out = dir.file("x.yaml");
   o.lighting = "C";
   EXPECT_NE(o.validate().at(0).find("--lighting"), std::string::npos);
+}
+
+// `wingman scenario sweep`: the target hovers, the scripted camera steps straight away from it, the localizer file
+// carries the airframe's radius.
+TEST(ScenarioSweep, TheSweepLoadsWithTheSimulatorsReaderAndStepsFromFromToTo) {
+  testing::TempDir dir;
+  for (const std::string view : {"behind", "side"}) {
+    ScenarioSweepOptions o;
+    o.airframe = "hex";
+    o.view = view;
+    o.from_m = 3.0;
+    o.to_m = 12.0;
+    o.step_m = 1.5;
+    o.frames_per_step = 4;
+    o.out = dir.file("w-" + view + ".yaml");
+    const ScenarioRandomResult r = write_sweep_scenario(o);
+    SCOPED_TRACE(view);
+    EXPECT_EQ(r.legs, 7);  // 3, 4.5, ..., 12 m
+    const sim::Scenario s = sim::load_scenario(r.scenario_path);
+    ASSERT_EQ(s.vehicles.size(), 2u);
+    const sim::VehicleSpec& camera = s.camera_vehicle();
+    const sim::VehicleSpec& target = s.vehicles[0].id == 0 ? s.vehicles[1] : s.vehicles[0];
+    EXPECT_EQ(camera.control, sim::VehicleSpec::Control::kScript);
+    ASSERT_EQ(camera.motion.type, sim::MotionSpec::Type::kTeleportSteps);
+    EXPECT_EQ(camera.motion.steps, 7);
+    EXPECT_EQ(camera.motion.frames_per_step, 4);
+    EXPECT_EQ(target.motion.type, sim::MotionSpec::Type::kHover);
+    // First and last distances along the line of sight (camera looks along +Y at the target).
+    const Eigen::Vector3d first = target.p_initial_in_world - camera.p_initial_in_world;
+    const Eigen::Vector3d last = first - 6.0 * camera.motion.step;
+    EXPECT_NEAR(first.norm(), 3.0, 1e-9);
+    EXPECT_NEAR(last.norm(), 12.0, 1e-9);
+    EXPECT_NEAR(camera.yaw_initial_rad, 90.0 * kDeg, 1e-9);
+    EXPECT_NEAR(target.yaw_initial_rad, view == "behind" ? 90.0 * kDeg : 0.0, 1e-9);
+    const auto loc = common::load_options<localizer::LocalizerOptions>(r.localizer_path);
+    EXPECT_NEAR(loc.sphere.radius_m, r.bounding_radius_m, 1e-9);
+    EXPECT_NEAR(loc.sphere.radius_m, sim::DroneModel::from_spec(target.drone).bounding_radius(), 1e-9);
+    EXPECT_NE(slurp(r.json_path).find("\"kind\": \"sweep\""), std::string::npos);
+  }
+  // Bad options name the option.
+  ScenarioSweepOptions bad;
+  bad.out = dir.file("bad.yaml");
+  bad.to_m = 2.0;
+  bad.step_m = 0.0;
+  bad.frames_per_step = 0;
+  const auto problems = bad.validate();
+  std::string all;
+  for (const auto& p : problems) all += p + "\n";
+  EXPECT_NE(all.find("--to = 2"), std::string::npos) << all;
+  EXPECT_NE(all.find("--step = 0"), std::string::npos) << all;
+  EXPECT_NE(all.find("--frames-per-step = 0"), std::string::npos) << all;
+  bad = ScenarioSweepOptions{};
+  bad.out = dir.file("bad.yaml");
+  bad.step_m = 0.001;  // 27000 steps
+  EXPECT_NE(bad.validate().at(0).find("more than 1000 steps"), std::string::npos);
+  bad.step_m = 0.5;
+  bad.from_m = 0.3;  // inside 1.5 x the radius
+  EXPECT_THROW(write_sweep_scenario(bad), std::invalid_argument);
 }
 
 }  // namespace

@@ -136,6 +136,39 @@ void write_file(const std::string& path, const std::string& text) {
   if (!f) throw std::runtime_error("cannot write '" + path + "'");
 }
 
+// The airframe named by --airframe (procedural with the seed, or a mesh file), its name and bounding radius into `r`.
+sim::DroneSpec airframe_spec(const std::string& airframe, uint64_t seed, const DatasetSynthConfig& synth,
+                             ScenarioRandomResult& r) {
+  sim::DroneSpec spec;
+  if (airframe == "quad" || airframe == "hex" || airframe == "octo") {
+    SynthRandom rng(seed, kAirframeStream, 0);
+    spec = random_airframe(synth, rng, airframe);
+    r.airframe = "procedural " + airframe;
+  } else {
+    if (!fs::is_regular_file(airframe))
+      throw std::invalid_argument("--airframe = '" + airframe + "': not quad, hex, octo nor a mesh file");
+    spec.frame = "mesh";
+    spec.mesh_path = fs::absolute(airframe).lexically_normal().string();
+    r.airframe = fs::path(airframe).filename().string();
+  }
+  r.bounding_radius_m = sim::DroneModel::from_spec(spec).bounding_radius();
+  return spec;
+}
+
+// The localizer's and the renderer's files of a written scenario (FILE.localizer.yaml, FILE.render.yaml).
+void write_localizer_and_render(const ScenarioRandomResult& r, const std::string& header, uint64_t seed,
+                                const std::string& lighting, const DatasetSynthConfig& synth) {
+  LocalizerTarget target;
+  target.radius_m = r.bounding_radius_m;
+  target.min_range_m = std::max(target.min_range_m, 1.5 * r.bounding_radius_m);
+  write_file(r.localizer_path, common::print_options(target, header + " (the localizer's defaults otherwise)"));
+  RenderSection render;
+  SynthRandom scene_rng(seed, kSceneStream, 0);
+  render.render = random_scene(synth, scene_rng);  // ground, treeline, clouds as dataset synth draws them
+  apply_lighting(lighting, render.render);
+  write_file(r.render_path, common::print_options(render, header + ": lighting " + lighting));
+}
+
 }  // namespace
 
 std::vector<std::string> ScenarioRandomOptions::validate() const {
@@ -175,19 +208,7 @@ ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
   const DatasetSynthConfig synth;  // the ranges `wingman dataset synth` draws airframes and scenes from
 
   // The leader's airframe and its bounding radius (propellers spinning), as the simulator computes and reports it.
-  sim::DroneSpec spec;
-  if (o.airframe == "quad" || o.airframe == "hex" || o.airframe == "octo") {
-    SynthRandom rng(o.seed, kAirframeStream, 0);
-    spec = random_airframe(synth, rng, o.airframe);
-    r.airframe = "procedural " + o.airframe;
-  } else {
-    if (!fs::is_regular_file(o.airframe))
-      throw std::invalid_argument("--airframe = '" + o.airframe + "': not quad, hex, octo nor a mesh file");
-    spec.frame = "mesh";
-    spec.mesh_path = fs::absolute(o.airframe).lexically_normal().string();
-    r.airframe = fs::path(o.airframe).filename().string();
-  }
-  r.bounding_radius_m = sim::DroneModel::from_spec(spec).bounding_radius();
+  sim::DroneSpec spec = airframe_spec(o.airframe, o.seed, synth, r);
 
   // The formation offset, and the headings that give the view.
   SynthRandom rng(o.seed, kPathStream, 0);
@@ -262,18 +283,10 @@ ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
   write_file(r.scenario_path, yaml);
 
   const std::string header = "written by `" + command + "` for " + out.filename().string();
-  LocalizerTarget target;
-  target.radius_m = r.bounding_radius_m;
-  target.min_range_m = std::max(target.min_range_m, 1.5 * r.bounding_radius_m);
-  write_file(r.localizer_path, common::print_options(target, header + " (the localizer's defaults otherwise)"));
+  write_localizer_and_render(r, header, o.seed, o.lighting, synth);
   FollowerFormation formation;
   formation.offset_m = {r.offset_in_world.x(), r.offset_in_world.y(), r.offset_in_world.z()};
   write_file(r.follower_path, common::print_options(formation, header + " (the follower's defaults otherwise)"));
-  RenderSection render;
-  SynthRandom scene_rng(o.seed, kSceneStream, 0);
-  render.render = random_scene(synth, scene_rng);  // ground, treeline, clouds as dataset synth draws them
-  apply_lighting(o.lighting, render.render);
-  write_file(r.render_path, common::print_options(render, header + ": lighting " + o.lighting));
 
   // What was drawn, for the suite's table (tools/experiment_summary.py suite).
   write_file(r.json_path,
@@ -291,9 +304,101 @@ ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
   return r;
 }
 
+std::vector<std::string> ScenarioSweepOptions::validate() const {
+  std::vector<std::string> p;
+  if (view != "behind" && view != "side") p.push_back("--view = '" + view + "': must be behind or side");
+  if (lighting != "A" && lighting != "B") p.push_back("--lighting = '" + lighting + "': must be A or B");
+  if (out.empty()) p.push_back("--out: required (the scenario file to write, e.g. build/suite/sweep.yaml)");
+  if (!out.empty() && fs::path(out).extension() != ".yaml") p.push_back("--out = '" + out + "': must end in .yaml");
+  if (airframe.empty()) p.push_back("--airframe: must be quad, hex, octo or a mesh file");
+  if (!(from_m > 0.0 && std::isfinite(from_m))) p.push_back(common::problem("--from", from_m, "must be > 0 m"));
+  if (!(to_m >= from_m && std::isfinite(to_m))) p.push_back(common::problem("--to", to_m, "must be >= --from"));
+  if (!(step_m > 0.0 && std::isfinite(step_m))) {
+    p.push_back(common::problem("--step", step_m, "must be > 0 m"));
+  } else if (to_m >= from_m && std::isfinite(to_m) && (to_m - from_m) / step_m > 1000.0) {
+    p.push_back(common::problem("--step", step_m, "gives more than 1000 steps from --from to --to"));
+  }
+  if (frames_per_step < 1 || frames_per_step > 1000)
+    p.push_back(common::problem("--frames-per-step", frames_per_step, "must be in [1, 1000]"));
+  if (!(height_m >= 1.0 && height_m <= 1000.0))
+    p.push_back(common::problem("height_m", height_m, "must be in [1, 1000] m"));
+  return p;
+}
+
+ScenarioRandomResult write_sweep_scenario(const ScenarioSweepOptions& o) {
+  if (const auto problems = o.validate(); !problems.empty())
+    throw std::invalid_argument(fmt::format("{}", fmt::join(problems, "; ")));
+  ScenarioRandomResult r;
+  const DatasetSynthConfig synth;
+  sim::DroneSpec spec = airframe_spec(o.airframe, o.seed, synth, r);
+  if (!(o.from_m > 1.5 * r.bounding_radius_m))
+    throw std::invalid_argument(fmt::format("--from = {}: must exceed 1.5 x the airframe's bounding radius ({:.3f} m)",
+                                            o.from_m, r.bounding_radius_m));
+  // Positions (teleport_steps' `steps`): from, from + step, ... up to to (a last partial step is left out).
+  r.legs = 1 + static_cast<int>(std::floor((o.to_m - o.from_m) / o.step_m + 1e-9));
+  // The camera looks along +Y at the target at the origin's column; the target faces away (behind: its heading +Y,
+  // its rear to the camera) or across (side: heading +X, its left side to the camera).
+  const Eigen::Vector3d p_target(0.0, 0.0, o.height_m);
+  const Eigen::Vector3d p_camera(0.0, -o.from_m, o.height_m);
+  r.offset_in_world = p_camera - p_target;
+  const double camera_fps = 30.0;  // wingman-sim's default camera.rate_hz: the scenario's length in frames
+  r.duration_s = std::ceil(r.legs * o.frames_per_step / camera_fps * 10.0) / 10.0;
+
+  const fs::path out(o.out);
+  const std::string stem = (out.parent_path() / out.stem()).string();
+  r.scenario_path = o.out;
+  r.localizer_path = stem + ".localizer.yaml";
+  r.render_path = stem + ".render.yaml";
+  r.json_path = stem + ".json";
+  if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
+  const std::string command = fmt::format(
+      "wingman scenario sweep --airframe {} --seed {} --view {} --lighting {} --from {} --to {} --step {} "
+      "--frames-per-step {}",
+      spec.frame == "mesh" ? spec.mesh_path : o.airframe, o.seed, o.view, o.lighting, o.from_m, o.to_m, o.step_m,
+      o.frames_per_step);
+  YamlSpecWriter drone("      ");
+  spec.visit(drone, "");
+  std::string yaml = fmt::format(
+      "# Written by `{}`: a range sweep (tools/experiment.sh suite). Keys: docs/simulation.md.\n"
+      "# Fly it with its configs: tools/fly.sh --scenario {} --localizer-config {} --render-config {}\n",
+      command, out.filename().string(), fs::path(r.localizer_path).filename().string(),
+      fs::path(r.render_path).filename().string());
+  yaml += fmt::format("name: {}\n", out.stem().string());
+  yaml += fmt::format(
+      "description: \"{} hovering, seen {}, lighting {}; camera from {} m to {} m in {} m steps, {} frames each\"\n",
+      r.airframe, o.view == "behind" ? "from behind" : "side-on", o.lighting, o.from_m, o.to_m, o.step_m,
+      o.frames_per_step);
+  yaml += "start_utime: 1767225600000000\nduration_s: 0\ncommand_delay_s: 0.1\n";
+  yaml += fmt::format("seed: {}\n\nvehicles:\n", o.seed);
+  yaml += fmt::format(
+      "  - name: camera\n    id: 0\n    control: script\n    initial:\n      position: {}\n      yaw_deg: 90\n"
+      "    motion:\n      type: teleport_steps\n      step: [0, {:.6g}, 0]\n      steps: {}\n      frames_per_step: "
+      "{}\n\n",
+      vec(p_camera), -o.step_m, r.legs, o.frames_per_step);
+  yaml += fmt::format(
+      "  - name: target\n    id: 1\n    control: script\n    initial:\n      position: {}\n      yaw_deg: {}\n"
+      "    drone:\n{}    motion:\n      type: hover\n",
+      vec(p_target), o.view == "behind" ? 90 : 0, drone.str());
+  write_file(r.scenario_path, yaml);
+  const std::string header = "written by `" + command + "` for " + out.filename().string();
+  write_localizer_and_render(r, header, o.seed, o.lighting, synth);
+  write_file(r.json_path,
+             fmt::format("{{\"kind\": \"sweep\", \"seed\": {}, \"airframe\": \"{}\", \"view\": \"{}\", "
+                         "\"lighting\": \"{}\", \"from_m\": {}, \"to_m\": {}, \"step_m\": {}, \"steps\": {}, "
+                         "\"frames_per_step\": {}, \"bounding_radius_m\": {:.6f}}}\n",
+                         o.seed, r.airframe, o.view, o.lighting, o.from_m, o.to_m, o.step_m, r.legs, o.frames_per_step,
+                         r.bounding_radius_m));
+  sim::load_scenario(r.scenario_path);
+  common::load_options<LocalizerTarget>(r.localizer_path);
+  common::load_options<RenderSection>(r.render_path);
+  return r;
+}
+
 struct ScenarioVerbs::State {
   CLI::App* random = nullptr;
+  CLI::App* sweep = nullptr;
   ScenarioRandomOptions options;
+  ScenarioSweepOptions sweep_options;
 };
 
 ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
@@ -312,11 +417,38 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->random->add_option("--view", o.view, "behind (the leader's rear faces the camera) or side (default behind)");
   s_->random->add_option("--lighting", o.lighting, "A (midday, clear) or B (evening, low sun, haze; default A)");
   s_->random->add_option("--out", o.out, "The scenario file to write, FILE.yaml")->required();
+
+  ScenarioSweepOptions& w = s_->sweep_options;
+  s_->sweep = scenario->add_subcommand(
+      "sweep",
+      "Write a range sweep for wingman-sim: the airframe hovers, the camera steps away from it along the line of "
+      "sight (--from to --to in --step, --frames-per-step frames each), and beside it FILE.localizer.yaml (the "
+      "airframe's bounding radius), FILE.render.yaml (lighting) and FILE.json for tools/fly.sh");
+  s_->sweep->add_option("--airframe", w.airframe,
+                        "quad, hex or octo (procedural, drawn with --seed) or a mesh file (default quad)");
+  s_->sweep->add_option("--seed", w.seed,
+                        "Seed of a procedural airframe, the scene and the image noise (default 2001)");
+  s_->sweep->add_option("--view", w.view, "behind (the rear faces the camera) or side (default behind)");
+  s_->sweep->add_option("--lighting", w.lighting, "A (midday) or B (evening; default A)");
+  s_->sweep->add_option("--from", w.from_m, "First distance, m (default 3)");
+  s_->sweep->add_option("--to", w.to_m, "Last distance, m (default 30)");
+  s_->sweep->add_option("--step", w.step_m, "Step, m (default 0.5)");
+  s_->sweep->add_option("--frames-per-step", w.frames_per_step, "Frames at each distance (default 8)");
+  s_->sweep->add_option("--out", w.out, "The scenario file to write, FILE.yaml")->required();
 }
 
 ScenarioVerbs::~ScenarioVerbs() = default;
 
 int ScenarioVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (*s_->sweep) {
+    return run_verb("wingman scenario sweep", err, [&] {
+      const ScenarioRandomResult r = write_sweep_scenario(s_->sweep_options);
+      out << fmt::format("wrote {} ({} steps, {}, bounding radius {:.3f} m) and its configs", r.scenario_path, r.legs,
+                         r.airframe, r.bounding_radius_m)
+          << std::endl;
+      return 0;
+    });
+  }
   if (!*s_->random) return -1;
   return run_verb("wingman scenario random", err, [&] {
     out << write_random_scenario(s_->options).one_line() << std::endl;

@@ -78,13 +78,39 @@ struct ScenarioRandomResult {
 /// or mesh problems, sim::ScenarioError if the written scenario does not load (a bug).
 ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& options);
 
-/// Adds `scenario random` to the CLI and runs it.
+/// What `wingman scenario sweep` writes: a range sweep of one airframe (issue 29's per-airframe sweeps). The target
+/// hovers; the camera vehicle (scripted, no setpoints) steps straight away from it along the line of sight.
+struct ScenarioSweepOptions {
+  /// --airframe: quad, hex or octo (procedural, drawn with --seed as `wingman scenario random` draws them), or a mesh
+  /// file (written into the scenario as an absolute path).
+  std::string airframe = "quad";
+  uint64_t seed = 2001;         ///< --seed: the procedural airframe, the scene and the image noise
+  std::string view = "behind";  ///< --view: behind (the target's rear faces the camera) or side (its left side)
+  std::string lighting = "A";   ///< --lighting: A or B, as `wingman scenario random`
+  double from_m = 3.0;          ///< --from: the first distance, camera to the target's centre, m (> radius)
+  double to_m = 30.0;           ///< --to: the last distance, m (>= from)
+  double step_m = 0.5;          ///< --step: distance added at each step, m (> 0); at most 1000 steps
+  int frames_per_step = 8;      ///< --frames-per-step: frames at each distance (>= 1)
+  double height_m = 5.0;        ///< both at this height: the target is seen level, m (>= 1)
+  std::string out;              ///< --out FILE.yaml; FILE.localizer.yaml, FILE.render.yaml and FILE.json beside it
+
+  /// Every problem, as "--key = value: rule" (empty when valid).
+  std::vector<std::string> validate() const;
+};
+
+/// Writes FILE.yaml (the sweep), FILE.localizer.yaml (target.radius_m = the airframe's bounding radius as the
+/// simulator reports it, range.min_m = max(0.5, 1.5 x radius); the localizer's defaults otherwise), FILE.render.yaml
+/// (lighting, the scene drawn with the seed) and FILE.json (what was written). The result's offset_in_world is the
+/// first step's target-minus-camera vector; legs = the number of steps. Throws as write_random_scenario.
+ScenarioRandomResult write_sweep_scenario(const ScenarioSweepOptions& options);
+
+/// Adds `scenario random` and `scenario sweep` to the CLI and runs them.
 class ScenarioVerbs {
  public:
   explicit ScenarioVerbs(CLI::App& app);
   ~ScenarioVerbs();
-  /// After parsing: runs `scenario random` when chosen and returns its exit code (0 ok, 1 failure, 2 bad
-  /// arguments), or -1 when it was not chosen. The summary goes to `out`, errors to `err`.
+  /// After parsing: runs `scenario random` or `scenario sweep` when chosen and returns its exit code (0 ok, 1
+  /// failure, 2 bad arguments), or -1 when neither was chosen. The summary goes to `out`, errors to `err`.
   int run_if_chosen(std::ostream& out, std::ostream& err);
 
  private:
