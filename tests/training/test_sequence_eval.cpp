@@ -528,6 +528,17 @@ TEST(RunSequenceEval, BoxesCacheGivesTheSameResultWithoutTheDetectorOrTheVideo) 
                                           "0.5 0.5 1 1 2 2 0\n";
   e = error_of([&] { read_clip_boxes(path); });
   EXPECT_NE(e.find(path + ":4: frame 12: not a tracked frame of 10"), std::string::npos) << e;
+  // A frame count that would loop for ever, and an infinite box, are named too.
+  std::ofstream(path, std::ios::trunc)
+      << "# wingman val --sequences boxes v1\nsettings s\nvideo 30 2000000000 160 128 1\n";
+  e = error_of([&] { read_clip_boxes(path); });
+  EXPECT_NE(e.find(path + ":3: video 30 2000000000 160 128 1: needs fps in (0, 1000], frames in [0, 10000000]"),
+            std::string::npos)
+      << e;
+  std::ofstream(path, std::ios::trunc) << "# wingman val --sequences boxes v1\nsettings s\nvideo 30 10 160 128 1\n"
+                                          "2 0 0.5 0.5 1 1 1e39 2 0\n";
+  e = error_of([&] { read_clip_boxes(path); });
+  EXPECT_NE(e.find(path + ":4:"), std::string::npos) << e;
 }
 
 // ---- the `wingman` binary ----

@@ -453,6 +453,7 @@ std::string SequenceEvalResult::json() const {
 
 namespace {
 constexpr const char* kBoxesMagic = "# wingman val --sequences boxes v1";
+constexpr int kMaxCachedFrames = 10000000;  // about 93 h at 30 frames/s: a clip, never a loop of billions of frames
 }  // namespace
 
 void write_clip_boxes(const std::string& path, const ClipBoxes& b) {
@@ -493,10 +494,12 @@ ClipBoxes read_clip_boxes(const std::string& path) {
     if (!(in >> word >> b.fps >> b.frames >> b.width >> b.height >> b.frame_step) || word != "video" ||
         !(in >> std::ws).eof())
       fail("expected 'video <fps> <frames> <width> <height> <frame_step>'");
-    if (!(b.fps > 0.0) || !std::isfinite(b.fps) || b.frames < 0 || b.frame_step < 1 ||
+    if (!(b.fps > 0.0 && b.fps <= 1000.0) || b.frames < 0 || b.frames > kMaxCachedFrames || b.frame_step < 1 ||
         (b.frames > 0 && (b.width <= 0 || b.height <= 0)))
-      fail(fmt::format("video {} {} {} {} {}: needs fps > 0, frames >= 0, a positive size, frame_step >= 1", b.fps,
-                       b.frames, b.width, b.height, b.frame_step));
+      fail(
+          fmt::format("video {} {} {} {} {}: needs fps in (0, 1000], frames in [0, {}], a positive size, "
+                      "frame_step >= 1",
+                      b.fps, b.frames, b.width, b.height, b.frame_step, kMaxCachedFrames));
   }
   while (std::getline(f, line)) {
     ++n;
@@ -509,9 +512,9 @@ ClipBoxes read_clip_boxes(const std::string& path) {
       fail("expected '<frame> <class> <confidence> <drone_score> <cx> <cy> <w> <h> <zoom 0|1>'");
     if (frame < 0 || frame >= b.frames || frame % b.frame_step != 0)
       fail(fmt::format("frame {}: not a tracked frame of {} (frame_step {})", frame, b.frames, b.frame_step));
-    if (x.class_id < 0 || !(x.w >= 0.0f) || !(x.h >= 0.0f) || !std::isfinite(x.cx) || !std::isfinite(x.cy) ||
-        !(x.confidence >= 0.0f && x.confidence <= 1.0f) || !(x.drone_score >= 0.0f && x.drone_score <= 1.0f) ||
-        (zoom != 0 && zoom != 1))
+    if (x.class_id < 0 || !(x.w >= 0.0f && std::isfinite(x.w)) || !(x.h >= 0.0f && std::isfinite(x.h)) ||
+        !std::isfinite(x.cx) || !std::isfinite(x.cy) || !(x.confidence >= 0.0f && x.confidence <= 1.0f) ||
+        !(x.drone_score >= 0.0f && x.drone_score <= 1.0f) || (zoom != 0 && zoom != 1))
       fail("a box needs class >= 0, scores in [0, 1], finite centre, w, h >= 0 and zoom 0 or 1");
     x.zoom_refined = zoom == 1;
     b.boxes[frame].push_back(x);
@@ -521,13 +524,16 @@ ClipBoxes read_clip_boxes(const std::string& path) {
 
 std::string detection_settings(const SequenceEvalOptions& o) {
   const detector::DetectorPipelineOptions& d = o.detection;
+  // A cfg file is keyed by its bytes' SHA-256 too (a built-in one by its name).
+  const std::string cfg_id =
+      o.cfg.rfind("builtin:", 0) == 0 ? std::string("builtin") : detector::weights_model_id(o.cfg);
   return fmt::format(
-      "cfg={} weights_sha256={} backend={} input_size={} p_thresh={} o_thresh={} subsquare={} zoom_in={} "
+      "cfg={} cfg_sha256={} weights_sha256={} backend={} input_size={} p_thresh={} o_thresh={} subsquare={} zoom_in={} "
       "zoom_max_fraction={} flip_fusion={} fusion_iou={} coarse_pass={} coarse_scale={} coarse_min_size={} "
       "drone_first={} policy={} max_detections={}",
-      o.cfg, detector::weights_model_id(o.weights), o.backend, o.input_size, d.p_thresh, d.o_thresh, d.subsquare,
-      d.zoom_in, d.zoom_max_fraction, d.flip_fusion, d.fusion_iou, d.coarse_pass, d.coarse_scale, d.coarse_min_size,
-      d.drone_first, d.policy, d.max_detections);
+      o.cfg, cfg_id, detector::weights_model_id(o.weights), o.backend, o.input_size, d.p_thresh, d.o_thresh,
+      d.subsquare, d.zoom_in, d.zoom_max_fraction, d.flip_fusion, d.fusion_iou, d.coarse_pass, d.coarse_scale,
+      d.coarse_min_size, d.drone_first, d.policy, d.max_detections);
 }
 
 SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDetector& detect_in,

@@ -215,11 +215,13 @@ struct ClipBoxes {
 void write_clip_boxes(const std::string& path, const ClipBoxes& b);
 
 /// Reads a file write_clip_boxes wrote. Throws DatasetError naming the file and line for anything else (a missing or
-/// unknown header, a bad number, a frame outside the clip or not a multiple of frame_step, a negative size).
+/// unknown header, a bad number, a frame outside the clip or not a multiple of frame_step, a negative size, more than
+/// 10^7 frames).
 ClipBoxes read_clip_boxes(const std::string& path);
 
-/// The settings string a boxes cache is keyed by: cfg, the weights' SHA-256 (detector::weights_model_id), backend,
-/// input size and every DetectorPipelineOptions field. "custom detector" when run_sequence_eval is given one.
+/// The settings string a boxes cache is keyed by: cfg (and a cfg file's SHA-256), the weights' SHA-256
+/// (detector::weights_model_id), backend, input size and every DetectorPipelineOptions field. "custom detector" when
+/// run_sequence_eval is given one. The detector's code is not in it: after a change to the detector, start a new cache.
 std::string detection_settings(const SequenceEvalOptions& o);
 
 /// Reads the labelled boxes of one Halmstad label CSV (`frame,class,x,y,w,h`; MATLAB pixels, so 0.5 px is
