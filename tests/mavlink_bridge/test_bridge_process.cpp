@@ -61,6 +61,18 @@ class BridgeRig {
       lcm_.handleTimeout(1);
     }
   }
+  /// run_for() until `done` holds (checked after every step) or `at_most` has passed; returns whether it held.
+  bool run_until(const std::function<bool()>& done, std::chrono::milliseconds at_most,
+                 const std::function<void(int64_t)>& each = nullptr) {
+    const int64_t end = epoch_ns() + at_most.count() * 1000000LL;
+    for (int64_t now = epoch_ns(); now < end; now = epoch_ns()) {
+      autopilot.step(now);
+      if (each) each(now);
+      lcm_.handleTimeout(1);
+      if (done()) return true;
+    }
+    return done();
+  }
   void publish(const setpoint_t& sp) { lcm_.publish("SETPOINT", &sp); }
   int stop() {
     child_->signal(SIGTERM);
@@ -200,14 +212,23 @@ TEST(MavlinkBridgeProcess, NeverSwitchesModeOrArmsUnlessAllowedAndStreamsOnlyInG
     last_sp_ns = now;
   };
   rig.run_for(2000ms, follower);
+  // The refusals are counted when the setpoints arrive (about 1 s in); the heartbeat that reports them may come up to
+  // one status period later: wait for it (at most 3 s more) instead of reading a heartbeat from before them.
+  const char* refusals[] = {"setpoint_not_engaged", "mode_switch_not_allowed", "arm_not_allowed"};
+  const auto reported = [&] {
+    if (rig.statuses.empty()) return false;
+    const std::string& d = rig.statuses.back().detail;
+    return std::all_of(std::begin(refusals), std::end(refusals),
+                       [&](const char* r) { return d.find(r) != std::string::npos; });
+  };
+  rig.run_until(reported, 3000ms, follower);
   EXPECT_TRUE(rig.autopilot.setpoints.empty()) << "ArduPilot in LOITER: nothing streamed";
   for (const auto& c : rig.autopilot.commands) {
     EXPECT_NE(c.command, wingman::mavlink::kMavCmdDoSetMode);
     EXPECT_NE(c.command, wingman::mavlink::kMavCmdComponentArmDisarm);
   }
   const std::string detail = rig.statuses.back().detail;
-  for (const char* r : {"setpoint_not_engaged", "mode_switch_not_allowed", "arm_not_allowed"})
-    EXPECT_NE(detail.find(r), std::string::npos) << r << " in " << detail;
+  for (const char* r : refusals) EXPECT_NE(detail.find(r), std::string::npos) << r << " in " << detail;
   rig.autopilot.set_mode(false, true, true);
   rig.run_for(1000ms, follower);
   ASSERT_FALSE(rig.autopilot.setpoints.empty());
