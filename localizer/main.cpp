@@ -5,6 +5,8 @@
 
 #include <wingman/common/runtime.hpp>
 
+#include <spdlog/spdlog.h>
+
 namespace {
 
 using namespace wingman;
@@ -21,9 +23,17 @@ localizer::CameraModel make_camera(const localizer::CameraOptions& o) {
 int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
   localizer::Localizer loc(o, make_camera(o.camera));
   rt.status().declare_output(o.output_channel);
-  rt.subscribe<own_pose_t>(o.own_pose_channel, [&](const own_pose_t& p) { loc.on_own_pose(p); });
+  // A time resync (one input re-anchored the clock) is worth a log line each time.
+  const auto log_notes = [&] {
+    for (const std::string& note : loc.take_notes()) spdlog::warn("{}", note);
+  };
+  rt.subscribe<own_pose_t>(o.own_pose_channel, [&](const own_pose_t& p) {
+    loc.on_own_pose(p);
+    log_notes();
+  });
   rt.subscribe<detections_t>(o.detections_channel, [&](const detections_t& d) {
     const localizer::LocalizerOutput out = loc.on_detections(d);
+    log_notes();
     rt.status().set_last_processed_seq(d.seq);
     for (const auto& why : out.rejections) rt.status().item_dropped(o.detections_channel, why);
     // Boxes of other classes than drone are expected, not drops: their counts since start are in the detail.

@@ -57,6 +57,7 @@ void Localizer::on_own_pose(const wingman::own_pose_t& m) {
   if (admission.resynced()) {  // the buffered poses belong to the old times: forget them
     poses_ = PoseBuffer(options_.pose);
     newest_pose_utime_ = -1;
+    notes_.push_back(admission.problem + "; the own-pose buffer is emptied");
   }
   std::string why;
   if (!poses_.add(s, &why)) throw std::invalid_argument("own_pose_t.utime = " + std::to_string(m.utime) + ": " + why);
@@ -81,7 +82,10 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
   }
   const common::TimeAdmission admission = clock_.admit(detections_input_, d.utime);
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);
-  if (admission.resynced()) tracker_ = Tracker(options_.tracker);  // its tracks live in the old times
+  if (admission.resynced()) {  // its tracks live in the old times
+    tracker_ = Tracker(options_.tracker);
+    notes_.push_back(admission.problem + "; the tracker restarts (new track ids)");
+  }
 
   LocalizerOutput result;
   std::vector<CameraMeasurement> measurements;
@@ -184,6 +188,12 @@ std::string Localizer::tracker_summary() const {
       "{} tentative track(s) with {} hits held back: mean confidence of the last {} below "
       "tracker.confirm_min_confidence {}",
       held, options_.tracker.birth_hits, options_.tracker.birth_window, options_.tracker.confirm_min_confidence);
+}
+
+std::vector<std::string> Localizer::take_notes() {
+  std::vector<std::string> out;
+  out.swap(notes_);
+  return out;
 }
 
 }  // namespace wingman::localizer

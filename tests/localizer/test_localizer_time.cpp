@@ -113,6 +113,25 @@ TEST(LocalizerTime, OneFutureOwnPoseIsDroppedAndDoesNotBlindTheLocalizer) {
   EXPECT_EQ(r.blind_after, 0) << "of " << r.detections_after << ": no own pose found after the lie";
 }
 
+TEST(LocalizerTime, AResyncIsANoteForTheLogNamingWhatWasForgotten) {
+  Localizer loc(LocalizerOptions{}, camera());
+  loc.on_own_pose(pose_at(kT0 + 1000 * kS));  // a first own pose from the future: the clock anchors on it
+  EXPECT_TRUE(loc.take_notes().empty());
+  int refused = 0;
+  for (int64_t t = 0; t <= 2 * kS; t += 20000) {
+    try {
+      loc.on_own_pose(pose_at(kT0 + t));
+    } catch (const std::invalid_argument&) {
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0);
+  const std::vector<std::string> notes = loc.take_notes();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("the own-pose buffer is emptied"), std::string::npos) << notes[0];
+  EXPECT_TRUE(loc.take_notes().empty()) << "taken once";
+}
+
 TEST(LocalizerTime, AFutureFirstMessageIsForgottenWithinTheResyncTime) {
   const Result r = fly(Lie::kFirstMessageInTheFuture);
   EXPECT_EQ(r.lie_thrown, 0) << "the first message has nothing to be compared with";

@@ -72,6 +72,10 @@ class Localizer {
   /// The non-drone boxes of every message since construction that passed the camera, image size and order checks.
   const NonDroneCounts& non_drone_boxes() const { return non_drone_boxes_; }
 
+  /// The lines worth a log line since the last call (a time resync: which input re-anchored the clock and what was
+  /// forgotten), oldest first; the list is emptied.
+  std::vector<std::string> take_notes();
+
   /// What the status says about the tracker, "" when nothing needs saying: the tentative tracks held back now by
   /// tracker.confirm_min_confidence (a model whose scores sit below the bar confirms nothing; this says why).
   std::string tracker_summary() const;
@@ -91,6 +95,7 @@ class Localizer {
   int detections_input_;
   int64_t newest_pose_utime_ = -1;
   NonDroneCounts non_drone_boxes_;
+  std::vector<std::string> notes_;  ///< take_notes()
 };
 
 }  // namespace wingman::localizer
