@@ -51,7 +51,10 @@ std::string unbounded(const std::string& pattern) {
       if (++depth > ChannelPattern::kMaxDepth)
         return fmt::format("parentheses nested deeper than {} at character {}", ChannelPattern::kMaxDepth, i + 1);
     } else if (c == ')') {
-      if (depth > 0) --depth;
+      // Unbalanced, it would close the anchoring group compile() wraps the pattern in: "a)|(b" would match any
+      // name that starts with a or ends with b.
+      if (depth == 0) return fmt::format("an unbalanced ')' at character {}", i + 1);
+      --depth;
     } else if (c == '{') {
       return fmt::format("counted repetition ('{{') at character {}: not supported", i + 1);
     }

@@ -174,6 +174,9 @@ TEST(ChannelPatternTest, HostilePatternsAreOneErrorAtLoadAndMatchingNeverBacktra
   EXPECT_EQ(why, "counted repetition ('{') at character 3: not supported");
   EXPECT_FALSE(ChannelPattern::compile("IMAGE[(", &why));
   EXPECT_FALSE(why.empty());
+  // An unbalanced ')' would escape the whole-name anchoring ("^(a)|(b)$").
+  EXPECT_FALSE(ChannelPattern::compile("a)|(b", &why));
+  EXPECT_EQ(why, "an unbalanced ')' at character 2");
   // Parentheses inside a bracket expression are literals, not nesting.
   const auto bracket = ChannelPattern::compile("[(((((((((((((((((((]X");
   ASSERT_TRUE(bracket);

@@ -42,7 +42,7 @@ struct TrackerOptions {
   double gate_chi2 = 16.27;
   /// M of the M-of-N birth rule: hits a tentative track needs within its first N frames. >= 1.
   /// 10 of 15 with confirm_min_confidence 0.4 (at 30 frames/s: half a second of evidence) was chosen on the
-  /// clip-disjoint Halmstad val split (models/wingman-small.md, "Track level"): against 3 of 5 without a confidence
+  /// clip-disjoint Halmstad val split (docs/training.md, "Track-level metrics"): against 3 of 5 without a confidence
   /// bar, 28 false tracks instead of 71 on its 22 distractor clips, 17 of 18 drone clips confirmed instead of 18.
   int birth_hits = 10;
   /// N of the M-of-N birth rule, frames (calls of update()); a tentative track that can no longer
