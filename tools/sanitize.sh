@@ -105,7 +105,7 @@ if [[ $# -gt 0 ]]; then
   stage "tsan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
   exit
 fi
-# Left out under TSan: the lockstep replay through live processes waits 20 s for the detector's first status, and
-# under TSan the detector's start-up (model load, the auto backend timing both backends) takes longer.
+# Left out under TSan: the lockstep replay through live processes starts the OpenCL detector ten times (each start
+# waited for up to 90 s), and under TSan the detector's start-up (model load, kernel build) is many times longer.
 stage "tsan multi-process tests" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -R "$TSAN_TESTS" \
   -E '^Replay\.LockstepReplayThroughLiveProcesses'
