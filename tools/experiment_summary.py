@@ -249,16 +249,37 @@ def max_range(out, run):
     write(out, "max_range", data, lines)
 
 
-def suite_rows(csv_path):
-    """The leader's targets (vehicle 1) of a flight's targets.csv: (t_s, true range m, 3-D error m, radius_m,
-    radius_sigma_m)."""
+def leader_targets(csv_path, kind, fields):
+    """The leader's targets (vehicle 1) of a run's targets.csv (`wingman eval --csv`): per row, the named fields as
+    floats (an empty radius column reads 0). Exits naming the file for a missing file, column or bad number."""
     import csv
     try:
         with open(csv_path) as f:
-            return [(float(r["t_s"]), float(r["range_m"]), float(r["error_m"]), float(r.get("radius_m") or 0),
-                     float(r.get("radius_sigma_m") or 0)) for r in csv.DictReader(f) if r["vehicle_id"] == "1"]
+            return [tuple(float(r[k] or 0) for k in fields) for r in csv.DictReader(f) if r["vehicle_id"] == "1"]
     except (OSError, KeyError, ValueError) as e:
-        sys.exit(f"experiment_summary: suite: cannot read {csv_path}: {e}")
+        sys.exit(f"experiment_summary: {kind}: cannot read {csv_path}: {e}")
+
+
+def suite_rows(csv_path):
+    """The leader's targets of a flight: (t_s, true range m, 3-D error m, radius_m, radius_sigma_m)."""
+    return leader_targets(csv_path, "suite", ("t_s", "range_m", "error_m", "radius_m", "radius_sigma_m"))
+
+
+def parse_bounds(kind, args, kinds):
+    """Leading `--key value` options of `kind` (kinds: option -> type, e.g. {"--max-rms": float}); returns (the
+    values by option, None where not given; the remaining arguments). Exits naming a bad or unknown option."""
+    args, values = list(args), {k: None for k in kinds}
+    while args and args[0].startswith("--"):
+        key = args.pop(0)
+        if key not in kinds:
+            sys.exit(f"experiment_summary: {kind}: unknown option {key} ({', '.join(kinds)})")
+        if not args:
+            sys.exit(f"experiment_summary: {kind}: {key} needs a value")
+        try:
+            values[key] = kinds[key](args.pop(0))
+        except ValueError:
+            sys.exit(f"experiment_summary: {kind}: {key}: expected a number")
+    return values, args
 
 
 def false_on_leader_ids(csv_path):
@@ -280,23 +301,8 @@ def suite(out, *args):
     drawing, OUT_DIR/scenarios/<flight>.json, written by `wingman scenario random`). With --max-rms M, --max-false N
     and --max-false-other K: exits 1 naming each flight whose 3-D RMS exceeds M metres (or that has no target on the
     leader), whose false targets exceed N, or whose false targets on track ids other than the leader's exceed K."""
-    args, max_rms, max_false, max_other = list(args), None, None, None
-    while args and args[0].startswith("--"):
-        key = args.pop(0)
-        if not args:
-            sys.exit(f"experiment_summary: suite: {key} needs a value")
-        try:
-            if key == "--max-rms":
-                max_rms = float(args.pop(0))
-            elif key == "--max-false":
-                max_false = int(args.pop(0))
-            elif key == "--max-false-other":
-                max_other = int(args.pop(0))
-            else:
-                sys.exit(f"experiment_summary: suite: unknown option {key} (--max-rms M, --max-false N, "
-                         "--max-false-other N)")
-        except ValueError:
-            sys.exit(f"experiment_summary: suite: {key}: expected a number")
+    bounds, args = parse_bounds("suite", args, {"--max-rms": float, "--max-false": int, "--max-false-other": int})
+    max_rms, max_false, max_other = bounds["--max-rms"], bounds["--max-false"], bounds["--max-false-other"]
     if not args:
         sys.exit("experiment_summary: suite: no flights (EVAL_JSON...)")
     flights, failures = [], []
@@ -367,16 +373,8 @@ def sweeps(out, *args):
     of frames with the target detected, the RMS of the 3-D error of its targets, and the median signed range error
     (estimated / true range - 1). With --max-rms M: exits 1 naming each sweep whose 3-D RMS exceeds M metres (or that
     has no target on it)."""
-    import csv
-    args, max_rms = list(args), None
-    if args[:1] == ["--max-rms"]:
-        if len(args) < 2:
-            sys.exit("experiment_summary: sweeps: --max-rms needs a value")
-        try:
-            max_rms = float(args[1])
-        except ValueError:
-            sys.exit("experiment_summary: sweeps: --max-rms: expected a number")
-        args = args[2:]
+    bounds, args = parse_bounds("sweeps", args, {"--max-rms": float})
+    max_rms = bounds["--max-rms"]
     if not args:
         sys.exit("experiment_summary: sweeps: no sweeps (EVAL_JSON...)")
     rows_out, failures = [], []
@@ -384,13 +382,8 @@ def sweeps(out, *args):
         r = load(path)
         name = os.path.basename(os.path.dirname(os.path.abspath(path)))
         scn = load(os.path.join(out, "scenarios", name + ".json"))
-        csv_path = os.path.join(os.path.dirname(path), "targets.csv")
-        try:
-            with open(csv_path) as f:
-                t = [(float(x["range_m"]), float(x["error_m"]), float(x["range_est_m"])) for x in csv.DictReader(f)
-                     if x["vehicle_id"] == "1"]
-        except (OSError, KeyError, ValueError) as e:
-            sys.exit(f"experiment_summary: sweeps: cannot read {csv_path}: {e}")
+        t = leader_targets(os.path.join(os.path.dirname(path), "targets.csv"), "sweeps",
+                           ("range_m", "error_m", "range_est_m"))
         bins = []
         for lo, hi in SWEEP_BINS:
             inside = [(rng, e, est) for rng, e, est in t if lo <= rng < hi]

@@ -52,8 +52,9 @@ val drones "$work/drones/data.yaml" train
 val distractors "$work/distractors/data.yaml" train
 val synth "$work/synth/data.yaml" val
 
-python3 - "$work" <<'PY'
+PYTHONPATH="$src/tests/support" python3 - "$work" <<'PY'
 import json, os, sys
+from bounds import check
 work = sys.argv[1]
 r = {n: json.load(open(os.path.join(work, n + ".json"))) for n in ("drones", "distractors", "synth")}
 drones, distractors, synth = r["drones"]["centre"]["all"], r["distractors"]["centre"]["all"], r["synth"]["iou"]["all"]
@@ -69,12 +70,5 @@ checks = [
 ]
 print(f"accuracy_guard: {r['drones']['images']} drone images ({r['drones']['truths']} drones), "
       f"{r['distractors']['images']} distractor images, {r['synth']['images']} synthetic images")
-failed = []
-for name, value, bound, at_least in checks:
-    ok = value >= bound if at_least else value <= bound
-    print(f"  {name}: {value:.3f} ({'>=' if at_least else '<='} {bound}) {'ok' if ok else 'FAIL'}")
-    if not ok:
-        failed.append(name)
-if failed:
-    sys.exit("accuracy_guard: FAIL: below the bound: " + "; ".join(failed))
+check("accuracy_guard", checks)
 PY

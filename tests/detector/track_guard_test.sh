@@ -35,8 +35,9 @@ clips=V_DRONE_003,V_DRONE_015,V_DRONE_029,V_DRONE_078,V_BIRD_011,V_BIRD_028,V_HE
   2> "$work/sequences.log" || { cat "$work/sequences.log" >&2; fail "wingman val --sequences"; }
 cat "$work/sequences.txt"
 
-python3 - "$work/sequences.json" <<'PY'
+PYTHONPATH="$src/tests/support" python3 - "$work/sequences.json" <<'PY'
 import json, sys
+from bounds import check
 r = json.load(open(sys.argv[1]))
 groups = {g["name"]: g for g in r["groups"]}
 drone, distractors = groups["DRONE"], groups["distractors"]
@@ -47,12 +48,5 @@ checks = [
     ("distractor clips evaluated", distractors["clips"], 4, True),
     ("false tracks on the distractor clips", distractors["false_tracks"], 9, False),
 ]
-failed = []
-for name, value, bound, at_least in checks:
-    ok = value >= bound if at_least else value <= bound
-    print(f"track_guard: {name}: {value} ({'>=' if at_least else '<='} {bound}) {'ok' if ok else 'FAIL'}")
-    if not ok:
-        failed.append(name)
-if failed:
-    sys.exit("track_guard: FAIL: outside the bound: " + "; ".join(failed))
+check("track_guard", checks)
 PY
