@@ -621,6 +621,12 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
     const std::string cache_path =
         o.boxes_cache.empty() ? std::string() : (fs::path(o.boxes_cache) / (sc.name + ".boxes")).string();
     std::unique_ptr<ClipTracker> tracker;
+    // The clip's tracker, on the nominal pinhole of its frame size (the first clip's focal length is reported).
+    const auto start_tracker = [&](int width, int height, double fps) {
+      const localizer::CameraModel camera = nominal_pinhole(width, height, o.hfov_deg);
+      if (result.focal_px == 0) result.focal_px = camera.fx();
+      return std::make_unique<ClipTracker>(loc_options, camera, fps);
+    };
     static const std::vector<cv::Rect2d> kNone;
     auto truths_at = [&](int k) -> const std::vector<cv::Rect2d>& {
       const auto it = truths.find(k);
@@ -642,11 +648,7 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
       if (c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
       static const std::vector<detector::Box> kNoBoxes;
       for (int k = 0; k < c.frames && c.skipped.empty(); k += o.frame_step) {
-        if (!tracker) {
-          const localizer::CameraModel camera = nominal_pinhole(cached.width, cached.height, o.hfov_deg);
-          if (result.focal_px == 0) result.focal_px = camera.fx();
-          tracker = std::make_unique<ClipTracker>(loc_options, camera, c.fps);
-        }
+        if (!tracker) tracker = start_tracker(cached.width, cached.height, c.fps);
         const auto it = cached.boxes.find(k);
         tracker->add_frame(k, it == cached.boxes.end() ? kNoBoxes : it->second, truths_at(k));
       }
@@ -677,9 +679,7 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
           if (!cap.read(frame) || frame.empty()) break;
           ++c.frames;
           if (!tracker) {
-            const localizer::CameraModel camera = nominal_pinhole(frame.cols, frame.rows, o.hfov_deg);
-            if (result.focal_px == 0) result.focal_px = camera.fx();
-            tracker = std::make_unique<ClipTracker>(loc_options, camera, c.fps);
+            tracker = start_tracker(frame.cols, frame.rows, c.fps);
             record.width = frame.cols, record.height = frame.rows;
           } else if (frame.cols != tracker->camera().width() || frame.rows != tracker->camera().height()) {
             c.skipped = fmt::format("{}: frame {} is {}x{}, the first {}x{}", video, k, frame.cols, frame.rows,
