@@ -114,7 +114,11 @@ TEST(ProcessConfig, BadConfigExitsNonZeroWithOneLineNamingFileAndEveryBadKey) {
 TEST(ProcessConfig, ADirectoryAsConfigIsAnErrorForEveryProcess) {
   TempDir dir;
   for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl",
-                          "wingman-recorder", "wingman-sim"}) {
+                          "wingman-recorder",
+#ifdef WINGMAN_WITH_SIM
+                          "wingman-sim"
+#endif
+       }) {
     const auto r = run({bin_path(exe), "--config", dir.path(), "--print-config"}, 10s);
     EXPECT_EQ(r.exit_code, 2) << exe;
     EXPECT_EQ(first_line(r.err), std::string(exe) + ": error: " + dir.path() + ": is a directory, not a config file");
