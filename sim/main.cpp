@@ -133,9 +133,16 @@ class MavlinkSide {
     flush();
   }
 
-  /// The frame's time: timeouts, the pilot, telemetry of the camera vehicle.
-  void on_frame_time() {
-    vehicle_.on_frame_time(simulator_.now_utime(), simulator_.vehicle_state(0), out_);
+  /// The frame's time: timeouts, the pilot, telemetry of the camera vehicle (its reported pose, with the pose
+  /// error and the covariance of SimFrame::own_pose).
+  void on_frame_time(const sim::SimFrame& frame) {
+    sim::ReportedPoseUncertainty u;
+    if (frame.own_pose.has_covariance) {
+      u.known = true;
+      u.position_var_m2 = frame.own_pose.cov_p_body_in_world[0];
+      u.attitude_var_rad2 = frame.own_pose.var_rpy_body[0];
+    }
+    vehicle_.on_frame_time(simulator_.now_utime(), frame.own_reported, out_, u);
     flush();
   }
 
@@ -205,6 +212,7 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     spdlog::info("rendering {}x{} with {}", camera.model.width(), camera.model.height(), renderer->gl_renderer());
   }
   sim::Simulator simulator(scenario, camera, renderer.get());
+  simulator.set_own_pose_error(o.own_pose_error);
 
   if (o.render) status.declare_output(o.image_channel);
   const bool via_mavlink = o.autopilot == "mavlink";
@@ -310,7 +318,7 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     const auto t0 = Clock::now();
     const sim::SimFrame frame = simulator.step();
     if (mav) {
-      mav->on_frame_time();  // the autopilot's telemetry of this frame goes to the companion
+      mav->on_frame_time(frame);  // the autopilot's telemetry of this frame goes to the companion
     } else {
       rt.publish(o.own_pose_channel, frame.own_pose);
     }

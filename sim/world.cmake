@@ -10,6 +10,7 @@ add_library(wingman_sim_world
   src/world/sim_options.cpp
   src/world/simulator.cpp
   src/world/mavlink_vehicle.cpp
+  src/world/own_pose_error.cpp
   src/world/truth_detections.cpp)
 add_library(wingman::sim_world ALIAS wingman_sim_world)
 target_include_directories(wingman_sim_world PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)

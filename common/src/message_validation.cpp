@@ -43,6 +43,37 @@ std::string check_quaternion(const char* type, const char* field, const double (
   return "";
 }
 
+// own_pose_t's covariance: zero when has_covariance is false; otherwise finite, variances >= 0 and each position
+// covariance within the Cauchy-Schwarz bound |c_ij| <= sqrt(c_ii c_jj) (1e-6 relative slack for rounding).
+std::string check_pose_covariance(const wingman::own_pose_t& m) {
+  if (!m.has_covariance) {
+    for (double c : m.cov_p_body_in_world)
+      if (c != 0.0) return "own_pose_t.cov_p_body_in_world: must be zero when has_covariance is false";
+    for (double c : m.var_rpy_body)
+      if (c != 0.0) return "own_pose_t.var_rpy_body: must be zero when has_covariance is false";
+    return "";
+  }
+  if (!all_finite(m.cov_p_body_in_world)) return "own_pose_t.cov_p_body_in_world: must be finite";
+  if (!all_finite(m.var_rpy_body)) return "own_pose_t.var_rpy_body: must be finite";
+  for (int i = 0; i < 3; ++i)
+    if (m.var_rpy_body[i] < 0) return fmt::format("own_pose_t.var_rpy_body[{}] = {}: must be >= 0", i, m.var_rpy_body[i]);
+  // Upper triangle row by row: (0,0) (0,1) (0,2) (1,1) (1,2) (2,2).
+  static constexpr int kIndex[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+  for (int i = 0; i < 3; ++i) {
+    const double d = m.cov_p_body_in_world[kIndex[i][i]];
+    if (d < 0) return fmt::format("own_pose_t.cov_p_body_in_world[{}] = {}: a variance must be >= 0", kIndex[i][i], d);
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) {
+      const double c = m.cov_p_body_in_world[kIndex[i][j]];
+      const double bound = std::sqrt(m.cov_p_body_in_world[kIndex[i][i]] * m.cov_p_body_in_world[kIndex[j][j]]);
+      if (std::abs(c) > bound * (1 + 1e-6) + 1e-300)
+        return fmt::format("own_pose_t.cov_p_body_in_world[{}] = {}: a covariance must be within +-sqrt(var var) = {}",
+                           kIndex[i][j], c, bound);
+    }
+  return "";
+}
+
 }  // namespace
 
 int bytes_per_pixel(int8_t pixel_format) {
@@ -133,7 +164,8 @@ std::string validate_message(const wingman::own_pose_t& m) {
   if (auto e = check_frame("own_pose_t", m.frame); !e.empty()) return e;
   if (!all_finite(m.p_body_in_world)) return "own_pose_t.p_body_in_world: must be finite";
   if (!all_finite(m.v_body_in_world)) return "own_pose_t.v_body_in_world: must be finite";
-  return check_quaternion("own_pose_t", "q_body_to_world", m.q_body_to_world);
+  if (auto e = check_quaternion("own_pose_t", "q_body_to_world", m.q_body_to_world); !e.empty()) return e;
+  return check_pose_covariance(m);
 }
 
 std::string validate_message(const wingman::targets_t& m) {

@@ -66,8 +66,18 @@ WorldMeasurement to_world(const CameraMeasurement& m, const Extrinsics& extrinsi
   WorldMeasurement w;
   w.utime = image_utime;
   w.camera_id = camera_id;
-  w.p_target_in_world = R_body_to_world * extrinsics.cam_to_body(m.p_target_in_cam) + pose_at_exposure.p_body_in_world;
+  const Eigen::Vector3d p_target_in_body = extrinsics.cam_to_body(m.p_target_in_cam);
+  w.p_target_in_world = R_body_to_world * p_target_in_body + pose_at_exposure.p_body_in_world;
   w.cov_p_in_world = rotate_covariance(R_cam_to_world, m.cov_p_in_cam);
+  if (!pose_at_exposure.var_rpy_body.isZero(0.0)) {
+    Eigen::Matrix3d skew;
+    skew << 0, -p_target_in_body.z(), p_target_in_body.y(),  //
+        p_target_in_body.z(), 0, -p_target_in_body.x(),      //
+        -p_target_in_body.y(), p_target_in_body.x(), 0;
+    const Eigen::Matrix3d J = R_body_to_world * skew;  // d p_target_in_world / d dtheta, up to sign
+    w.cov_p_in_world += J * pose_at_exposure.var_rpy_body.asDiagonal() * J.transpose();
+  }
+  w.cov_p_in_world += pose_at_exposure.cov_p_body_in_world;
   w.cov_p_in_world = 0.5 * (w.cov_p_in_world + w.cov_p_in_world.transpose());  // exact symmetry for the filter
   w.p_target_in_cam = m.p_target_in_cam;
   w.p_cam_in_world = R_body_to_world * extrinsics.p_cam_in_body + pose_at_exposure.p_body_in_world;

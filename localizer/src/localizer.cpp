@@ -51,6 +51,13 @@ void Localizer::on_own_pose(const wingman::own_pose_t& m) {
       Eigen::Quaterniond(m.q_body_to_world[0], m.q_body_to_world[1], m.q_body_to_world[2], m.q_body_to_world[3])
           .normalized();
   s.v_body_in_world = Eigen::Vector3d(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
+  if (m.has_covariance && options_.pose.use_covariance) {
+    const double* c = m.cov_p_body_in_world;  // upper triangle row by row: xx xy xz yy yz zz
+    s.cov_p_body_in_world << c[0], c[1], c[2],  //
+        c[1], c[3], c[4],                       //
+        c[2], c[4], c[5];
+    s.var_rpy_body = Eigen::Vector3d(m.var_rpy_body[0], m.var_rpy_body[1], m.var_rpy_body[2]);
+  }
   if (m.frame == wingman::own_pose_t::FRAME_NED) s = pose_ned_frd_to_enu_flu(s);  // world ENU, body FLU inside
   const common::TimeAdmission admission = clock_.admit(own_pose_input_, m.utime);
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 #include <wingman/common/config.hpp>
+#include <wingman/common/ned_enu.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -51,6 +52,8 @@ PoseSample pose_ned_frd_to_enu_flu(const PoseSample& ned_frd) {
   out.v_body_in_world = R_ned_to_enu * ned_frd.v_body_in_world;
   const Eigen::Matrix3d R_flu_to_enu = R_ned_to_enu * ned_frd.q_body_to_world.toRotationMatrix() * R_flu_to_frd;
   out.q_body_to_world = Eigen::Quaterniond(R_flu_to_enu).normalized();
+  out.cov_p_body_in_world = common::swap_ned_enu_covariance(ned_frd.cov_p_body_in_world);
+  out.var_rpy_body = ned_frd.var_rpy_body;
   return out;
 }
 
@@ -61,6 +64,8 @@ PoseSample interpolate(const PoseSample& a, const PoseSample& b, int64_t utime) 
   out.p_body_in_world = a.p_body_in_world + s * (b.p_body_in_world - a.p_body_in_world);
   out.v_body_in_world = a.v_body_in_world + s * (b.v_body_in_world - a.v_body_in_world);
   out.q_body_to_world = a.q_body_to_world.slerp(s, b.q_body_to_world).normalized();  // Eigen: shortest arc
+  out.cov_p_body_in_world = a.cov_p_body_in_world + s * (b.cov_p_body_in_world - a.cov_p_body_in_world);
+  out.var_rpy_body = a.var_rpy_body + s * (b.var_rpy_body - a.var_rpy_body);
   return out;
 }
 
@@ -75,7 +80,8 @@ PoseBuffer::PoseBuffer(PoseBufferOptions options) : options_(options) {
 
 bool PoseBuffer::add(const PoseSample& sample, std::string* why) {
   const bool finite = sample.p_body_in_world.allFinite() && sample.v_body_in_world.allFinite() &&
-                      sample.q_body_to_world.coeffs().allFinite();
+                      sample.q_body_to_world.coeffs().allFinite() && sample.cov_p_body_in_world.allFinite() &&
+                      sample.var_rpy_body.allFinite();
   if (!finite) {
     set(why, fmt::format("own pose at utime {} has non-finite values", sample.utime));
     return false;

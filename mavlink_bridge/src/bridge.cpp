@@ -184,7 +184,7 @@ void Bridge::on_frame(const Frame& f, int64_t mono_us, int64_t wall_ns, BridgeOu
     default:
       return;
   }
-  if (!why.empty()) refuse("bad_pose_message", why);
+  if (!why.empty()) refuse(pose ? "bad_pose_covariance" : "bad_pose_message", why);
   if (pose && pose->position_std_m >= 0) position_std_m_ = pose->position_std_m;
   if (pose) publish_pose(*pose, out);
 }

@@ -91,11 +91,30 @@ std::optional<NedPose> OwnPoseAssembler::on_odometry(const mavlink::Odometry& m,
     *why = "ODOMETRY.x..vz: not finite";
     return std::nullopt;
   }
-  // pose_covariance: upper triangle of the 6x6 (x, y, z, roll, pitch, yaw) covariance, row-major: x, y and z
-  // variances at 0, 6 and 11. NaN in the first element: unknown.
-  if (std::isfinite(m.pose_covariance[0])) {
-    const double mean_var = (m.pose_covariance[0] + m.pose_covariance[6] + m.pose_covariance[11]) / 3.0;
-    if (std::isfinite(mean_var) && mean_var >= 0) pose.position_std_m = std::sqrt(mean_var);
+  // pose_covariance: upper triangle of the 6x6 (x, y, z, roll, pitch, yaw) covariance, row by row: row x at 0..5,
+  // row y at 6..10, row z at 11..14, then roll-roll 15, pitch-pitch 18, yaw-yaw 20. NaN first: unknown.
+  if (!std::isnan(m.pose_covariance[0])) {
+    const auto& c = m.pose_covariance;
+    Eigen::Matrix3d P;
+    P << c[0], c[1], c[2],  //
+        c[1], c[6], c[7],   //
+        c[2], c[7], c[11];
+    const Eigen::Vector3d var_rpy(c[15], c[18], c[20]);
+    std::string problem;
+    if (!P.allFinite() || !var_rpy.allFinite()) problem = "not finite";
+    else if ((P.diagonal().array() < 0).any() || (var_rpy.array() < 0).any()) problem = "a negative variance";
+    for (int i = 0; i < 3 && problem.empty(); ++i)
+      for (int j = i + 1; j < 3 && problem.empty(); ++j)
+        if (std::abs(P(i, j)) > std::sqrt(P(i, i) * P(j, j)) * (1 + 1e-6) + 1e-300)
+          problem = "a covariance beyond +-sqrt(var var)";
+    if (problem.empty()) {
+      pose.has_covariance = true;
+      pose.cov_p_in_ned = P;
+      pose.var_rpy_frd = var_rpy;
+      pose.position_std_m = std::sqrt(P.trace() / 3.0);
+    } else {
+      *why = "ODOMETRY.pose_covariance: " + problem + "; the pose is published without a covariance";
+    }
   }
   odometry_seen_ = true;
   return pose;
@@ -116,6 +135,14 @@ wingman::own_pose_t own_pose_message(const NedPose& pose, int64_t utime, bool en
   m.q_body_to_world[1] = q.x();
   m.q_body_to_world[2] = q.y();
   m.q_body_to_world[3] = q.z();
+  if (pose.has_covariance) {
+    // Roll, pitch, yaw variances are the same for an FRD and an FLU body (the axes differ by sign only).
+    const Eigen::Matrix3d C = enu ? common::swap_ned_enu_covariance(pose.cov_p_in_ned) : pose.cov_p_in_ned;
+    m.has_covariance = true;
+    const double upper[6] = {C(0, 0), C(0, 1), C(0, 2), C(1, 1), C(1, 2), C(2, 2)};
+    for (int i = 0; i < 6; ++i) m.cov_p_body_in_world[i] = upper[i];
+    for (int i = 0; i < 3; ++i) m.var_rpy_body[i] = pose.var_rpy_frd[i];
+  }
   return m;
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <wingman/common/message_validation.hpp>
 
+#include <cmath>
 #include <limits>
 
 namespace {
@@ -118,6 +119,39 @@ TEST(ValidateOwnPose, RejectsNonUnitQuaternionAndUnknownFrame) {
   p.q_body_to_world[0] = 1;
   p.frame = 5;
   EXPECT_NE(validate_message(p).find("own_pose_t.frame = 5"), std::string::npos);
+}
+
+TEST(ValidateOwnPose, ACovarianceMustBeOneOrBeAbsent) {
+  wingman::own_pose_t p{};
+  p.utime = 1;
+  p.q_body_to_world[0] = 1;
+  // Absent: both arrays zero.
+  p.cov_p_body_in_world[3] = 0.1;
+  EXPECT_EQ(validate_message(p), "own_pose_t.cov_p_body_in_world: must be zero when has_covariance is false");
+  p.cov_p_body_in_world[3] = 0;
+  p.var_rpy_body[2] = 0.1;
+  EXPECT_EQ(validate_message(p), "own_pose_t.var_rpy_body: must be zero when has_covariance is false");
+  // Present: xx xy xz yy yz zz.
+  p.has_covariance = true;
+  const double good[6] = {0.25, 0.1, 0.0, 0.16, -0.05, 1.0};
+  for (int i = 0; i < 6; ++i) p.cov_p_body_in_world[i] = good[i];
+  EXPECT_EQ(validate_message(p), "");
+  p.cov_p_body_in_world[1] = 0.21;  // |xy| > sqrt(0.25 * 0.16) = 0.2
+  EXPECT_NE(validate_message(p).find("own_pose_t.cov_p_body_in_world[1] = 0.21: a covariance must be within"),
+            std::string::npos)
+      << validate_message(p);
+  p.cov_p_body_in_world[1] = 0.1;
+  p.cov_p_body_in_world[5] = -1;
+  EXPECT_NE(validate_message(p).find("own_pose_t.cov_p_body_in_world[5] = -1: a variance must be >= 0"),
+            std::string::npos)
+      << validate_message(p);
+  p.cov_p_body_in_world[5] = NAN;
+  EXPECT_EQ(validate_message(p), "own_pose_t.cov_p_body_in_world: must be finite");
+  p.cov_p_body_in_world[5] = 1;
+  p.var_rpy_body[0] = -1e-6;
+  EXPECT_NE(validate_message(p).find("own_pose_t.var_rpy_body[0]"), std::string::npos) << validate_message(p);
+  p.var_rpy_body[0] = INFINITY;
+  EXPECT_EQ(validate_message(p), "own_pose_t.var_rpy_body: must be finite");
 }
 
 TEST(ValidateSetpoint, RejectsUnknownMode) {

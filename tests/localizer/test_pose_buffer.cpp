@@ -172,4 +172,44 @@ TEST(PoseFrames, NedFrdPoseBecomesEnuFlu) {
   EXPECT_TRUE((enu.q_body_to_world * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitZ(), 1e-12));
 }
 
+TEST(PoseFrames, NedCovarianceBecomesTheCovarianceOfTheEnuPosition) {
+  // The covariance of p_enu = S p_ned is S C S^T: north and east variances exchange, covariances with down change
+  // sign. Checked on the definition: for any u, var(u . p_enu) = (S^T u)^T C (S^T u).
+  PoseSample ned;
+  ned.cov_p_body_in_world << 4, 1, 0.5,  //
+      1, 9, -2,                          //
+      0.5, -2, 16;
+  ned.var_rpy_body = {1e-4, 2e-4, 3e-4};
+  const PoseSample enu = wingman::localizer::pose_ned_frd_to_enu_flu(ned);
+  EXPECT_DOUBLE_EQ(enu.cov_p_body_in_world(0, 0), 9);   // east
+  EXPECT_DOUBLE_EQ(enu.cov_p_body_in_world(1, 1), 4);   // north
+  EXPECT_DOUBLE_EQ(enu.cov_p_body_in_world(2, 2), 16);  // up
+  EXPECT_DOUBLE_EQ(enu.cov_p_body_in_world(0, 1), 1);
+  EXPECT_DOUBLE_EQ(enu.cov_p_body_in_world(0, 2), 2);     // east-up = -(east-down)
+  EXPECT_DOUBLE_EQ(enu.cov_p_body_in_world(1, 2), -0.5);  // north-up = -(north-down)
+  EXPECT_TRUE(enu.cov_p_body_in_world.isApprox(enu.cov_p_body_in_world.transpose()));
+  EXPECT_TRUE(enu.var_rpy_body.isApprox(ned.var_rpy_body));  // FRD and FLU axes differ by sign only
+}
+
+TEST(PoseBuffer, InterpolatesTheCovarianceLinearly) {
+  PoseBuffer b;
+  PoseSample a = sample(kT0, {0, 0, 0}, 0);
+  a.cov_p_body_in_world = Eigen::Matrix3d::Identity();
+  a.var_rpy_body = {1e-4, 1e-4, 1e-4};
+  PoseSample c = sample(kT0 + 40'000, {0, 0, 0}, 0);
+  c.cov_p_body_in_world = 3 * Eigen::Matrix3d::Identity();
+  c.var_rpy_body = {3e-4, 3e-4, 5e-4};
+  ASSERT_TRUE(b.add(a));
+  ASSERT_TRUE(b.add(c));
+  const auto mid = b.at(kT0 + 10'000);
+  ASSERT_TRUE(mid);
+  EXPECT_TRUE(mid->cov_p_body_in_world.isApprox(1.5 * Eigen::Matrix3d::Identity()));
+  EXPECT_TRUE(mid->var_rpy_body.isApprox(Eigen::Vector3d(1.5e-4, 1.5e-4, 2e-4)));
+  PoseSample bad = sample(kT0 + 80'000, {0, 0, 0}, 0);
+  bad.cov_p_body_in_world(0, 0) = NAN;
+  std::string why;
+  EXPECT_FALSE(b.add(bad, &why));
+  EXPECT_NE(why.find("non-finite"), std::string::npos) << why;
+}
+
 }  // namespace

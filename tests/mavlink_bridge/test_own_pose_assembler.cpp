@@ -111,3 +111,79 @@ TEST(OwnPoseAssembler, BadMessagesSayWhichField) {
   EXPECT_FALSE(a.on_odometry(o, &why));
   EXPECT_NE(why.find("ODOMETRY.frame_id"), std::string::npos);
 }
+
+TEST(OwnPoseAssembler, OdometryCovarianceReachesTheOwnPoseInBothFrames) {
+  OwnPoseAssembler a(PoseSource::kOdometry, 100000);
+  mav::Odometry o;
+  o.time_usec = 5000000;
+  o.frame_id = mav::kMavFrameLocalNed;
+  o.child_frame_id = mav::kMavFrameBodyFrd;
+  o.q = {1, 0, 0, 0};
+  o.pose_covariance.fill(0);
+  // Upper triangle of the 6x6, row by row: xx xy xz .. (0..5), yy yz .. (6..10), zz .. (11..14), then
+  // roll 15, pitch 18, yaw 20.
+  o.pose_covariance[0] = 0.25f;   // north
+  o.pose_covariance[1] = 0.05f;   // north-east
+  o.pose_covariance[2] = -0.1f;   // north-down
+  o.pose_covariance[6] = 0.16f;   // east
+  o.pose_covariance[7] = 0.02f;   // east-down
+  o.pose_covariance[11] = 0.64f;  // down
+  o.pose_covariance[15] = 1e-4f;
+  o.pose_covariance[18] = 4e-4f;
+  o.pose_covariance[20] = 9e-4f;
+  o.pose_covariance[3] = 7.0f;  // x-roll: not carried (own_pose_t has no position-attitude cross terms)
+  std::string why;
+  const auto pose = a.on_odometry(o, &why);
+  ASSERT_TRUE(pose) << why;
+  EXPECT_TRUE(why.empty()) << why;
+  ASSERT_TRUE(pose->has_covariance);
+  const auto ned = own_pose_message(*pose, 1, false);
+  ASSERT_TRUE(ned.has_covariance);
+  const double want_ned[6] = {0.25, 0.05, -0.1, 0.16, 0.02, 0.64};
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(ned.cov_p_body_in_world[i], want_ned[i], 1e-7) << i;
+  const auto enu = own_pose_message(*pose, 1, true);
+  ASSERT_TRUE(enu.has_covariance);
+  // ENU: x east, y north, z up.
+  const double want_enu[6] = {0.16, 0.05, -0.02, 0.25, 0.1, 0.64};
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(enu.cov_p_body_in_world[i], want_enu[i], 1e-7) << i;
+  const double want_rpy[3] = {1e-4, 4e-4, 9e-4};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(enu.var_rpy_body[i], want_rpy[i], 1e-10) << i;
+    EXPECT_NEAR(ned.var_rpy_body[i], want_rpy[i], 1e-10) << i;
+  }
+}
+
+TEST(OwnPoseAssembler, AnInvalidOdometryCovarianceKeepsThePoseAndSaysWhy) {
+  OwnPoseAssembler a(PoseSource::kOdometry, 100000);
+  mav::Odometry o;
+  o.time_usec = 5000000;
+  o.frame_id = mav::kMavFrameLocalNed;
+  o.child_frame_id = mav::kMavFrameBodyFrd;
+  o.q = {1, 0, 0, 0};
+  struct Case {
+    int index;
+    float value;
+    const char* says;
+  };
+  for (const Case c : {Case{0, -1.0f, "negative variance"}, Case{18, -1e-4f, "negative variance"},
+                       Case{1, 0.5f, "beyond +-sqrt(var var)"}, Case{6, INFINITY, "not finite"},
+                       Case{20, NAN, "not finite"}}) {
+    o.pose_covariance.fill(0);
+    o.pose_covariance[0] = o.pose_covariance[6] = o.pose_covariance[11] = 0.04f;
+    o.pose_covariance[c.index] = c.value;
+    std::string why;
+    const auto pose = a.on_odometry(o, &why);
+    ASSERT_TRUE(pose) << c.index;
+    EXPECT_FALSE(pose->has_covariance) << c.index;
+    EXPECT_FALSE(own_pose_message(*pose, 1, true).has_covariance);
+    EXPECT_NE(why.find("ODOMETRY.pose_covariance: "), std::string::npos) << why;
+    EXPECT_NE(why.find(c.says), std::string::npos) << c.index << ": " << why;
+  }
+  o.pose_covariance.fill(0);
+  o.pose_covariance[0] = NAN;  // unknown: no covariance and nothing to say
+  std::string why;
+  const auto pose = a.on_odometry(o, &why);
+  ASSERT_TRUE(pose);
+  EXPECT_FALSE(pose->has_covariance);
+  EXPECT_TRUE(why.empty()) << why;
+}

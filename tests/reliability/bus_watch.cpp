@@ -6,7 +6,9 @@
 //   <recv_wall_us> DETECTIONS <channel> <utime> <seq> <num_detections>
 //   <recv_wall_us> SETPOINT <utime> <mode>
 //   <recv_wall_us> IMAGE <channel> <utime> <seq>
-//   <recv_wall_us> STATUS <channel> <pid> <state> <detail>
+//   <recv_wall_us> STATUS <channel> <pid> <state> <drops_total> <detail>
+//   <recv_wall_us> INPUT <status channel> <pid> <input channel> <count> <drops>   (one per input of the heartbeat)
+//   <recv_wall_us> LASTERR <status channel> <pid> <last_error>                    (when it is not empty)
 // Usage: wingman-bus-watch --lcm-url URL [--targets CH] [--detections CH] [--setpoint CH] [--image CH]... --seconds S
 // Exits 0 after --seconds of wall time or on SIGTERM/SIGINT; 1 with one line if the LCM URL cannot be opened.
 #include <lcm/lcm-cpp.hpp>
@@ -78,8 +80,19 @@ struct Printer {
     if (!decode(rbuf, ch, m)) return;
     std::string detail = m.detail;
     std::replace(detail.begin(), detail.end(), '\n', ' ');
-    std::printf("%lld STATUS %s %d %d %s\n", static_cast<long long>(wall_us()), ch.c_str(), m.pid, m.state,
-                detail.c_str());
+    const long long now = static_cast<long long>(wall_us());
+    std::printf("%lld STATUS %s %d %d %lld %s\n", now, ch.c_str(), m.pid, m.state,
+                static_cast<long long>(m.drops_total), detail.c_str());
+    for (const auto& c : m.channels) {
+      if (c.direction != wingman::channel_stats_t::DIRECTION_IN) continue;
+      std::printf("%lld INPUT %s %d %s %lld %lld\n", now, ch.c_str(), m.pid, c.channel.c_str(),
+                  static_cast<long long>(c.count), static_cast<long long>(c.drops));
+    }
+    if (!m.last_error.empty()) {
+      std::string error = m.last_error;
+      std::replace(error.begin(), error.end(), '\n', ' ');
+      std::printf("%lld LASTERR %s %d %s\n", now, ch.c_str(), m.pid, error.c_str());
+    }
   }
 };
 

@@ -5,6 +5,7 @@
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <wingman/common/message_validation.hpp>
 #include <wingman/localizer/sphere_projection.hpp>
 #include <wingman/sim/scenario.hpp>
 #include <wingman/sim/simulator.hpp>
@@ -98,6 +99,68 @@ TEST(Simulator, OwnPoseIsTheCameraVehiclesTruth) {
     for (int i = 0; i < 4; ++i) EXPECT_EQ(f.own_pose.q_body_to_world[i], t.q_body_to_world[i]);
     EXPECT_EQ(int{f.own_pose.frame}, int{wingman::own_pose_t::FRAME_ENU});
     EXPECT_EQ(t.name, "follower");
+  }
+}
+
+TEST(Simulator, TheReportedOwnPoseCarriesTheConfiguredErrorAndItsCovariance) {
+  // own_pose.position_std_m 0.5, attitude_std_rad 0.02, correlation 0.5 s, over 60 s at 30 Hz (seed 3): the sample
+  // std of the reported-minus-true position and rotation is the configured one within 25 % (about 120 correlation
+  // times: a sampling error near 13 % of the std), successive errors are correlated as exp(-dt / tau), and the
+  // message reports the variances. The true pose (ground truth, the camera) is untouched.
+  Simulator sim(scenario("follow_1d"), default_camera());
+  wingman::sim::OwnPoseErrorOptions o;
+  o.position_std_m = 0.5;
+  o.attitude_std_rad = 0.02;
+  o.correlation_time_s = 0.5;
+  o.seed = 3;
+  sim.set_own_pose_error(o);
+  double sum_p2 = 0, sum_a2 = 0, lag1 = 0, sum_x2 = 0;
+  int n = 0;
+  double previous_ex = 0;
+  for (int k = 0; k < 1800; ++k) {
+    const SimFrame f = sim.step();
+    const auto& t = truth_of(f, 0);
+    const Eigen::Vector3d dp = vec(f.own_pose.p_body_in_world) - vec(t.p_body_in_world);
+    const Eigen::Quaterniond q_rep(f.own_pose.q_body_to_world[0], f.own_pose.q_body_to_world[1],
+                                   f.own_pose.q_body_to_world[2], f.own_pose.q_body_to_world[3]);
+    const Eigen::Quaterniond q_true(t.q_body_to_world[0], t.q_body_to_world[1], t.q_body_to_world[2],
+                                    t.q_body_to_world[3]);
+    const Eigen::AngleAxisd d(q_true.conjugate() * q_rep);  // the rotation error in the body frame
+    sum_p2 += dp.squaredNorm() / 3;
+    sum_a2 += std::pow(d.angle(), 2) / 3;
+    if (k > 0) lag1 += dp.x() * previous_ex;
+    sum_x2 += dp.x() * dp.x();
+    previous_ex = dp.x();
+    ++n;
+    EXPECT_TRUE(f.own_pose.has_covariance);
+    EXPECT_DOUBLE_EQ(f.own_pose.cov_p_body_in_world[0], 0.25);
+    EXPECT_DOUBLE_EQ(f.own_pose.cov_p_body_in_world[3], 0.25);
+    EXPECT_DOUBLE_EQ(f.own_pose.cov_p_body_in_world[5], 0.25);
+    EXPECT_DOUBLE_EQ(f.own_pose.cov_p_body_in_world[1], 0.0);
+    EXPECT_DOUBLE_EQ(f.own_pose.var_rpy_body[2], 0.0004);
+    EXPECT_EQ(wingman::common::validate_message(f.own_pose), "");
+    EXPECT_TRUE((f.own_reported.p_body_in_world - dp - vec(t.p_body_in_world)).isZero(1e-9));
+  }
+  EXPECT_NEAR(std::sqrt(sum_p2 / n), 0.5, 0.125);
+  EXPECT_NEAR(std::sqrt(sum_a2 / n), 0.02, 0.005);
+  // Lag-one correlation of x over 1/30 s: exp(-1/15) = 0.936.
+  EXPECT_NEAR(lag1 / (n - 1) / (sum_x2 / n), std::exp(-1.0 / 15.0), 0.03);
+
+  // report_covariance false: the same error, reported as unknown.
+  Simulator quiet(scenario("follow_1d"), default_camera());
+  o.report_covariance = false;
+  quiet.set_own_pose_error(o);
+  const SimFrame f = quiet.step();
+  EXPECT_FALSE(f.own_pose.has_covariance);
+  EXPECT_EQ(wingman::common::validate_message(f.own_pose), "");
+  EXPECT_GT((vec(f.own_pose.p_body_in_world) - vec(truth_of(f, 0).p_body_in_world)).norm(), 0.0);
+  // Bad options are named.
+  o.correlation_time_s = 0;
+  try {
+    quiet.set_own_pose_error(o);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("own_pose.correlation_time_s"), std::string::npos) << e.what();
   }
 }
 

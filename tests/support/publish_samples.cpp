@@ -134,7 +134,7 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   out.push_back(encode_sample("DETECTIONS_CAM0", detections));
 
   // Follower at 10 m altitude heading north (ENU yaw = +90°), flying north at 2 m/s.
-  wingman::own_pose_t pose;
+  wingman::own_pose_t pose{};
   pose.utime = utime;
   pose.frame = wingman::own_pose_t::FRAME_ENU;
   set3(pose.p_body_in_world, 0.0, 0.0, 10.0);

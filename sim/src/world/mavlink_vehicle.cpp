@@ -273,7 +273,8 @@ bool MavlinkVehicle::due(uint32_t msgid, int64_t now_utime) {
   return true;
 }
 
-void MavlinkVehicle::on_frame_time(int64_t now_utime, const MultirotorState& state, VehicleOutput& out) {
+void MavlinkVehicle::on_frame_time(int64_t now_utime, const MultirotorState& state, VehicleOutput& out,
+                                   const ReportedPoseUncertainty& uncertainty) {
   // Timeouts, judged on simulated time.
   if (engaged_ && o_.px4() &&
       (!last_setpoint_utime_ || now_utime - *last_setpoint_utime_ > us(o_.px4_offboard_loss_timeout_s))) {
@@ -314,7 +315,14 @@ void MavlinkVehicle::on_frame_time(int64_t now_utime, const MultirotorState& sta
     m.pitchspeed = static_cast<float>(w_frd.y());
     m.yawspeed = static_cast<float>(w_frd.z());
     m.pose_covariance.fill(0.0f);
-    m.pose_covariance[0] = NAN;  // unknown
+    if (uncertainty.known) {  // upper triangle of the 6x6, row by row: x, y, z at 0, 6, 11; roll, pitch, yaw 15, 18, 20
+      m.pose_covariance[0] = m.pose_covariance[6] = m.pose_covariance[11] =
+          static_cast<float>(uncertainty.position_var_m2);
+      m.pose_covariance[15] = m.pose_covariance[18] = m.pose_covariance[20] =
+          static_cast<float>(uncertainty.attitude_var_rad2);
+    } else {
+      m.pose_covariance[0] = NAN;  // unknown
+    }
     m.velocity_covariance.fill(0.0f);
     m.velocity_covariance[0] = NAN;
     send(m, out);

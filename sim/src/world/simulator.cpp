@@ -177,6 +177,12 @@ void Simulator::advance_to(int64_t utime) {
   }
 }
 
+void Simulator::set_own_pose_error(const OwnPoseErrorOptions& options) {
+  if (options.enabled()) own_pose_error_.emplace(options);
+  else
+    own_pose_error_.reset();
+}
+
 SimFrame Simulator::step() {
   if (done()) {
     throw std::logic_error(fmt::format("scenario {}: step() after the last frame ({})", scenario_.name, frame_count_));
@@ -187,11 +193,19 @@ SimFrame Simulator::step() {
   advance_to(f.utime);
 
   const MultirotorState& own = camera_vehicle_->body.state();
+  f.own_reported = own_pose_error_ ? own_pose_error_->reported(own, f.utime) : own;
   f.own_pose.utime = f.utime;
   f.own_pose.frame = wingman::own_pose_t::FRAME_ENU;
-  copy3(own.p_body_in_world, f.own_pose.p_body_in_world);
-  copy_q(own.q_body_to_world, f.own_pose.q_body_to_world);
-  copy3(own.v_body_in_world, f.own_pose.v_body_in_world);
+  copy3(f.own_reported.p_body_in_world, f.own_pose.p_body_in_world);
+  copy_q(f.own_reported.q_body_to_world, f.own_pose.q_body_to_world);
+  copy3(f.own_reported.v_body_in_world, f.own_pose.v_body_in_world);
+  if (own_pose_error_ && own_pose_error_->options().report_covariance) {
+    const double var_p = std::pow(own_pose_error_->options().position_std_m, 2);
+    const double var_a = std::pow(own_pose_error_->options().attitude_std_rad, 2);
+    f.own_pose.has_covariance = true;
+    f.own_pose.cov_p_body_in_world[0] = f.own_pose.cov_p_body_in_world[3] = f.own_pose.cov_p_body_in_world[5] = var_p;
+    for (double& v : f.own_pose.var_rpy_body) v = var_a;
+  }
 
   Eigen::Isometry3d T_cam_to_body = Eigen::Isometry3d::Identity();
   T_cam_to_body.linear() = camera_.mount.R_cam_to_body;

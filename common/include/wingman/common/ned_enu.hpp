@@ -13,6 +13,16 @@ namespace wingman::common {
 /// NED <-> ENU for a vector or point: (x, y, z) -> (y, x, -z). The map is its own inverse.
 inline Eigen::Vector3d swap_ned_enu(const Eigen::Vector3d& v) { return {v.y(), v.x(), -v.z()}; }
 
+/// A 3x3 covariance of a world-frame vector between the conventions: S C S^T with S the NED<->ENU axis swap
+/// (x and y exchanged, z negated), so the variances of x and y exchange and the covariances with z change sign.
+inline Eigen::Matrix3d swap_ned_enu_covariance(const Eigen::Matrix3d& C) {
+  Eigen::Matrix3d S;
+  S << 0, 1, 0,  //
+      1, 0, 0,   //
+      0, 0, -1;
+  return S * C * S.transpose();
+}
+
 /// Angle wrapped into (-pi, pi].
 inline double wrap_pi(double angle_rad) {
   const double a = std::remainder(angle_rad, 2.0 * M_PI);  // [-pi, pi]

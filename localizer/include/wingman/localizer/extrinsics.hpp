@@ -71,9 +71,12 @@ inline Eigen::Matrix3d rotate_covariance(const Eigen::Matrix3d& R_a_to_b, const 
 /// Maps a camera-frame measurement into the world frame with the body pose at the image's exposure
 /// time (`pose_at_exposure`, from PoseBuffer::at(image_utime)):
 /// p_in_world = R_body_to_world (R_cam_to_body p_in_cam + p_cam_in_body) + p_body_in_world,
-/// cov_in_world = R_cam_to_world cov_in_cam R_cam_to_world^T with R_cam_to_world = R_body_to_world R_cam_to_body.
-/// The own pose's uncertainty is not added (own_pose_t carries none). `image_utime` and `camera_id`
-/// are copied to the result, as are p_target_in_cam, range and confidence.
+/// cov_in_world = R_cam_to_world cov_in_cam R_cam_to_world^T with R_cam_to_world = R_body_to_world R_cam_to_body,
+/// plus the own pose's uncertainty to first order (both zero where the pose reports none):
+/// + cov_p_body_in_world, the body position's, and
+/// + R_body_to_world [p_b]x diag(var_rpy_body) [p_b]x^T R_body_to_world^T, the attitude's, with p_b the target in the
+///   body frame (a small body rotation dtheta moves the target by -R_body_to_world [p_b]x dtheta).
+/// `image_utime` and `camera_id` are copied to the result, as are p_target_in_cam, range and confidence.
 WorldMeasurement to_world(const CameraMeasurement& m, const Extrinsics& extrinsics, const PoseSample& pose_at_exposure,
                           int64_t image_utime, int32_t camera_id);
 

@@ -23,6 +23,11 @@ struct PoseSample {
   Eigen::Vector3d p_body_in_world = Eigen::Vector3d::Zero();            ///< body origin in the world frame, metres
   Eigen::Quaterniond q_body_to_world = Eigen::Quaterniond::Identity();  ///< rotates body vectors into world
   Eigen::Vector3d v_body_in_world = Eigen::Vector3d::Zero();            ///< body velocity in the world frame, m/s
+  /// Covariance of p_body_in_world, m^2, world frame (zero: exact or unknown, adds nothing).
+  Eigen::Matrix3d cov_p_body_in_world = Eigen::Matrix3d::Zero();
+  /// Variances of small rotations of the body about its own x, y, z axes (roll, pitch, yaw), rad^2 (zero: exact or
+  /// unknown). The same numbers in FLU and FRD: the two bodies differ by signs of y and z only.
+  Eigen::Vector3d var_rpy_body = Eigen::Vector3d::Zero();
 };
 
 /// Converts a pose reported in the NED world frame with an FRD body (PX4, ArduPilot) into Wingman's
@@ -40,12 +45,18 @@ struct PoseBufferOptions {
   /// Samples older than this, counted back from the newest sample, are dropped. Must cover the
   /// detector's latency. Seconds, > 0.
   double history_s = 2.0;
+  /// Adds the own pose's reported uncertainty (own_pose_t.has_covariance: position covariance and attitude
+  /// variances) to each measurement's world covariance, so the tracker trusts a measurement less when the vehicle
+  /// knows its own pose less. false: own poses are taken as exact (as they are when none is reported).
+  bool use_covariance = true;
 
   template <class V>
   void visit(V& v) {
     v("pose.max_gap_s", max_gap_s, "largest gap between the two own poses that bracket an image time, s");
     v("pose.max_extrapolation_s", max_extrapolation_s, "largest extrapolation beyond the newest/oldest own pose, s");
     v("pose.history_s", history_s, "own poses kept, counted back from the newest, s (must cover detector latency)");
+    v("pose.use_covariance", use_covariance,
+      "add the own pose's reported covariance (own_pose_t.has_covariance) to each measurement's world covariance");
   }
   /// One "key = value: rule" line per problem; empty when valid.
   std::vector<std::string> validate() const;
@@ -82,7 +93,7 @@ class PoseBuffer {
 };
 
 /// Interpolates between two samples at `utime` (a.utime <= utime <= b.utime, a.utime < b.utime):
-/// position and velocity linearly, orientation by slerp.
+/// position, velocity and the covariances linearly, orientation by slerp.
 PoseSample interpolate(const PoseSample& a, const PoseSample& b, int64_t utime);
 
 }  // namespace wingman::localizer

@@ -49,7 +49,7 @@ class Bridge {
   /// Refusals outside the stream (poses that could not be made or stamped, commands the autopilot refused).
   const Refusals& refusals() const { return refusals_; }
   int64_t poses_published() const { return poses_; }
-  /// The newest ODOMETRY's position standard deviation, metres (own_pose_t has no covariance); -1 unknown.
+  /// The newest ODOMETRY's position standard deviation (sqrt of the mean variance), metres; -1 unknown.
   double position_std_m() const { return position_std_m_; }
   /// SYSTEM_TIME: the autopilot's Unix clock minus ours at its arrival, seconds (monitoring only: own poses are
   /// stamped through TIMESYNC); NaN before one with a Unix time arrived.

@@ -22,6 +22,9 @@ struct NedPose {
   Eigen::Vector3d v_body_in_ned = Eigen::Vector3d::Zero();           ///< m/s north, east, down
   Eigen::Quaterniond q_frd_to_ned = Eigen::Quaterniond::Identity();  ///< FRD body -> NED
   double position_std_m = -1;  ///< ODOMETRY: sqrt of the mean of its x, y, z variances; -1 unknown
+  bool has_covariance = false;  ///< ODOMETRY with a valid pose_covariance: the two below are set
+  Eigen::Matrix3d cov_p_in_ned = Eigen::Matrix3d::Zero();  ///< covariance of p_body_in_ned, m^2
+  Eigen::Vector3d var_rpy_frd = Eigen::Vector3d::Zero();   ///< variances of roll, pitch, yaw (FRD body axes), rad^2
 };
 
 /// Where poses come from (BridgeOptions::pose_source).
@@ -31,6 +34,8 @@ enum class PoseSource { kAuto, kOdometry, kAttitudePosition };
 /// ATTITUDE_QUATERNION if it is within max_attitude_age of it; odometry: a pose per ODOMETRY (pose in
 /// MAV_FRAME_LOCAL_NED, velocity in MAV_FRAME_BODY_FRD or MAV_FRAME_LOCAL_NED); auto: odometry once one was used, until
 /// then the pair. A message that gives no pose says why in `*why` (empty when it is simply waiting for its partner).
+/// An ODOMETRY whose pose_covariance is given but not a covariance (not finite, a negative variance, a covariance
+/// beyond +-sqrt(var var)) gives its pose without one and says why.
 class OwnPoseAssembler {
  public:
   OwnPoseAssembler(PoseSource source, int64_t max_attitude_age_us)

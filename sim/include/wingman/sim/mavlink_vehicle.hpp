@@ -16,6 +16,14 @@
 
 namespace wingman::sim {
 
+/// The uncertainty a vehicle reports with its pose (ODOMETRY.pose_covariance): the same variance on each position
+/// axis and on each rotation (roll, pitch, yaw). Unknown by default (ODOMETRY.pose_covariance[0] = NaN).
+struct ReportedPoseUncertainty {
+  bool known = false;
+  double position_var_m2 = 0.0;    ///< variance of each position axis, m^2
+  double attitude_var_rad2 = 0.0;  ///< variance of each rotation, rad^2
+};
+
 /// Options of the simulated autopilot's MAVLink side (config keys `mavlink.*` of config/sim.yaml; used with
 /// `autopilot: mavlink`). Times are simulated seconds unless they say wall clock.
 struct MavlinkVehicleOptions {
@@ -111,8 +119,10 @@ class MavlinkVehicle {
   /// A frame from the companion, at simulated time `now_utime`.
   void on_frame(const mavlink::Frame& frame, int64_t now_utime, VehicleOutput& out);
   /// A new frame time: the stream and guided timeouts, the pilot, then the telemetry of `state` (ENU world, FLU body:
-  /// sent in NED with an FRD body). Call after the vehicle was stepped to `now_utime`.
-  void on_frame_time(int64_t now_utime, const MultirotorState& state, VehicleOutput& out);
+  /// sent in NED with an FRD body; the reported state, with any pose error) and its `uncertainty` in ODOMETRY's
+  /// pose_covariance. Call after the vehicle was stepped to `now_utime`.
+  void on_frame_time(int64_t now_utime, const MultirotorState& state, VehicleOutput& out,
+                     const ReportedPoseUncertainty& uncertainty = {});
   /// Our HEARTBEAT (the caller paces it on the wall clock; mode changes send one at once).
   void heartbeat(VehicleOutput& out);
   /// A TIMESYNC request whose answer (VehicleOutput::pong_ts1 == the returned ts1) marks that the companion has

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wingman/sim/mavlink_vehicle.hpp"
+#include "wingman/sim/own_pose_error.hpp"
 #include "wingman/sim/render_options.hpp"
 
 #include <wingman/localizer/extrinsics.hpp>
@@ -109,6 +110,9 @@ struct SimOptions {
   /// telemetry and sends it the setpoints; docs/autopilot.md, "Try it against the simulator").
   std::string autopilot = "lcm";
   MavlinkVehicleOptions mavlink;
+  /// The error of the camera vehicle's reported pose (OWN_POSE over LCM, the telemetry over MAVLink); the camera
+  /// sees from the true pose.
+  OwnPoseErrorOptions own_pose_error;
   /// Render and publish images. Off: no image is published, no EGL is needed, and truth boxes are projected from
   /// the drone models (no occlusion).
   bool render = true;
@@ -129,6 +133,7 @@ struct SimOptions {
     v("autopilot", autopilot,
       "lcm (take SETPOINT, publish OWN_POSE) or mavlink (a MAVLink vehicle for wingman-mavlink, keys mavlink.*)");
     mavlink.visit(v);
+    own_pose_error.visit(v);
     camera.visit(v);
     extrinsics.visit(v);
     detections.visit(v);

@@ -7,6 +7,7 @@
 #include "wingman/sim/frame_clock.hpp"
 #include "wingman/sim/motion_script.hpp"
 #include "wingman/sim/multirotor.hpp"
+#include "wingman/sim/own_pose_error.hpp"
 #include "wingman/sim/scenario.hpp"
 #include "wingman/sim/truth_box.hpp"
 
@@ -42,7 +43,8 @@ struct SimCamera {
 struct SimFrame {
   int64_t index = 0;              ///< frame number k (the image's seq)
   int64_t utime = 0;              ///< exposure time t_k = start_utime + round(k * 1e6 / rate), microseconds since epoch
-  wingman::own_pose_t own_pose;   ///< the camera vehicle's body pose at t_k (ENU world, FLU body)
+  wingman::own_pose_t own_pose{};  ///< the camera vehicle's reported body pose at t_k (ENU world, FLU body)
+  MultirotorState own_reported;   ///< the same as a state (the pose error applied), for the MAVLink telemetry
   wingman::ground_truth_t truth;  ///< every vehicle at t_k and every target's box (image_seq -1 without image)
   cv::Mat bgr;                    ///< the rendered image (CV_8UC3); empty when rendering is off
   Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the camera at t_k (optical -> ENU)
@@ -89,6 +91,10 @@ class Simulator {
   /// Advances to the next frame's time and returns the frame. Precondition: !done() (std::logic_error otherwise).
   SimFrame step();
 
+  /// The error of the reported own pose from now on (SimFrame::own_pose, own_reported); none by default.
+  /// Throws std::invalid_argument listing options.validate() problems.
+  void set_own_pose_error(const OwnPoseErrorOptions& options);
+
   /// A setpoint for the camera vehicle: it takes effect at setpoint.utime + command_delay_s, or at once when that
   /// time has passed (counted as late). Setpoints taking effect at the same time apply in arrival order.
   /// Precondition: the message passed validate_message() (std::invalid_argument otherwise).
@@ -119,6 +125,7 @@ class Simulator {
   int64_t command_delay_us_ = 0;
   std::multimap<int64_t, VehicleCommand> pending_;  ///< setpoint commands by the utime they take effect
   SetpointCounts setpoint_counts_;
+  std::optional<OwnPoseError> own_pose_error_;
 };
 
 /// The image message of a rendered frame: BGR8, stride = 3 * width, as wingman-camera-driver publishes.
