@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Renders config/supervisor/wingman.conf (written for the installed layout) for a build tree or any other layout:
-# the same file with its paths, LCM URL and log folder substituted, so what runs is what ships.
+# the same file with its paths, LCM URL and log folder substituted, so what runs is what ships (its stopped-process
+# listener, installed in share/wingman/supervisor, runs from config/supervisor of this checkout).
 #
 # Usage: tools/supervise.sh [--bin DIR] [--etc DIR] [--log-dir DIR] [--lcm-url URL] [--out FILE]
 #                           [--standalone DIR]
@@ -60,6 +61,7 @@ render() {
   sed -e "s|/usr/local/bin/|$(esc "$bin")/|g" \
       -e "s|/usr/local/etc/wingman/|$(esc "$etc")/|g" \
       -e "s|/var/log/wingman/|$(esc "$log_dir")/|g" \
+      -e "s|/usr/local/share/wingman/supervisor/|$(esc "$src/config/supervisor")/|g" \
       ${url:+-e "s|udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304|$(esc "$url")|g"} \
       "$template"
 }
