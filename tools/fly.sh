@@ -9,6 +9,7 @@
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
 #                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE] [--follower-config FILE]
 #                     [--render-config FILE] [--autopilot lcm|mavlink] [--firmware px4|ardupilot]
+#                     [--own-pose-error M,RAD]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -34,6 +35,9 @@
 #                    simulator is a MAVLink vehicle on UDP loopback (inside the namespace) and wingman-mavlink bridges
 #                    it (config/mavlink_bridge.sim.yaml): OWN_POSE from its telemetry, setpoints through OFFBOARD/GUIDED
 #   --firmware       with --autopilot mavlink: the simulated autopilot's rules, px4 (OFFBOARD, default) or ardupilot
+#   --own-pose-error the follower's reported pose is wrong by a drifting error (Gauss-Markov, 2 s) of M metres per
+#                    position axis and RAD radians per rotation (standard deviations; wingman-sim's own_pose.* keys),
+#                    reported with its covariance as an autopilot's ODOMETRY would be; the camera sees from the truth
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -41,7 +45,7 @@ bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
 zoom_in=false flip_fusion=false coarse_pass=false localizer_config="" follower_config="" render_config=""
-autopilot=lcm firmware=px4
+autopilot=lcm firmware=px4 own_pose_error=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -56,6 +60,7 @@ while [ $# -gt 0 ]; do
     --render-config) render_config=$(realpath "$2"); shift 2 ;;
     --autopilot) autopilot="$2"; shift 2 ;;
     --firmware) firmware="$2"; shift 2 ;;
+    --own-pose-error) own_pose_error="$2"; shift 2 ;;
     --no-render) render=false; shift ;;
     --render) render=true; shift ;;
     --record-images) record_images=true; shift ;;
@@ -70,6 +75,13 @@ case "$truth_box" in sphere|silhouette) ;; *) echo "fly: --truth-box '$truth_box
 case "$detections" in cnn|truth) ;; *) echo "fly: --detections '$detections': expected cnn or truth" >&2; exit 2 ;; esac
 case "$autopilot" in lcm|mavlink) ;; *) echo "fly: --autopilot '$autopilot': expected lcm or mavlink" >&2; exit 2 ;; esac
 case "$firmware" in px4|ardupilot) ;; *) echo "fly: --firmware '$firmware': expected px4 or ardupilot" >&2; exit 2 ;; esac
+own_pose_yaml=""
+if [ -n "$own_pose_error" ]; then  # the values are checked by wingman-sim's config loader (own_pose.*)
+  IFS=, read -r pose_m pose_rad pose_extra <<< "$own_pose_error"
+  [ -n "$pose_m" ] && [ -n "$pose_rad" ] && [ -z "$pose_extra" ] ||
+    { echo "fly: --own-pose-error '$own_pose_error': expected M,RAD (e.g. 0.3,0.01)" >&2; exit 2; }
+  own_pose_yaml="own_pose: {position_std_m: $pose_m, attitude_std_rad: $pose_rad}"
+fi
 [ -r "$scenario_file" ] || { echo "fly: no scenario '$scenario' (looked for $scenario_file)" >&2; exit 2; }
 out="${out:-$src/build/flights/$name}"
 exes=(wingman-sim wingman-detector wingman-localizer wingman-follower-ctrl wingman)
@@ -144,6 +156,7 @@ detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.
 render: {enabled: $render}
 autopilot: $autopilot
 mavlink: {firmware: $firmware, streams: [odometry, attitude_quaternion, local_position_ned]}
+$own_pose_yaml
 YAML
 if [ "$detections" = cnn ]; then
   printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s, flip_fusion: %s, coarse_pass: %s}\n' \
