@@ -339,7 +339,8 @@ after_fault() {
     if wait_for 10 is_flying; then fly_ms=$(( ($(flying) - from) / 1000 )); else
       fly_ms="none"; fail "$name: the follower published no velocity setpoint within 10 s"
     fi
-    line="$name: first fresh target $back_ms ms after ($met ${survive_s} s); targets gap $gap_s s of message time,"
+    line="$name: first fresh target $back_ms ms after ($met ${survive_s} s); in the $gap_s s of message time from the"
+    line+=" newest targets before it to that one,"
     line+=" $n_hold of $n_sp setpoints without a target within hold.timeout_s were holds ($n_ok answered one),"
     line+=" first velocity setpoint $fly_ms ms after"
   else
