@@ -9,7 +9,7 @@
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
 #                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE] [--follower-config FILE]
 #                     [--render-config FILE] [--autopilot lcm|mavlink] [--firmware px4|ardupilot]
-#                     [--own-pose-error M,RAD]
+#                     [--own-pose-error M,RAD[,TAU]]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
 #   --out            output folder (default build/flights/NAME)
 #   --duration       stop after S simulated seconds (default: the scenario's own length)
@@ -35,9 +35,10 @@
 #                    simulator is a MAVLink vehicle on UDP loopback (inside the namespace) and wingman-mavlink bridges
 #                    it (config/mavlink_bridge.sim.yaml): OWN_POSE from its telemetry, setpoints through OFFBOARD/GUIDED
 #   --firmware       with --autopilot mavlink: the simulated autopilot's rules, px4 (OFFBOARD, default) or ardupilot
-#   --own-pose-error the follower's reported pose is wrong by a drifting error (Gauss-Markov, 2 s) of M metres per
-#                    position axis and RAD radians per rotation (standard deviations; wingman-sim's own_pose.* keys),
-#                    reported with its covariance as an autopilot's ODOMETRY would be; the camera sees from the truth
+#   --own-pose-error the follower's reported pose is wrong by a drifting error (Gauss-Markov, correlation time TAU
+#                    seconds, default 2) of M metres per position axis and RAD radians per rotation (standard
+#                    deviations; wingman-sim's own_pose.* keys), reported with its covariance as an autopilot's
+#                    ODOMETRY would be; the camera sees from the truth
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -77,10 +78,10 @@ case "$autopilot" in lcm|mavlink) ;; *) echo "fly: --autopilot '$autopilot': exp
 case "$firmware" in px4|ardupilot) ;; *) echo "fly: --firmware '$firmware': expected px4 or ardupilot" >&2; exit 2 ;; esac
 own_pose_yaml=""
 if [ -n "$own_pose_error" ]; then  # the values are checked by wingman-sim's config loader (own_pose.*)
-  IFS=, read -r pose_m pose_rad pose_extra <<< "$own_pose_error"
+  IFS=, read -r pose_m pose_rad pose_tau pose_extra <<< "$own_pose_error"
   [ -n "$pose_m" ] && [ -n "$pose_rad" ] && [ -z "$pose_extra" ] ||
-    { echo "fly: --own-pose-error '$own_pose_error': expected M,RAD (e.g. 0.3,0.01)" >&2; exit 2; }
-  own_pose_yaml="own_pose: {position_std_m: $pose_m, attitude_std_rad: $pose_rad}"
+    { echo "fly: --own-pose-error '$own_pose_error': expected M,RAD or M,RAD,TAU (e.g. 0.3,0.01)" >&2; exit 2; }
+  own_pose_yaml="own_pose: {position_std_m: $pose_m, attitude_std_rad: $pose_rad, correlation_time_s: ${pose_tau:-2.0}}"
 fi
 [ -r "$scenario_file" ] || { echo "fly: no scenario '$scenario' (looked for $scenario_file)" >&2; exit 2; }
 out="${out:-$src/build/flights/$name}"
@@ -103,6 +104,7 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   [ -z "$localizer_config" ] || again+=(--localizer-config "$localizer_config")
   [ -z "$follower_config" ] || again+=(--follower-config "$follower_config")
   [ -z "$render_config" ] || again+=(--render-config "$render_config")
+  [ -z "$own_pose_error" ] || again+=(--own-pose-error "$own_pose_error")
   exec tools/netns_run.sh "$0" "${again[@]}"
 fi
 for f in "$localizer_config" "$follower_config" "$render_config"; do

@@ -40,18 +40,12 @@ std::vector<std::string> PoseBufferOptions::validate() const {
   return p;
 }
 
-PoseSample pose_ned_frd_to_enu_flu(const PoseSample& ned_frd) {
-  Eigen::Matrix3d R_ned_to_enu;
-  R_ned_to_enu << 0, 1, 0,  //
-      1, 0, 0,              //
-      0, 0, -1;
-  const Eigen::Matrix3d R_flu_to_frd = Eigen::Vector3d(1, -1, -1).asDiagonal();
+PoseSample pose_ned_frd_to_enu_flu(const PoseSample& ned_frd) {  // common/ned_enu.hpp: the one conversion
   PoseSample out;
   out.utime = ned_frd.utime;
-  out.p_body_in_world = R_ned_to_enu * ned_frd.p_body_in_world;
-  out.v_body_in_world = R_ned_to_enu * ned_frd.v_body_in_world;
-  const Eigen::Matrix3d R_flu_to_enu = R_ned_to_enu * ned_frd.q_body_to_world.toRotationMatrix() * R_flu_to_frd;
-  out.q_body_to_world = Eigen::Quaterniond(R_flu_to_enu).normalized();
+  out.p_body_in_world = common::swap_ned_enu(ned_frd.p_body_in_world);
+  out.v_body_in_world = common::swap_ned_enu(ned_frd.v_body_in_world);
+  out.q_body_to_world = common::swap_ned_frd_enu_flu(ned_frd.q_body_to_world);
   out.cov_p_body_in_world = common::swap_ned_enu_covariance(ned_frd.cov_p_body_in_world);
   out.var_rpy_body = ned_frd.var_rpy_body;
   return out;

@@ -5,10 +5,14 @@
 # localization errors stay within the bounds stated in docs/simulation.md and that the flight is flagged when its
 # detections came from ground truth: the 20 s flight uses the simulator's ground-truth boxes and no images, so its
 # bounds measure localization and control; `rendered` flies 2 s with rendered 1280x720 images through the detector
-# process and its shipped CNN model instead.
-# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered]
+# process and its shipped CNN model instead; `pose_error` flies 30 s with ground-truth boxes while the follower's
+# reported pose is wrong by a drifting error (tools/fly.sh --own-pose-error 0.3,0.01: 0.3 m per position axis,
+# 0.01 rad per rotation, 2-s correlation), reported with its covariance, which the localizer must take into account
+# (pose.use_covariance) to keep the track and the formation. Extra arguments go to tools/fly.sh (for runs by hand).
+# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered|pose_error] [fly.sh arguments...]
 set -euo pipefail
 src="$1"; bin="$2"; kind="${3:-flight}"
+shift $(( $# < 3 ? $# : 3 ))
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 cd "$src"
 fail() { echo "sim_flight_test: $1" >&2; exit 1; }
@@ -25,7 +29,34 @@ if [ "$kind" = rendered ]; then
   echo "sim_flight_test: ok"
   exit 0
 fi
-log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 --detections truth --out "$out" 2>&1) || { echo "$log"; fail "the flight failed"; }
+if [ "$kind" = pose_error ]; then
+  log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 30 --detections truth \
+    --own-pose-error 0.3,0.01 --out "$out" "$@" 2>&1) || { echo "$log"; fail "the flight failed"; }
+  echo "$log"
+  PYENV_VERSION=system python3 - "$out/eval.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+problems = []
+def check(ok, what):
+    if not ok: problems.append(what)
+# Bounds (docs/localization.md, "The own pose's uncertainty"): 30 s of formation_2d with the own pose wrong by
+# 0.3 m / 0.01 rad (seed 1). The localization error includes the own pose's own error (0.3 m per axis, 0.52 m in 3-D)
+# since the target is placed from it; the formation is flown on the same wrong pose, so much of it cancels.
+check(r["truth_frames"] >= 675, f"{r['truth_frames']} ground-truth frames recorded of 900")
+check(r["track_ids_on_leader"] == 1, f"{r['track_ids_on_leader']} track ids on the leader, expected 1")
+check(r["false_targets"] == 0, f"{r['false_targets']} false targets")
+loc, fh = r["localization"], r["formation_horizontal"]
+check(loc["n"] >= 0.9 * r["truth_frames"], f"only {loc['n']} localized targets matched to truth of {r['truth_frames']}")
+check(loc["rms_m"] <= 0.75, f"localization RMS {loc['rms_m']:.3f} m > 0.75 m")
+check(fh["rms_m"] <= 0.5, f"formation horizontal RMS {fh['rms_m']:.3f} m > 0.5 m")
+print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
+print(f"sim_flight_test: measured localization RMS {loc['rms_m']:.3f} m (n {loc['n']}), formation horizontal RMS "
+      f"{fh['rms_m']:.3f} m, {r['track_ids_on_leader']} id(s), {r['false_targets']} false targets")
+sys.exit(1 if problems else 0)
+PY
+  exit
+fi
+log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 20 --detections truth --out "$out" "$@" 2>&1) || { echo "$log"; fail "the flight failed"; }
 echo "$log"
 [ -s "$out/eval.json" ] || fail "no eval.json"
 [ -s "$out/report.html" ] || fail "no report.html"
