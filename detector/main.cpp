@@ -9,6 +9,7 @@
 #include <wingman/common/latest_worker.hpp>
 #include <wingman/common/runtime.hpp>
 #include <wingman/common/sequence_gaps.hpp>
+#include <wingman/common/time_sanity.hpp>
 
 #include <fmt/format.h>
 
@@ -25,11 +26,34 @@ namespace {
 
 using namespace wingman;
 
+/// The detector's clock: image times only (time.*). admit() throws std::invalid_argument naming the field, its value
+/// and the rule for an image dated too far ahead or out of order (the runtime drops and counts it); a resync is
+/// logged once.
+class ImageClock {
+ public:
+  explicit ImageClock(const common::TimeSanityOptions& options)
+      : clock_(options), input_(clock_.add_input("image_t.utime", "image", true)) {}
+  void admit(const image_t& img) {
+    const common::TimeAdmission a = clock_.admit(input_, img.utime);
+    if (!a.accepted()) throw std::invalid_argument(a.problem);
+    if (a.resynced()) spdlog::warn("{}", a.problem);
+  }
+
+ private:
+  common::StageClock clock_;
+  int input_;
+};
+
 /// Without weights: check and count images only (the state says why).
 int run_without_model(common::Runtime& rt, const detector::DetectorOptions& o, const common::ImageLimits& limits) {
   rt.status().set_state(status_t::STATE_DEGRADED, "no model.weights configured: images are checked and counted only");
+  ImageClock clock(o.time);
   rt.subscribe<image_t>(
-      o.input_channel, [&rt](const image_t& img) { rt.status().set_last_processed_seq(img.seq); },
+      o.input_channel,
+      [&rt, &clock](const image_t& img) {
+        clock.admit(img);
+        rt.status().set_last_processed_seq(img.seq);
+      },
       [limits](const image_t& img) { return common::validate_message(img, limits); });
   return rt.spin();
 }
@@ -161,6 +185,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     }
   };
   auto accounted = [&] { drops_accounted = rt.status().input_drops(o.input_channel); };
+  ImageClock clock(o.time);
 
   if (o.mode == "replay" || rt.input_is_file()) {
     // Every frame, in order, inside its handler: deterministic, and lockstep-friendly.
@@ -170,6 +195,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
           count_gap(img);
           accounted();
           try {
+            clock.admit(img);  // a frame dated ahead or out of order is a counted drop: never detected
             const Detected d = detect(img);
             publish_detections(img, d.boxes, d.latency_us);
           } catch (...) {
@@ -210,6 +236,13 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       o.input_channel,
       [&](const image_t& img) {
         count_gap(img);
+        accounted();
+        try {
+          clock.admit(img);  // a frame dated ahead or out of order is a counted drop: never detected
+        } catch (...) {
+          handler_threw = true;  // the runtime drops and counts it
+          throw;
+        }
         if (const auto superseded = worker.offer(img)) {  // the copy is made here, outside the worker's lock
           rt.status().item_dropped(
               o.input_channel, fmt::format("channel {}: frame seq {} superseded by seq {} while busy", o.input_channel,

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <wingman/common/runtime.hpp>
 #include <wingman/image_t.hpp>
+#include <wingman/detections_t.hpp>
 #include <wingman/status_t.hpp>
 
 #include <poll.h>
@@ -277,6 +278,46 @@ TEST(ProcessFileIo, DetectorCountsFramesMissingFromTheSequenceAsDropsButNotThose
   int detections = 0;
   for (const auto& e : out) detections += e.channel == "DETECTIONS_CAM0";
   EXPECT_EQ(detections, 5);
+}
+
+TEST(ProcessFileIo, DetectorDropsAnImageDatedAheadOrOutOfOrderBeforeDetectingIt) {
+  // Issue 33: the detector passed a future frame's time on to its detections (the localizer dropped them). Frames
+  // 0..5 in order, one copy of frame 6 dated 1 h ahead, one of frame 7 dated before frame 5, then 8 and 9: the two
+  // lies are dropped and counted naming image_t.utime, no detections_t is dated after frame 9, and the clock is not
+  // moved by the lie (frames 8 and 9 are detected).
+  TempDir dir;
+  std::vector<wingman::testing::LogEvent> events;
+  for (int i = 0; i < 6; ++i) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
+  auto ahead = gray_image(6);
+  ahead.utime += 3600LL * 1000000;
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", ahead, 1006));
+  auto behind = gray_image(7);
+  behind.utime = gray_image(4).utime;
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", behind, 1007));
+  for (int i : {8, 9}) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+  const auto r = run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
+                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
+                     20s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = wingman::testing::read_log(dir.file("out.lcmlog"));
+  ASSERT_FALSE(out.empty());
+  wingman::status_t last;
+  ASSERT_GE(last.decode(out.back().data.data(), 0, static_cast<int>(out.back().data.size())), 0);
+  EXPECT_EQ(last.messages_handled, 10);
+  EXPECT_EQ(last.drops_total, 2);  // the two lies
+  // The heartbeat's last error names the newer lie: before its input's previous image.
+  EXPECT_NE(last.last_error.find("image_t.utime = " + std::to_string(behind.utime)), std::string::npos)
+      << last.last_error;
+  std::vector<int64_t> seqs;
+  for (const auto& e : out) {
+    if (e.channel != "DETECTIONS_CAM0") continue;
+    wingman::detections_t d;
+    ASSERT_GE(d.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0);
+    EXPECT_LE(d.utime, gray_image(9).utime);
+    seqs.push_back(d.seq);
+  }
+  EXPECT_EQ(seqs, (std::vector<int64_t>{0, 1, 2, 3, 4, 5, 8, 9}));
 }
 
 TEST(ProcessFileIo, FileInputIsProcessedToItsEndWithExitZeroAndBadMessagesAreCountedNotFatal) {

@@ -5,6 +5,8 @@
 #include "wingman/detector/detection_pipeline.hpp"
 #include "wingman/detector/opencl_options.hpp"
 
+#include <wingman/common/time_sanity.hpp>
+
 #include <string>
 #include <vector>
 
@@ -39,6 +41,10 @@ struct DetectorOptions {
   std::string input_size = "auto";
   DetectorPipelineOptions detection;
   OpenClOptions opencl;
+  /// Time sanity of the images (time.*): an image dated more than max_ahead_s after the newest accepted image, or
+  /// not after the previous one, is dropped and counted (never detected, its time never passed on); after
+  /// resync_after_s of such images in order the detector re-anchors on them (common/time_sanity.hpp).
+  common::TimeSanityOptions time;
 
   template <class V>
   void visit(V& v) {
@@ -59,6 +65,7 @@ struct DetectorOptions {
       "(the cfg's size) or WxH (multiples of 32)");
     detection.visit(v);
     opencl.visit(v);
+    time.visit(v);
   }
   std::vector<std::string> validate() const;
 };
