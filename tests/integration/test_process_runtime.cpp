@@ -257,6 +257,20 @@ TEST(ProcessWatchdog, SdNotifyReadyThenPingsThatStopWhileTheProcessIsStopped) {
   close(fd);
 }
 
+/// The detector (shipped model) run file to file over `events` (written to DIR/in.lcmlog): what it wrote, and its
+/// last heartbeat. Fails the calling test (ASSERT) when it does not exit 0 or writes nothing.
+void run_detector_file_to_file(const TempDir& dir, const std::vector<wingman::testing::LogEvent>& events,
+                               std::vector<wingman::testing::LogEvent>* out, wingman::status_t* last) {
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+  const auto r = run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
+                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
+                     20s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  *out = wingman::testing::read_log(dir.file("out.lcmlog"));
+  ASSERT_FALSE(out->empty());
+  ASSERT_GE(last->decode(out->back().data.data(), 0, static_cast<int>(out->back().data.size())), 0);
+}
+
 TEST(ProcessFileIo, DetectorCountsFramesMissingFromTheSequenceAsDropsButNotThoseThatArrivedBroken) {
   // seq 0 1 2 (3 and 4 never arrive) 5, garbage in place of 6, 7: two frames lost upstream, one dropped here.
   TempDir dir;
@@ -264,15 +278,9 @@ TEST(ProcessFileIo, DetectorCountsFramesMissingFromTheSequenceAsDropsButNotThose
   for (int i : {0, 1, 2, 5}) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
   events.push_back({1006, "IMAGE_CAM0", {1, 2, 3}});
   events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(7), 1007));
-  wingman::testing::write_log(dir.file("in.lcmlog"), events);
-  const auto r = run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
-                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
-                     20s);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto out = wingman::testing::read_log(dir.file("out.lcmlog"));
-  ASSERT_FALSE(out.empty());
+  std::vector<wingman::testing::LogEvent> out;
   wingman::status_t last;
-  ASSERT_GE(last.decode(out.back().data.data(), 0, static_cast<int>(out.back().data.size())), 0);
+  ASSERT_NO_FATAL_FAILURE(run_detector_file_to_file(dir, events, &out, &last));
   EXPECT_EQ(last.messages_handled, 6);
   EXPECT_EQ(last.drops_total, 3);  // 3 and 4 (missing), the garbage (arrived, does not decode)
   int detections = 0;
@@ -295,15 +303,9 @@ TEST(ProcessFileIo, DetectorDropsAnImageDatedAheadOrOutOfOrderBeforeDetectingIt)
   behind.utime = gray_image(4).utime;
   events.push_back(wingman::testing::make_event("IMAGE_CAM0", behind, 1007));
   for (int i : {8, 9}) events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(i), 1000 + i));
-  wingman::testing::write_log(dir.file("in.lcmlog"), events);
-  const auto r = run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0",
-                      "--lcm-out", "file://" + dir.file("out.lcmlog") + "?mode=w"},
-                     20s);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto out = wingman::testing::read_log(dir.file("out.lcmlog"));
-  ASSERT_FALSE(out.empty());
+  std::vector<wingman::testing::LogEvent> out;
   wingman::status_t last;
-  ASSERT_GE(last.decode(out.back().data.data(), 0, static_cast<int>(out.back().data.size())), 0);
+  ASSERT_NO_FATAL_FAILURE(run_detector_file_to_file(dir, events, &out, &last));
   EXPECT_EQ(last.messages_handled, 10);
   EXPECT_EQ(last.drops_total, 2);  // the two lies
   // The heartbeat's last error names the newer lie: before its input's previous image.

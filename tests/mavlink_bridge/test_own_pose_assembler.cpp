@@ -26,6 +26,17 @@ mav::AttitudeQuaternion attitude(uint32_t ms, const Eigen::Quaterniond& q) {
   return a;
 }
 
+/// An ODOMETRY at boot time 5 s, level and facing north (pose in LOCAL_NED, velocity in the FRD body), no covariance.
+mav::Odometry odometry() {
+  mav::Odometry o;
+  o.time_usec = 5000000;
+  o.frame_id = mav::kMavFrameLocalNed;
+  o.child_frame_id = mav::kMavFrameBodyFrd;
+  o.q = {1, 0, 0, 0};
+  o.pose_covariance.fill(0);
+  return o;
+}
+
 mav::LocalPositionNed position(uint32_t ms) {
   mav::LocalPositionNed p;
   p.time_boot_ms = ms;
@@ -114,12 +125,7 @@ TEST(OwnPoseAssembler, BadMessagesSayWhichField) {
 
 TEST(OwnPoseAssembler, OdometryCovarianceReachesTheOwnPoseInBothFrames) {
   OwnPoseAssembler a(PoseSource::kOdometry, 100000);
-  mav::Odometry o;
-  o.time_usec = 5000000;
-  o.frame_id = mav::kMavFrameLocalNed;
-  o.child_frame_id = mav::kMavFrameBodyFrd;
-  o.q = {1, 0, 0, 0};
-  o.pose_covariance.fill(0);
+  mav::Odometry o = odometry();
   // Upper triangle of the 6x6, row by row: xx xy xz .. (0..5), yy yz .. (6..10), zz .. (11..14), then
   // roll 15, pitch 18, yaw 20.
   o.pose_covariance[0] = 0.25f;   // north
@@ -155,11 +161,7 @@ TEST(OwnPoseAssembler, OdometryCovarianceReachesTheOwnPoseInBothFrames) {
 
 TEST(OwnPoseAssembler, AnInvalidOdometryCovarianceKeepsThePoseAndSaysWhy) {
   OwnPoseAssembler a(PoseSource::kOdometry, 100000);
-  mav::Odometry o;
-  o.time_usec = 5000000;
-  o.frame_id = mav::kMavFrameLocalNed;
-  o.child_frame_id = mav::kMavFrameBodyFrd;
-  o.q = {1, 0, 0, 0};
+  mav::Odometry o = odometry();
   struct Case {
     int index;
     float value;
