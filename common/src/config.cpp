@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -64,31 +65,88 @@ ConfigLoader ConfigLoader::from_string(const std::string& yaml_text, const std::
 }
 
 ConfigLoader::ConfigLoader(std::string source_name, const YAML::Node& root) : source_name_(std::move(source_name)) {
-  flatten(root, "");
+  flatten(root, "", source_name_);
 }
 
-void ConfigLoader::flatten(const YAML::Node& node, const std::string& prefix) {
+std::string ConfigSources::describe() const {
+  if (empty()) return "built-in defaults";
+  std::string out;
+  for (const auto& f : files) out += (out.empty() ? "" : ", ") + f;
+  for (const auto& s : sets) out += (out.empty() ? "" : ", ") + ("--set " + s);
+  return out;
+}
+
+ConfigLoader ConfigLoader::from_sources(const ConfigSources& sources) {
+  // One file alone reads exactly as from_file (its name is every message's source).
+  ConfigLoader out(sources.files.size() == 1 && sources.sets.empty() ? sources.files.front() : sources.describe());
+  for (const auto& file : sources.files) {
+    const ConfigLoader one = from_file(file);  // throws at once for an unreadable file or one that is not YAML
+    for (const auto& [key, leaf] : one.leaves_) out.leaves_[key] = leaf;  // a later file's key wins
+    out.errors_.insert(out.errors_.end(), one.errors_.begin(), one.errors_.end());
+  }
+  for (const auto& assignment : sources.sets) out.add_set(assignment);
+  return out;
+}
+
+void ConfigLoader::add_set(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  const std::string key = eq == std::string::npos ? "" : assignment.substr(0, eq);
+  bool plain = !key.empty() && key.front() != '.' && key.back() != '.' && key.find("..") == std::string::npos;
+  for (char c : key) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-');
+  if (!plain) {
+    errors_.push_back(fmt::format("--set '{}': expected KEY=VALUE with KEY a dotted name (e.g. formation.offset_m=[-6,2,0])",
+                                  assignment));
+    return;
+  }
+  const std::string text = assignment.substr(eq + 1);
+  const std::string source = "--set " + key;
+  if (const std::string bad = check_yaml_bounds(text, source); !bad.empty()) {
+    errors_.push_back(bad);
+    return;
+  }
+  YAML::Node value;
+  try {
+    value = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    errors_.push_back(fmt::format("--set {}: not valid YAML: {}", key, e.msg));
+    return;
+  }
+  if (value.IsMap()) {  // --set section={a: 1, b: 2}: each key of the mapping
+    flatten(value, key, "--set");
+    return;
+  }
+  leaves_[key] = Leaf{value, "--set", false};
+}
+
+void ConfigLoader::flatten(const YAML::Node& node, const std::string& prefix, const std::string& source) {
   for (const auto& kv : node) {
     if (!kv.first.IsScalar()) {  // e.g. "? mode: x" or "? [a, b]": YAML allows it, a configuration does not
       const std::string at = prefix.empty() ? std::string("(top level)") : prefix;
-      errors_.push_back(
-          fmt::format("{}: a key must be a plain name, got {}", where(at, kv.first), scalar_text(kv.first)));
+      errors_.push_back(fmt::format("{}: a key must be a plain name, got {}",
+                                    where(at, kv.first, source, source != "--set"), scalar_text(kv.first)));
       continue;
     }
     const std::string name = kv.first.as<std::string>();
     const std::string key = prefix.empty() ? name : prefix + "." + name;
     if (kv.second.IsMap()) {
-      flatten(kv.second, key);
+      flatten(kv.second, key, source);
     } else {
-      leaves_[key] = kv.second;
+      leaves_[key] = Leaf{kv.second, source, source != "--set"};
     }
   }
 }
 
 std::string ConfigLoader::where(const std::string& key, const YAML::Node& node) const {
+  if (current_ != nullptr) return where(key, node, current_->source, current_->has_lines);
+  return where(key, node, source_name_, true);
+}
+
+std::string ConfigLoader::where(const std::string& key, const YAML::Node& node, const std::string& source,
+                                bool has_lines) const {
+  if (!has_lines) return fmt::format("{} {}", source, key);  // "--set formation.offset_m"
   const auto mark = node.Mark();
-  if (mark.line >= 0) return fmt::format("{}:{}: {}", source_name_, mark.line + 1, key);
-  return fmt::format("{}: {}", source_name_, key);
+  if (mark.line >= 0) return fmt::format("{}:{}: {}", source, mark.line + 1, key);
+  return fmt::format("{}: {}", source, key);
 }
 
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, bool& out) {
@@ -192,7 +250,7 @@ void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::
 
 void ConfigLoader::finish(const std::vector<std::string>& validation_errors) const {
   std::vector<std::string> all = errors_;
-  for (const auto& [key, node] : leaves_) {
+  for (const auto& [key, leaf] : leaves_) {
     if (known_.count(key)) continue;
     // Suggest a known key with the same last component, if any (typo in the section).
     std::string hint;
@@ -203,9 +261,19 @@ void ConfigLoader::finish(const std::vector<std::string>& validation_errors) con
         break;
       }
     }
-    all.push_back(fmt::format("{}: unknown key{}", where(key, node), hint));
+    all.push_back(fmt::format("{}: unknown key{}", where(key, leaf.node, leaf.source, leaf.has_lines), hint));
   }
-  for (const auto& e : validation_errors) all.push_back(fmt::format("{}: {}", source_name_, e));
+  for (const auto& e : validation_errors) {
+    // "key = value: rule": named by the source that gave the key, else by every source.
+    const std::string key = e.substr(0, e.find_first_of(" :"));
+    const auto it = leaves_.find(key);
+    if (it == leaves_.end())
+      all.push_back(fmt::format("{}: {}", source_name_, e));
+    else if (it->second.source == "--set")
+      all.push_back("--set " + e);  // "--set key = value: rule"
+    else
+      all.push_back(fmt::format("{}: {}", it->second.source, e));
+  }
   if (all.empty()) return;
   std::string msg = fmt::format("{} problem{} in configuration: ", all.size(), all.size() == 1 ? "" : "s");
   for (size_t i = 0; i < all.size(); ++i) msg += (i ? "; " : "") + all[i];

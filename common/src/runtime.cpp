@@ -374,11 +374,30 @@ int Runtime::shutdown(const std::string& reason) {
 int run_process_impl(const ProcessInfo& info, int argc, char** argv,
                      const std::function<std::string(const std::string&, bool)>& load_config,
                      const std::function<int(Runtime&)>& body) {
+  auto one_file = [&](const ConfigSources& sources, bool print) -> std::string {
+    if (sources.files.size() > 1 || !sources.sets.empty())
+      throw ConfigError("this process reads one --config FILE and takes no --set (got " + sources.describe() + ")");
+    return load_config(sources.files.empty() ? std::string() : sources.files.front(), print);
+  };
+  return run_process_impl(info, argc, argv, std::function<std::string(const ConfigSources&, bool)>(one_file), body);
+}
+
+int run_process_impl(const ProcessInfo& info, int argc, char** argv,
+                     const std::function<std::string(const ConfigSources&, bool)>& load_config,
+                     const std::function<int(Runtime&)>& body) {
   const std::string prog = info.executable;
   RuntimeOptions ro;
   CLI::App app{info.description, prog};
-  app.add_option("--config", ro.config_path,
-                 "YAML configuration file (default: built-in defaults; see config/" + info.name + ".yaml)");
+  app.add_option("--config", ro.config.files,
+                 "YAML configuration file (default: built-in defaults; see config/" + info.name +
+                     ".yaml); repeatable: files are read in order, a later file's keys win")
+      ->allow_extra_args(false)
+      ->type_name("FILE");
+  app.add_option("--set", ro.config.sets,
+                 "KEY=VALUE: one key over the --config files, VALUE a YAML scalar or sequence (e.g. "
+                 "formation.offset_m=[-6,2,0]); repeatable, a later --set wins")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
   app.add_flag("--print-config", ro.print_config, "Print the effective configuration as YAML and exit");
   app.add_option("--lcm-url", ro.lcm_url, "LCM URL for input and output (default: LCM_DEFAULT_URL or LCM's default)");
   app.add_option("--lcm-in", ro.lcm_in,
@@ -417,7 +436,7 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
   spdlog::set_level(spdlog::level::from_str(ro.log_level));
 
   try {
-    const std::string printed = load_config(ro.config_path, ro.print_config);
+    const std::string printed = load_config(ro.config, ro.print_config);
     if (ro.print_config) {
       std::cout << printed << std::flush;
       return 0;

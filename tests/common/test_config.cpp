@@ -6,6 +6,7 @@
 #include <wingman/common/time_sanity.hpp>
 
 #include <chrono>
+#include <cstdio>
 
 namespace {
 
@@ -164,3 +165,90 @@ TEST(ConfigLoader, AnAliasBombIsANamedProblemNotGigabytes) {
 }
 
 }  // namespace
+
+// Layered configuration (issue 32): --config A --config B (later wins) and --set KEY=VALUE over both.
+namespace layered {
+
+using wingman::common::ConfigSources;
+using wingman::common::load_options;
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/wingman_layered_" + name;
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  EXPECT_NE(f, nullptr) << path;
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  return path;
+}
+
+std::string error_of(const ConfigSources& sources) {
+  try {
+    load_options<Demo>(sources);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected ConfigError from " << sources.describe();
+  return "";
+}
+
+TEST(ConfigLayers, LaterFilesWinKeyByKeyAndKeepTheRest) {
+  const std::string a = write_file("a.yaml", "camera: {width: 1280, fps: 15}\nfile: {k: [1, 2, 3]}\n");
+  const std::string b = write_file("b.yaml", "camera:\n  fps: 60\n");
+  const Demo ab = load_options<Demo>(ConfigSources{{a, b}, {}});
+  EXPECT_EQ(ab.width, 1280);  // only in a
+  EXPECT_DOUBLE_EQ(ab.fps, 60);  // b over a
+  EXPECT_EQ(ab.k, (std::vector<double>{1, 2, 3}));
+  const Demo ba = load_options<Demo>(ConfigSources{{b, a}, {}});
+  EXPECT_DOUBLE_EQ(ba.fps, 15);  // the order is the command line's
+}
+
+TEST(ConfigLayers, SetTakesScalarsAndSequencesOverEveryFile) {
+  const std::string a = write_file("s.yaml", "camera: {width: 1280, device: /dev/video2}\nfile: {k: [1, 2]}\n");
+  const Demo d = load_options<Demo>(ConfigSources{
+      {a}, {"camera.width=320", "file.k=[-6,2,0]", "file.loop=true", "camera.device=", "camera.width=800"}});
+  EXPECT_EQ(d.width, 800);  // the later --set wins
+  EXPECT_EQ(d.k, (std::vector<double>{-6, 2, 0}));
+  EXPECT_TRUE(d.loop);
+  EXPECT_EQ(d.device, "");  // an empty value is YAML's null: an empty string
+  // A mapping value sets each of its keys; no file at all is fine.
+  const Demo m = load_options<Demo>(ConfigSources{{}, {"camera={fps: 5, width: 2}"}});
+  EXPECT_DOUBLE_EQ(m.fps, 5);
+  EXPECT_EQ(m.width, 2);
+}
+
+TEST(ConfigLayers, EveryBadSetIsNamedWithTheFilesProblemsInOneLine) {
+  const std::string a = write_file("bad_a.yaml", "camera:\n  fps: fast\n");
+  const std::string m = error_of(ConfigSources{
+      {a}, {"camera.width=-3", "file.k=[1, x]", "camera.colour=red", "nonsense", "file.loop=maybe"}});
+  EXPECT_NE(m.find("6 problems"), std::string::npos) << m;
+  EXPECT_NE(m.find(a + ":2: camera.fps: expected a number, got 'fast'"), std::string::npos) << m;
+  EXPECT_NE(m.find("--set file.k[1]: expected a number, got 'x'"), std::string::npos) << m;
+  EXPECT_NE(m.find("--set camera.colour: unknown key"), std::string::npos) << m;
+  EXPECT_NE(m.find("--set 'nonsense': expected KEY=VALUE"), std::string::npos) << m;
+  EXPECT_NE(m.find("--set file.loop: expected true or false, got 'maybe'"), std::string::npos) << m;
+  EXPECT_NE(m.find("--set camera.width = -3: must be > 0"), std::string::npos) << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+}
+
+TEST(ConfigLayers, AnUnknownKeyInTheSecondFileNamesThatFile) {
+  const std::string a = write_file("first.yaml", "camera: {width: 100}\n");
+  const std::string b = write_file("second.yaml", "camera:\n  width: 0\n  colour: red\n");
+  const std::string m = error_of(ConfigSources{{a, b}, {}});
+  EXPECT_NE(m.find("2 problems"), std::string::npos) << m;
+  EXPECT_NE(m.find(b + ":3: camera.colour: unknown key"), std::string::npos) << m;
+  EXPECT_NE(m.find(b + ": camera.width = 0: must be > 0"), std::string::npos) << "the file that gave the value: " << m;
+  EXPECT_EQ(m.find(a + ":"), std::string::npos) << "the first file has no problem: " << m;
+  // A file that cannot be read is named, whichever layer it is.
+  EXPECT_NE(error_of(ConfigSources{{a, "/nonexistent/second.yaml"}, {}}).find("/nonexistent/second.yaml: cannot open"),
+            std::string::npos);
+}
+
+TEST(ConfigLayers, OneFileReadsAsBeforeAndDescribeNamesEverySource) {
+  const std::string a = write_file("one.yaml", "camera:\n  fps: fast\n");
+  EXPECT_NE(error_of(ConfigSources{{a}, {}}).find(a + ":2: camera.fps: expected a number"), std::string::npos);
+  EXPECT_EQ(ConfigSources{}.describe(), "built-in defaults");
+  EXPECT_EQ((ConfigSources{{"a.yaml", "b.yaml"}, {"x.y=1"}}.describe()), "a.yaml, b.yaml, --set x.y=1");
+  EXPECT_EQ(load_options<Demo>(ConfigSources{}).width, 640);
+}
+
+}  // namespace layered

@@ -19,7 +19,19 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Reads an options struct from a YAML file of sections (`section: {key: value}`), collecting every
+/// Where a configuration comes from: YAML files read in order, then `key=value` overrides (the command line's
+/// `--config A --config B --set k=v`). A key in a later file replaces the same key of an earlier one; a `--set`
+/// replaces both. No file and no `--set`: the built-in defaults.
+struct ConfigSources {
+  std::vector<std::string> files;  ///< --config FILE, in order
+  std::vector<std::string> sets;   ///< --set KEY=VALUE, in order (VALUE: a YAML scalar or flow sequence)
+
+  bool empty() const { return files.empty() && sets.empty(); }
+  /// "built-in defaults", "a.yaml", or "a.yaml, b.yaml, --set k=v" (for --print-config headers).
+  std::string describe() const;
+};
+
+/// Reads an options struct from YAML files of sections (`section: {key: value}`), collecting every
 /// problem before failing once.
 ///
 /// An options struct describes its keys once:
@@ -38,13 +50,20 @@ class ConfigLoader {
   static ConfigLoader from_file(const std::string& path);
   /// Parses YAML text; `source_name` stands for the file name in messages.
   static ConfigLoader from_string(const std::string& yaml_text, const std::string& source_name);
+  /// Layers `sources`: every file in order, then every `--set`. Each key remembers the file (and line) or the
+  /// `--set` that gave it, and every problem names that source. Throws ConfigError at once for a file that is
+  /// unreadable or not YAML; a `--set` that is not KEY=VALUE, or whose value is not a scalar or a sequence, is one
+  /// of the problems finish() reports.
+  static ConfigLoader from_sources(const ConfigSources& sources);
 
   template <class T>
   void operator()(const std::string& key, T& value, const char* /*doc*/) {
     known_.insert(key);
     auto it = leaves_.find(key);
     if (it == leaves_.end()) return;
-    convert(key, it->second, value);
+    current_ = &it->second;
+    convert(key, it->second.node, value);
+    current_ = nullptr;
   }
 
   /// Throws ConfigError listing every conversion error, every unknown key and every entry of
@@ -55,9 +74,19 @@ class ConfigLoader {
   const std::vector<std::string>& errors() const { return errors_; }
 
  private:
+  /// One value and where it came from.
+  struct Leaf {
+    YAML::Node node;     ///< scalar, sequence or null
+    std::string source;  ///< the file name, or "--set"
+    bool has_lines;      ///< whether node's line numbers refer to `source` (not for a --set value)
+  };
   ConfigLoader(std::string source_name, const YAML::Node& root);
-  void flatten(const YAML::Node& node, const std::string& prefix);
+  explicit ConfigLoader(std::string source_name) : source_name_(std::move(source_name)) {}
+  void flatten(const YAML::Node& node, const std::string& prefix, const std::string& source);
+  void add_set(const std::string& assignment);
+  /// "file:line: key", or "--set key" for a --set value: `node` of the leaf being converted (current_).
   std::string where(const std::string& key, const YAML::Node& node) const;
+  std::string where(const std::string& key, const YAML::Node& node, const std::string& source, bool has_lines) const;
   void convert(const std::string& key, const YAML::Node& node, bool& out);
   void convert(const std::string& key, const YAML::Node& node, int& out);
   void convert(const std::string& key, const YAML::Node& node, int64_t& out);
@@ -67,8 +96,9 @@ class ConfigLoader {
   void convert(const std::string& key, const YAML::Node& node, std::vector<int>& out);
   void convert(const std::string& key, const YAML::Node& node, std::vector<std::string>& out);
 
-  std::string source_name_;
-  std::map<std::string, YAML::Node> leaves_;  // dotted key -> scalar or sequence node
+  std::string source_name_;            // every source, for problems that no single key's source owns
+  std::map<std::string, Leaf> leaves_;  // dotted key -> its value from the last source that gave it
+  const Leaf* current_ = nullptr;       // the leaf convert() is working on (names its source)
   std::set<std::string> known_;
   std::vector<std::string> errors_;
 };
@@ -107,6 +137,22 @@ template <class Options>
 Options load_options(const std::string& path) {
   Options options;
   ConfigLoader loader = ConfigLoader::from_file(path);
+  options.visit(loader);
+  loader.finish(options.validate());
+  return options;
+}
+
+/// Loads `Options` from layered files and `--set` overrides (defaults for keys none gives) and validates it.
+/// Throws ConfigError naming, for each bad key, the file or `--set` that gave it, every problem at once.
+template <class Options>
+Options load_options(const ConfigSources& sources) {
+  Options options;
+  if (sources.empty()) {
+    if (const auto problems = options.validate(); !problems.empty())
+      throw ConfigError("built-in defaults invalid: " + problems.front());
+    return options;
+  }
+  ConfigLoader loader = ConfigLoader::from_sources(sources);
   options.visit(loader);
   loader.finish(options.validate());
   return options;

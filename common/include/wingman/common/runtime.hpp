@@ -34,7 +34,9 @@ struct ProcessInfo {
 
 /// Options common to every process, from the command line (not the YAML file).
 struct RuntimeOptions {
-  std::string config_path;         ///< --config FILE; "" = built-in defaults
+  /// --config FILE (repeatable, read in order: a later file's keys win) and --set KEY=VALUE (repeatable, applied
+  /// after every file); none = built-in defaults.
+  ConfigSources config;
   bool print_config = false;       ///< --print-config: print the effective config and exit 0
   std::string lcm_url;             ///< --lcm-url; "" = LCM_DEFAULT_URL or LCM's default
   std::string lcm_in;              ///< --lcm-in: URL to read from; "" = lcm_url
@@ -249,30 +251,35 @@ void Runtime::publish(const std::string& channel, const Msg& msg) {
   status_.output(channel, msg.utime);
 }
 
-/// Sets up logging, parses the common options and `--config`, builds the Runtime and runs `body`.
+/// Sets up logging, parses the common options, `--config` and `--set`, builds the Runtime and runs `body`.
 /// Turns every error into one line on stderr and an exit code: 0 on success, SIGINT/SIGTERM or end
 /// of a file input; 2 for a bad command line or config; 1 for any other fatal error.
-/// `Options` needs visit() and validate() (see ConfigLoader).
+/// `load_config(sources, print)` loads the options (throws ConfigError) and returns, when `print`, the
+/// `--print-config` text.
+int run_process_impl(const ProcessInfo& info, int argc, char** argv,
+                     const std::function<std::string(const ConfigSources& sources, bool print)>& load_config,
+                     const std::function<int(Runtime&)>& body);
+
+/// The same for a process whose loader reads one file (`path`, "" = built-in defaults): several --config or a
+/// --set are a configuration error (exit 2) naming this.
 int run_process_impl(const ProcessInfo& info, int argc, char** argv,
                      const std::function<std::string(const std::string& path, bool print)>& load_config,
                      const std::function<int(Runtime&)>& body);
 
+/// run_process_impl for an `Options` struct with visit() and validate() (see ConfigLoader), loaded from the
+/// layered --config files and --set overrides.
 template <class Options>
 int run_process(const ProcessInfo& info, int argc, char** argv,
                 const std::function<int(Runtime&, const Options&)>& body) {
   Options options;
-  auto load = [&](const std::string& path, bool print) -> std::string {
-    if (!path.empty())
-      options = load_options<Options>(path);
-    else {
-      const auto problems = options.validate();
-      if (!problems.empty()) throw ConfigError("built-in defaults invalid: " + problems.front());
-    }
+  auto load = [&](const ConfigSources& sources, bool print) -> std::string {
+    options = load_options<Options>(sources);
     if (!print) return "";
     return print_options(options, info.executable + " effective configuration" +
-                                      (path.empty() ? " (built-in defaults)" : " (from " + path + ")"));
+                                      (sources.empty() ? " (built-in defaults)" : " (from " + sources.describe() + ")"));
   };
-  return run_process_impl(info, argc, argv, load, [&](Runtime& rt) { return body(rt, options); });
+  return run_process_impl(info, argc, argv, std::function<std::string(const ConfigSources&, bool)>(load),
+                          [&](Runtime& rt) { return body(rt, options); });
 }
 
 }  // namespace wingman::common
