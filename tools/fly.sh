@@ -137,14 +137,15 @@ else
 fi
 
 # The box noise follows the scenario's seed (as the rendered noise does), so runs of different seeds differ.
-scenario_seed=$(awk '/^seed:/{print $2; exit}' "$scenario_file")
-case "$scenario_seed" in ''|*[!0-9]*) scenario_seed=1 ;; esac
+scenario_seed=$("$bin/wingman" scenario get "$scenario_file" seed)  # read and checked by the simulator's loader
 
 # Per-flight configs: the process defaults, plus config/flights/<scenario>.<process>.yaml where one exists.
 # flight_cfg PROCESS: sets cfg_args to (--config FILE) where that file exists, else to nothing.
 flight_cfg() { local f="$src/config/flights/$name.$1.yaml"; cfg_args=(); if [ -r "$f" ]; then cfg_args=(--config "$f"); fi; }
 if [ -n "$localizer_config" ]; then localizer_args=(--config "$localizer_config"); else flight_cfg localizer; localizer_args=("${cfg_args[@]}"); fi
 if [ -n "$follower_config" ]; then follower_args=(--config "$follower_config"); else flight_cfg follower_ctrl; follower_args=("${cfg_args[@]}"); fi
+# wingman eval reads the same follower configuration (its --follower-config) and the scenario for its target.
+follower_eval_args=(); [ ${#follower_args[@]} -eq 0 ] || follower_eval_args=(--follower-config "${follower_args[1]}")
 # Lockstep, paced at most 5x real time: the logger is outside the loop. Unpaced, a truth-mode flight ran ~2600
 # frames/s and a loaded machine's logger recorded 383 of 600 ground-truth frames; at 10x, 505-600 of 600 with six
 # busy loops beside it; at 5x, 600 of 600 in each of 10 such runs. Slower flights (rendering, the CNN) are not affected.
@@ -160,11 +161,13 @@ autopilot: $autopilot
 mavlink: {firmware: $firmware, streams: [odometry, attitude_quaternion, local_position_ned]}
 $own_pose_yaml
 YAML
+# The detector: its defaults with these keys over them (--set, read by its config loader).
+detector_args=(--set input.mode=replay)
 if [ "$detections" = cnn ]; then
-  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {cfg: "%s", weights: "%s"}\ndetection: {zoom_in: %s, flip_fusion: %s, coarse_pass: %s}\n' \
-    "$model_cfg" "$model_weights" "$zoom_in" "$flip_fusion" "$coarse_pass" > "$out/detector.yaml"
+  detector_args+=(--set "model.cfg=\"$model_cfg\"" --set "model.weights=\"$model_weights\"" --set "detection.zoom_in=$zoom_in"
+                  --set "detection.flip_fusion=$flip_fusion" --set "detection.coarse_pass=$coarse_pass")
 else
-  printf '# Written by tools/fly.sh for this flight.\ninput: {mode: replay}\nmodel: {weights: ""}\n' > "$out/detector.yaml"
+  detector_args+=(--set 'model.weights=""')
 fi
 
 pids=() logger_pid=""
@@ -180,7 +183,7 @@ echo "fly: scenario $name, LCM bus $url (private network namespace), output in $
 logger_args=(--lcm-url="$url" --force --quiet)
 [ "$record_images" = true ] || logger_args+=(--channel='IMAGE_.*' --invert-channels)
 lcm-logger "${logger_args[@]}" "$log" & logger_pid=$!
-"$bin/wingman-detector" --lcm-url "$url" --config "$out/detector.yaml" --log-level warn & pids+=($!)
+"$bin/wingman-detector" --lcm-url "$url" "${detector_args[@]}" --log-level warn & pids+=($!)
 "$bin/wingman-localizer" --lcm-url "$url" "${localizer_args[@]}" --log-level warn & pids+=($!)
 "$bin/wingman-follower-ctrl" --lcm-url "$url" "${follower_args[@]}" --log-level warn & pids+=($!)
 if [ "$autopilot" = mavlink ]; then
@@ -198,20 +201,10 @@ cleanup
 pids=() logger_pid=""
 trap - EXIT
 
-# Formation target of this flight, from the follower's effective config.
-follower_cfg=$("$bin/wingman-follower-ctrl" "${follower_args[@]}" --print-config)
-mode=$(echo "$follower_cfg" | awk '/^controller:/{c=1} c && /mode:/{gsub(/"/,"",$2); print $2; exit}')
-eval_args=("$log" --report "$out/report.html" --json "$out/eval.json" --csv "$out/targets.csv" --title "Wingman flight: $name")
-if [ "$mode" = formation ]; then
-  offset=$(echo "$follower_cfg" | awk '/^formation:/{f=1} f && /offset_m:/{sub(/.*offset_m:/,""); gsub(/[][ ]/,""); print; exit}')
-  eval_args+=(--formation-offset "$offset")
-elif [ "$mode" = pid_1d ]; then
-  # The 1-D follow keeps the leader straight ahead: the desired position is the leader's, moved back to the
-  # follower's own line (the scenario's start), so the horizontal error is the error along the leader's path.
-  fy=$(awk '/name: follower/{f=1} f && /position:/{gsub(/[][,]/," "); print $3; exit}' "$scenario_file")
-  ly=$(awk '/name: leader/{l=1} l && /position:/{gsub(/[][,]/," "); print $3; exit}' "$scenario_file")
-  eval_args+=(--formation-offset "0,$(awk -v a="$fy" -v b="$ly" 'BEGIN{print a - b}'),0")
-fi
+# The formation error is measured against the follower's own target: wingman eval reads the follower's configuration
+# (formation.offset_m) and, for the 1-D follow, the scenario's start (the leader moved back to the follower's line).
+eval_args=("$log" --report "$out/report.html" --json "$out/eval.json" --csv "$out/targets.csv" --title "Wingman flight: $name"
+           --scenario "$scenario_file" "${follower_eval_args[@]}")
 echo
 echo "fly: $name flown in $wall s of wall-clock time; errors against ground truth:"
 "$bin/wingman" eval "${eval_args[@]}"

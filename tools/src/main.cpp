@@ -4,6 +4,7 @@
 // (out-of-sample flights), train / val / import-halmstad (training).
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
+#include "wingman/tools/eval_target.hpp"
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
@@ -137,12 +138,28 @@ int main(int argc, char** argv) {
   // `eval` and `report` read a flight's log the same way; both take the matching options.
   EvalOptions eval, report;
   std::vector<double> eval_offset, report_offset;
+  FlightTargetSources eval_target, report_target;
   bool eval_json_stdout = false, eval_quiet = false, report_quiet = false;
-  const auto add_eval_options = [](CLI::App* c, EvalOptions& o, std::vector<double>& offset, bool& quiet) {
+  const auto add_eval_options = [](CLI::App* c, EvalOptions& o, std::vector<double>& offset,
+                                   FlightTargetSources& target, bool& quiet) {
     c->add_option("log", o.log, "LCM log with GROUND_TRUTH and TARGETS (and DETECTIONS_CAM0, IMAGE_CAM0)")->required();
     c->add_option("--formation-offset", offset, "Desired follower minus leader position x,y,z (ENU), metres")
         ->expected(3)
         ->delimiter(',');
+    c->add_option("--follower-config", target.follower.files,
+                  "The follower's configuration (wingman-follower-ctrl --config; repeatable, a later file wins): the "
+                  "formation error is measured against its target (mode formation: formation.offset_m; mode pid_1d: "
+                  "the leader moved to the follower's starting line, from --scenario)")
+        ->allow_extra_args(false)
+        ->type_name("FILE");
+    c->add_option("--follower-set", target.follower.sets,
+                  "KEY=VALUE over --follower-config, as wingman-follower-ctrl --set (repeatable)")
+        ->allow_extra_args(false)
+        ->type_name("KEY=VALUE");
+    c->add_option("--scenario", target.scenario,
+                  "The flight's scenario file (read with wingman-sim's loader): the vehicles' start for a pid_1d "
+                  "follower (ids --follower-id and --leader-id); with it and no --follower-config, the follower's "
+                  "built-in defaults are its configuration");
     c->add_option("--formation-height", o.formation_height_m, "The follower's constant height, metres");
     c->add_option("--settle", o.settle_s, "Skip this many seconds before measuring formation error (default 5)");
     c->add_option("--leader-id", o.leader_id, "vehicle_id of the leader in ground truth (default 1)");
@@ -161,14 +178,14 @@ int main(int argc, char** argv) {
   };
   auto* ev = app.add_subcommand(
       "eval", "Localization, tracking, latency and box errors of a simulated flight's log against its ground truth");
-  add_eval_options(ev, eval, eval_offset, eval_quiet);
+  add_eval_options(ev, eval, eval_offset, eval_target, eval_quiet);
   ev->add_option("--json", eval.json_path, "Also write the result as JSON to this file");
   ev->add_flag("--json-stdout", eval_json_stdout, "Print JSON instead of the table");
   ev->add_option("--csv", eval.csv_path, "Write the per-target time series (t, track, range, estimate, truth, error)");
   ev->add_option("--report", eval.report_path, "Write a self-contained HTML report to this file");
   auto* rp = app.add_subcommand(
       "report", "One self-contained HTML page about a simulated flight: charts and camera frames (opens offline)");
-  add_eval_options(rp, report, report_offset, report_quiet);
+  add_eval_options(rp, report, report_offset, report_target, report_quiet);
   rp->add_option("-o,--output", report.report_path, "HTML file to write")->required();
   rp->add_option("--json", report.json_path, "Also write the result as JSON to this file");
   rp->add_option("--csv", report.csv_path, "Also write the per-target time series as CSV to this file");
@@ -231,11 +248,26 @@ int main(int argc, char** argv) {
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);
     if (*bd) return run_bench_detector_verb(bench_detector, std::cout, std::cerr);
-    for (auto [cmd, o, offset, quiet] : {std::make_tuple(ev, &eval, &eval_offset, eval_quiet),
-                                         std::make_tuple(rp, &report, &report_offset, report_quiet)}) {
+    for (auto [cmd, o, offset, target, quiet] :
+         {std::make_tuple(ev, &eval, &eval_offset, &eval_target, eval_quiet),
+          std::make_tuple(rp, &report, &report_offset, &report_target, report_quiet)}) {
       if (!*cmd) continue;
+      if (!offset->empty() && target->given()) {
+        std::cerr << "wingman: error: --formation-offset, or the follower's configuration and the scenario "
+                     "(--follower-config, --follower-set, --scenario), not both (see --help)"
+                  << std::endl;
+        return 2;
+      }
       if (!offset->empty()) {
         o->formation_offset_in_world = {(*offset)[0], (*offset)[1], (*offset)[2]};
+        o->has_formation = true;
+      } else if (target->given()) {
+        try {
+          o->formation_offset_in_world = formation_offset_for(*target, o->follower_id, o->leader_id);
+        } catch (const wingman::common::ConfigError& e) {
+          std::cerr << "wingman: error: " << e.what() << std::endl;
+          return 2;
+        }
         o->has_formation = true;
       }
       if (!quiet) o->progress = &std::cerr;

@@ -394,15 +394,37 @@ ScenarioRandomResult write_sweep_scenario(const ScenarioSweepOptions& o) {
   return r;
 }
 
+namespace {
+
+// `wingman scenario get FILE KEY`: one top-level value of a scenario, read with the simulator's loader (scripts ask
+// for it instead of reading the YAML as text).
+std::string scenario_value(const std::string& path, const std::string& key) {
+  const sim::Scenario s = sim::load_scenario(path);  // every problem of the file at once
+  if (key == "name") return s.name;
+  if (key == "description") return s.description;
+  if (key == "start_utime") return std::to_string(s.start_utime);
+  if (key == "duration_s") return fmt::format("{}", s.duration_s);
+  if (key == "command_delay_s") return fmt::format("{}", s.command_delay_s);
+  if (key == "seed") return std::to_string(s.seed);
+  throw common::ConfigError(fmt::format(
+      "{}: no top-level key '{}' to get (name, description, start_utime, duration_s, command_delay_s or seed)", path,
+      key));
+}
+
+}  // namespace
+
 struct ScenarioVerbs::State {
   CLI::App* random = nullptr;
   CLI::App* sweep = nullptr;
+  CLI::App* get = nullptr;
+  std::string get_file, get_key;
   ScenarioRandomOptions options;
   ScenarioSweepOptions sweep_options;
 };
 
 ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
-  CLI::App* scenario = app.add_subcommand("scenario", "Simulation scenarios: random out-of-sample formation flights");
+  CLI::App* scenario = app.add_subcommand(
+      "scenario", "Simulation scenarios: random out-of-sample formation flights, range sweeps, a scenario's values");
   scenario->require_subcommand(1);
   ScenarioRandomOptions& o = s_->options;
   s_->random = scenario->add_subcommand(
@@ -435,11 +457,23 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->sweep->add_option("--step", w.step_m, "Step, m (default 0.5)");
   s_->sweep->add_option("--frames-per-step", w.frames_per_step, "Frames at each distance (default 8)");
   s_->sweep->add_option("--out", w.out, "The scenario file to write, FILE.yaml")->required();
+
+  s_->get = scenario->add_subcommand(
+      "get", "Print one top-level value of a scenario file, read (and checked) with wingman-sim's scenario loader");
+  s_->get->add_option("file", s_->get_file, "The scenario file")->required();
+  s_->get->add_option("key", s_->get_key, "name, description, start_utime, duration_s, command_delay_s or seed")
+      ->required();
 }
 
 ScenarioVerbs::~ScenarioVerbs() = default;
 
 int ScenarioVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (*s_->get) {
+    return run_verb("wingman scenario get", err, [&] {
+      out << scenario_value(s_->get_file, s_->get_key) << std::endl;
+      return 0;
+    });
+  }
   if (*s_->sweep) {
     return run_verb("wingman scenario sweep", err, [&] {
       const ScenarioRandomResult r = write_sweep_scenario(s_->sweep_options);
