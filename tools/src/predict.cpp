@@ -85,7 +85,9 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
   std::unique_ptr<detector::SizedDetector> pipeline;
   try {
     const int batch = options.detection.zoom_in ? std::min(8, options.detection.max_detections) : 1;
-    auto make_backend = [&](const detector::DarknetModel& sized) {
+    // Kept by the pipeline and called again when an image of another aspect needs a new network: it must own what it
+    // uses from this scope (batch by value; it once read a dangling `batch`, e.g. -501724864, issue #34).
+    auto make_backend = [&options, &err, batch](const detector::DarknetModel& sized) {
       std::string why;
       auto backend = detector::make_backend(options.backend, sized, detector::OpenClOptions{}, batch, &why);
       err << fmt::format("wingman predict: {} (network input {}x{})", why, sized.net.width, sized.net.height) << "\n";
