@@ -165,6 +165,10 @@ TEST(YoloDatasetWrite, LabelsAndDataYamlReadBack) {
     EXPECT_FLOAT_EQ(ds.images[0].boxes[i].h, boxes[i].h);
   }
   EXPECT_EQ(load_yolo_dataset(dir.file("data.yaml"), "val").images.size(), 1u);
+  // Issue #34: `path: .` made Ultralytics look in its datasets folder; without the key the root is the file's folder.
+  std::ifstream yaml(dir.file("data.yaml"));
+  const std::string text((std::istreambuf_iterator<char>(yaml)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("path:"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -292,7 +292,9 @@ void write_data_yaml(const std::string& path, const std::vector<std::string>& cl
                      const std::vector<std::string>& comments) {
   std::ofstream f(path);
   for (const std::string& c : comments) f << "# " << c << "\n";
-  f << "path: .\ntrain: images/train\nval: images/val\n";
+  // No `path:` key: readers take the data.yaml's own folder as the root (ours, and Ultralytics, which resolves a
+  // relative `path` against its datasets folder, not this file's), so the set works from anywhere and can be moved.
+  f << "train: images/train\nval: images/val\n";
   f << "nc: " << class_names.size() << "\nnames: [";
   for (size_t i = 0; i < class_names.size(); ++i) f << (i ? ", " : "") << class_names[i];
   f << "]\n";
