@@ -7,5 +7,8 @@
 # --render, --duration 30); see tools/fly.sh --help. The camera-driver demo of a video file: tools/demo_camera.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+for a in "$@"; do  # help without building
+  case "$a" in -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; echo; exec tools/fly.sh --help ;; esac
+done
 tools/build.sh
 exec tools/fly.sh "$@"

@@ -7,6 +7,7 @@
 #        e.g. tools/demo_camera.sh ../shared/datasets/halmstad/videos/V_DRONE_001.mp4 for a real one)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+case "${1:-}" in -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; exit 0 ;; esac  # help without building
 tools/build.sh
 out=build/demo
 mkdir -p "$out"

@@ -6,6 +6,9 @@
 # the host. Tests that read ../shared skip with a message when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+case "${1:-}" in  # help without building
+  -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; echo "Arguments (a selection) go to ctest, e.g. tools/test.sh -R Localizer."; exit 0 ;;
+esac
 tools/build.sh
 export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
 ctest --test-dir build --output-on-failure -j2 --timeout 900 "$@"
