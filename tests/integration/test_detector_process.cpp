@@ -79,7 +79,7 @@ DetectorRun run_detector(const TempDir& dir, const std::string& in, const std::s
   const std::string out = dir.file(name + ".lcmlog");
   const auto r = run({bin_path("wingman-detector"), "--config", cfg, "--lcm-in", "file://" + in + "?speed=0",
                       "--lcm-out", "file://" + out + "?mode=w"},
-                     120s);
+                     240s);  // a bound: seconds here, over 120 s under ThreadSanitizer beside other work
   if (r.exit_code != 0) throw std::runtime_error("detector failed: " + r.err);
   DetectorRun result;
   for (const auto& e : read_log(out)) {
