@@ -69,14 +69,14 @@ fi
 export PYENV_VERSION=system WINGMAN_BIN_DIR="$bin"
 py() { python3 "$src/tools/experiment_summary.py" "$@"; }
 
-# A copy of a scenario with some top-level or motion keys replaced (sed expressions), named like the original so that
-# fly.sh finds its config/flights/NAME.* files.
-scenario_variant() {  # dir scenario sed-expression...
+# A copy of a scenario with some keys replaced (wingman scenario set: KEY=VALUE, a vehicle named by its name; the copy is
+# read back with the simulator's scenario loader), named like the original so that fly.sh finds its
+# config/flights/NAME.* files.
+scenario_variant() {  # dir scenario KEY=VALUE...
   local dir="$1" scn="$2"; shift 2
-  mkdir -p "$dir"
   local args=()
-  for e in "$@"; do args+=(-e "$e"); done
-  sed "${args[@]}" "$src/config/scenarios/$scn.yaml" > "$dir/$scn.yaml"
+  for kv in "$@"; do args+=(--set "$kv"); done
+  "$bin/wingman" scenario set "$src/config/scenarios/$scn.yaml" "${args[@]}" --out "$dir/$scn.yaml" > /dev/null || exit 1
   echo "$dir/$scn.yaml"
 }
 
@@ -94,7 +94,7 @@ static_sweep() {
   local out="$out_root/static_sweep" fps=8; $quick && fps=2
   rm -rf "$out"; mkdir -p "$out"
   # The thesis: a hovering drone seen from the side from 0.5 to 30 m; 8 frames per 0.25 m step.
-  local scn; scn=$(scenario_variant "$out/scenario" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/")
+  local scn; scn=$(scenario_variant "$out/scenario" static_sweep "vehicles.camera.motion.frames_per_step=$fps")
   # The bounding sphere's own radius (the default quad's) and ratio 1 (no box relation), so that the sweep measures
   # the boxes' raw range scale.
   printf 'target: {radius_m: 0.348, box_relation: sphere}\n' > "$out/sphere.localizer.yaml"
@@ -103,9 +103,8 @@ static_sweep() {
   # The same sweep with the drone turned 90 degrees, seen from behind as a follower sees its leader (single pass): the
   # boxes' width, and so the range scale, depends on the view (models/wingman-small.boxes.yaml tabulates it by the
   # box's aspect).
-  local behind; behind=$(scenario_variant "$out/scenario-behind" static_sweep "s/frames_per_step: 100/frames_per_step: $fps/" \
-    "s/yaw_deg: 0 *# seen from the side/yaw_deg: 90               # seen from behind/")
-  grep -q "seen from behind" "$behind" || { echo "experiment: could not turn the drone in $behind" >&2; exit 1; }
+  local behind; behind=$(scenario_variant "$out/scenario-behind" static_sweep "vehicles.camera.motion.frames_per_step=$fps" \
+    "vehicles.target.initial.yaw_deg=90")
   fly "$out/behind" --scenario "$behind" --localizer-config "$out/sphere.localizer.yaml"
   py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json" "$out/behind/eval.json"
 }
@@ -117,8 +116,7 @@ calibration() {
   # the simulator's default quad) and the shipped box relation, on a formation flight like the ones measured, with
   # another seed (7; formation_2d's runs use 1-3 and the README's flight 2). The summary reports the median true /
   # estimated range of the leader's targets (1: the relation holds on this view) and the radius it would imply.
-  local scn; scn=$(scenario_variant "$out/scenario" formation_2d "s/^seed: .*/seed: 7/")
-  grep -q "^seed: 7$" "$scn" || { echo "experiment: could not set the seed in $scn" >&2; exit 1; }
+  local scn; scn=$(scenario_variant "$out/scenario" formation_2d seed=7)
   fly "$out/run" --scenario "$scn" --duration "$dur"
   py calibration "$out" 0.348 "$out/run/eval.json"
 }
@@ -150,7 +148,7 @@ formation_2d() {
   rm -rf "$out"; mkdir -p "$out"
   local runs=()
   for seed in 1 2 3; do
-    local scn; scn=$(scenario_variant "$out/scenario$seed" formation_2d "s/^seed: .*/seed: $seed/")
+    local scn; scn=$(scenario_variant "$out/scenario$seed" formation_2d "seed=$seed")
     fly "$out/run$seed" --scenario "$scn" --duration "$dur"
     runs+=("$out/run$seed/eval.json")
   done
@@ -161,9 +159,9 @@ max_range() {
   local out="$out_root/max_range" fps=2; $quick && fps=1
   rm -rf "$out"; mkdir -p "$out"
   # The static sweep carried on to 60 m in 0.5 m steps from 10 m, an F450-sized quad (the default airframe).
-  local scn; scn=$(scenario_variant "$out/scenario" static_sweep \
-    "s/frames_per_step: 100/frames_per_step: $fps/" "s/position: \[0, -0.5, 5\]/position: [0, -10, 5]/" \
-    "s/step: \[0, -0.25, 0\]/step: [0, -0.5, 0]/" "s/steps: 119 /steps: 100 /")
+  local scn; scn=$(scenario_variant "$out/scenario" static_sweep "vehicles.camera.motion.frames_per_step=$fps" \
+    "vehicles.camera.initial.position=[0, -10, 5]" "vehicles.camera.motion.step=[0, -0.5, 0]" \
+    "vehicles.camera.motion.steps=100")
   fly "$out/single" --scenario "$scn"
   py max_range "$out" "$out/single/eval.json"
 }

@@ -2,6 +2,8 @@
 // `wingman scenario random`: a seeded random formation flight for wingman-sim, with the configs fly.sh flies it with.
 #include "wingman/tools/scenario_random.hpp"
 
+#include "wingman/tools/scenario_edit.hpp"
+
 #include "run_verb.hpp"
 #include "synth_random.hpp"
 
@@ -418,6 +420,8 @@ struct ScenarioVerbs::State {
   CLI::App* sweep = nullptr;
   CLI::App* get = nullptr;
   std::string get_file, get_key;
+  CLI::App* set = nullptr;
+  ScenarioSetOptions set_options;
   ScenarioRandomOptions options;
   ScenarioSweepOptions sweep_options;
 };
@@ -463,11 +467,30 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->get->add_option("file", s_->get_file, "The scenario file")->required();
   s_->get->add_option("key", s_->get_key, "name, description, start_utime, duration_s, command_delay_s or seed")
       ->required();
+
+  ScenarioSetOptions& c = s_->set_options;
+  s_->set = scenario->add_subcommand(
+      "set", "Write a copy of a scenario with keys replaced, read back with wingman-sim's scenario loader");
+  s_->set->add_option("file", c.file, "The scenario file to copy")->required();
+  s_->set->add_option("--set", c.sets,
+                      "KEY=VALUE, repeatable, in order: KEY a dotted path, a vehicle named by its name (seed=7, "
+                      "vehicles.camera.motion.frames_per_step=2, vehicles.target.initial.position=[0,-10,5]); VALUE "
+                      "a YAML scalar or flow sequence")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  s_->set->add_option("--out", c.out, "The copy to write")->required();
 }
 
 ScenarioVerbs::~ScenarioVerbs() = default;
 
 int ScenarioVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (*s_->set) {
+    return run_verb("wingman scenario set", err, [&] {
+      write_scenario_copy(s_->set_options);
+      out << "wrote " << s_->set_options.out << std::endl;
+      return 0;
+    });
+  }
   if (*s_->get) {
     return run_verb("wingman scenario get", err, [&] {
       out << scenario_value(s_->get_file, s_->get_key) << std::endl;
