@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # The demo's pipeline run; call it through tools/netns_run.sh (it refuses to multicast on the host).
-# Usage: tools/demo_pipeline.sh VIDEO OUTDIR
+# Usage: tools/demo_pipeline.sh VIDEO OUTDIR   (WINGMAN_BIN_DIR: the executables, default build/bin)
 set -euo pipefail
 [ "${WINGMAN_IN_NETNS:-}" = "1" ] || { echo "demo_pipeline: run me through tools/netns_run.sh" >&2; exit 1; }
-video="$1"; out="$2"; bin=build/bin; url="$WINGMAN_LCM_URL"
+video="$1"; out="$2"; bin="${WINGMAN_BIN_DIR:-build/bin}"; url="$WINGMAN_LCM_URL"
 log="$out/demo.lcmlog"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }

@@ -7,7 +7,9 @@ src="$1"; bin="$2"
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 "$bin/wingman" make-video "$out/clip.avi" --frames 30 --width 320 --height 240
 cd "$src"
-log=$(timeout 120 tools/netns_run.sh tools/demo_pipeline.sh "$out/clip.avi" "$out" 2>&1) || { echo "$log"; exit 1; }
+# The executables of the build under test (build-tsan's under ThreadSanitizer), not build/bin.
+log=$(WINGMAN_BIN_DIR="$bin" timeout 120 tools/netns_run.sh tools/demo_pipeline.sh "$out/clip.avi" "$out" 2>&1) ||
+  { echo "$log"; exit 1; }
 echo "$log"
 fail() { echo "demo_test: $1" >&2; exit 1; }
 echo "$log" | grep -Eq '^IMAGE_CAM0 +image_t +30 ' || fail "expected 30 image_t frames on IMAGE_CAM0"
