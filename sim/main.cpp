@@ -464,9 +464,10 @@ int main(int argc, char** argv) {
 
   sim::SimOptions options;
   std::optional<sim::Scenario> scenario;
-  auto load = [&](const std::string& path, bool print) -> std::string {
-    if (!path.empty()) {
-      options = common::load_options<sim::SimOptions>(path);
+  // The layered --config files and --set overrides, through the one loader (common/config.hpp), as every process.
+  auto load = [&](const common::ConfigSources& sources, bool print) -> std::string {
+    if (!sources.empty()) {
+      options = common::load_options<sim::SimOptions>(sources);
     } else if (const auto problems = options.validate(); !problems.empty()) {
       throw common::ConfigError("built-in defaults invalid: " + problems.front());
     }
@@ -477,8 +478,9 @@ int main(int argc, char** argv) {
       options.render_options = common::load_options<RenderConfig>(*render_config_arg).render;
     }
     if (print) {
-      return common::print_options(options, info.executable + " effective configuration" +
-                                                (path.empty() ? " (built-in defaults)" : " (from " + path + ")"));
+      return common::print_options(
+          options, info.executable + " effective configuration" +
+                       (sources.empty() ? " (built-in defaults)" : " (from " + sources.describe() + ")"));
     }
     if (options.scenario.empty()) {
       throw common::ConfigError(
@@ -489,6 +491,7 @@ int main(int argc, char** argv) {
     if (duration_arg) scenario->duration_s = *duration_arg;
     return "";
   };
-  return common::run_process_impl(info, static_cast<int>(args.size()), args.data(), load,
+  return common::run_process_impl(info, static_cast<int>(args.size()), args.data(),
+                                  std::function<std::string(const common::ConfigSources&, bool)>(load),
                                   [&](common::Runtime& rt) { return run(rt, options, *scenario); });
 }

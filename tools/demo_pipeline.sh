@@ -24,13 +24,10 @@ for _ in $(seq 120); do
   sleep 0.5
 done
 
-cat > "$out/camera_driver.yaml" <<YAML
-# Demo: play the clip once at its own rate, stamped by the wall clock like a live camera.
-source: {kind: file}
-file: {path: "$video", mode: realtime, loop: false}
-YAML
 echo "demo: playing $video through wingman-camera-driver"
-"$bin/wingman-camera-driver" --config "$out/camera_driver.yaml" --lcm-url "$url" --status-period 0.5
+# Play the clip once at its own rate, stamped by the wall clock like a live camera.
+"$bin/wingman-camera-driver" --set source.kind=file --set "file={path: \"$video\", mode: realtime, loop: false}" \
+  --lcm-url "$url" --status-period 0.5
 # The detector may still be working on the last frames (or building a network for the clip's frame size): wait, at
 # most 60 s, until its heartbeat has every frame accounted for (detected or counted as dropped), then one more
 # heartbeat from every process.

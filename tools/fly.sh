@@ -76,12 +76,13 @@ case "$truth_box" in sphere|silhouette) ;; *) echo "fly: --truth-box '$truth_box
 case "$detections" in cnn|truth) ;; *) echo "fly: --detections '$detections': expected cnn or truth" >&2; exit 2 ;; esac
 case "$autopilot" in lcm|mavlink) ;; *) echo "fly: --autopilot '$autopilot': expected lcm or mavlink" >&2; exit 2 ;; esac
 case "$firmware" in px4|ardupilot) ;; *) echo "fly: --firmware '$firmware': expected px4 or ardupilot" >&2; exit 2 ;; esac
-own_pose_yaml=""
+own_pose_sets=()
 if [ -n "$own_pose_error" ]; then  # the values are checked by wingman-sim's config loader (own_pose.*)
   IFS=, read -r pose_m pose_rad pose_tau pose_extra <<< "$own_pose_error"
   [ -n "$pose_m" ] && [ -n "$pose_rad" ] && [ -z "$pose_extra" ] ||
     { echo "fly: --own-pose-error '$own_pose_error': expected M,RAD or M,RAD,TAU (e.g. 0.3,0.01)" >&2; exit 2; }
-  own_pose_yaml="own_pose: {position_std_m: $pose_m, attitude_std_rad: $pose_rad, correlation_time_s: ${pose_tau:-2.0}}"
+  own_pose_sets=(--set "own_pose.position_std_m=$pose_m" --set "own_pose.attitude_std_rad=$pose_rad"
+                 --set "own_pose.correlation_time_s=${pose_tau:-2.0}")
 fi
 [ -r "$scenario_file" ] || { echo "fly: no scenario '$scenario' (looked for $scenario_file)" >&2; exit 2; }
 out="${out:-$src/build/flights/$name}"
@@ -149,18 +150,17 @@ follower_eval_args=(); [ ${#follower_args[@]} -eq 0 ] || follower_eval_args=(--f
 # Lockstep, paced at most 5x real time: the logger is outside the loop. Unpaced, a truth-mode flight ran ~2600
 # frames/s and a loaded machine's logger recorded 383 of 600 ground-truth frames; at 10x, 505-600 of 600 with six
 # busy loops beside it; at 5x, 600 of 600 in each of 10 such runs. Slower flights (rendering, the CNN) are not affected.
-wait_for="detector, localizer, follower_ctrl"
-[ "$autopilot" = lcm ] || wait_for="$wait_for, mavlink_bridge"
-cat > "$out/sim.yaml" <<YAML
-# Written by tools/fly.sh for this flight.
-scenario: {file: "$scenario_file"}
-sync: {mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: [$wait_for], startup_timeout_s: 60.0}
-detections: {from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0, seed: $scenario_seed}
-render: {enabled: $render}
-autopilot: $autopilot
-mavlink: {firmware: $firmware, streams: [odometry, attitude_quaternion, local_position_ned]}
-$own_pose_yaml
-YAML
+wait_for="[detector, localizer, follower_ctrl]"
+[ "$autopilot" = lcm ] || wait_for="[detector, localizer, follower_ctrl, mavlink_bridge]"
+# The simulator: its defaults with these keys over them (--set, read by its config loader, as for every process).
+sim_sets=(--set "scenario.file=$scenario_file"
+  --set "sync={mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: $wait_for, startup_timeout_s: 60.0}"
+  --set "detections={from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0, seed: $scenario_seed}"
+  --set "render.enabled=$render" --set "autopilot=$autopilot"
+  --set "mavlink={firmware: $firmware, streams: [odometry, attitude_quaternion, local_position_ned]}"
+  "${own_pose_sets[@]}")
+# The flight's effective simulator configuration, as the loader merged it (a record; the process reads the --set).
+"$bin/wingman-sim" "${sim_sets[@]}" --print-config > "$out/sim.yaml"
 # The detector: its defaults with these keys over them (--set, read by its config loader).
 detector_args=(--set input.mode=replay)
 if [ "$detections" = cnn ]; then
@@ -191,7 +191,7 @@ if [ "$autopilot" = mavlink ]; then
   "$bin/wingman-mavlink" --lcm-url "$url" --config "$src/config/mavlink_bridge.sim.yaml" --log-level info & pids+=($!)
 fi
 
-sim_args=(--lcm-url "$url" --config "$out/sim.yaml")
+sim_args=(--lcm-url "$url" "${sim_sets[@]}")
 [ -n "$duration" ] && sim_args+=(--duration "$duration")
 [ -n "$render_config" ] && sim_args+=(--render-config "$render_config")
 SECONDS=0

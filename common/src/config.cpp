@@ -94,8 +94,8 @@ void ConfigLoader::add_set(const std::string& assignment) {
   bool plain = !key.empty() && key.front() != '.' && key.back() != '.' && key.find("..") == std::string::npos;
   for (char c : key) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-');
   if (!plain) {
-    errors_.push_back(fmt::format("--set '{}': expected KEY=VALUE with KEY a dotted name (e.g. formation.offset_m=[-6,2,0])",
-                                  assignment));
+    errors_.push_back(fmt::format(
+        "--set '{}': expected KEY=VALUE with KEY a dotted name (e.g. formation.offset_m=[-6,2,0])", assignment));
     return;
   }
   const std::string text = assignment.substr(eq + 1);

@@ -122,7 +122,10 @@ const WireStruct kOwnPose{"own_pose_t",
                            {"frame", Wire::kI8},
                            {"p_body_in_world", Wire::kF64, 3},
                            {"q_body_to_world", Wire::kF64, 4},
-                           {"v_body_in_world", Wire::kF64, 3}}};
+                           {"v_body_in_world", Wire::kF64, 3},
+                           {"has_covariance", Wire::kBool},
+                           {"cov_p_body_in_world", Wire::kF64, 6},
+                           {"var_rpy_body", Wire::kF64, 3}}};
 const WireStruct kSetpoint{"setpoint_t",
                            {{"utime", Wire::kI64},
                             {"mode", Wire::kI8},

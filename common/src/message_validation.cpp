@@ -56,7 +56,8 @@ std::string check_pose_covariance(const wingman::own_pose_t& m) {
   if (!all_finite(m.cov_p_body_in_world)) return "own_pose_t.cov_p_body_in_world: must be finite";
   if (!all_finite(m.var_rpy_body)) return "own_pose_t.var_rpy_body: must be finite";
   for (int i = 0; i < 3; ++i)
-    if (m.var_rpy_body[i] < 0) return fmt::format("own_pose_t.var_rpy_body[{}] = {}: must be >= 0", i, m.var_rpy_body[i]);
+    if (m.var_rpy_body[i] < 0)
+      return fmt::format("own_pose_t.var_rpy_body[{}] = {}: must be >= 0", i, m.var_rpy_body[i]);
   // Upper triangle row by row: (0,0) (0,1) (0,2) (1,1) (1,2) (2,2).
   static constexpr int kIndex[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
   for (int i = 0; i < 3; ++i) {

@@ -372,17 +372,6 @@ int Runtime::shutdown(const std::string& reason) {
 }
 
 int run_process_impl(const ProcessInfo& info, int argc, char** argv,
-                     const std::function<std::string(const std::string&, bool)>& load_config,
-                     const std::function<int(Runtime&)>& body) {
-  auto one_file = [&](const ConfigSources& sources, bool print) -> std::string {
-    if (sources.files.size() > 1 || !sources.sets.empty())
-      throw ConfigError("this process reads one --config FILE and takes no --set (got " + sources.describe() + ")");
-    return load_config(sources.files.empty() ? std::string() : sources.files.front(), print);
-  };
-  return run_process_impl(info, argc, argv, std::function<std::string(const ConfigSources&, bool)>(one_file), body);
-}
-
-int run_process_impl(const ProcessInfo& info, int argc, char** argv,
                      const std::function<std::string(const ConfigSources&, bool)>& load_config,
                      const std::function<int(Runtime&)>& body) {
   const std::string prog = info.executable;

@@ -52,7 +52,7 @@ void Localizer::on_own_pose(const wingman::own_pose_t& m) {
           .normalized();
   s.v_body_in_world = Eigen::Vector3d(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
   if (m.has_covariance && options_.pose.use_covariance) {
-    const double* c = m.cov_p_body_in_world;  // upper triangle row by row: xx xy xz yy yz zz
+    const double* c = m.cov_p_body_in_world;    // upper triangle row by row: xx xy xz yy yz zz
     s.cov_p_body_in_world << c[0], c[1], c[2],  //
         c[1], c[3], c[4],                       //
         c[2], c[4], c[5];

@@ -101,8 +101,10 @@ std::optional<NedPose> OwnPoseAssembler::on_odometry(const mavlink::Odometry& m,
         c[2], c[7], c[11];
     const Eigen::Vector3d var_rpy(c[15], c[18], c[20]);
     std::string problem;
-    if (!P.allFinite() || !var_rpy.allFinite()) problem = "not finite";
-    else if ((P.diagonal().array() < 0).any() || (var_rpy.array() < 0).any()) problem = "a negative variance";
+    if (!P.allFinite() || !var_rpy.allFinite())
+      problem = "not finite";
+    else if ((P.diagonal().array() < 0).any() || (var_rpy.array() < 0).any())
+      problem = "a negative variance";
     for (int i = 0; i < 3 && problem.empty(); ++i)
       for (int j = i + 1; j < 3 && problem.empty(); ++j)
         if (std::abs(P(i, j)) > std::sqrt(P(i, i) * P(j, j)) * (1 + 1e-6) + 1e-300)

@@ -195,7 +195,7 @@ TEST(ConfigLayers, LaterFilesWinKeyByKeyAndKeepTheRest) {
   const std::string a = write_file("a.yaml", "camera: {width: 1280, fps: 15}\nfile: {k: [1, 2, 3]}\n");
   const std::string b = write_file("b.yaml", "camera:\n  fps: 60\n");
   const Demo ab = load_options<Demo>(ConfigSources{{a, b}, {}});
-  EXPECT_EQ(ab.width, 1280);  // only in a
+  EXPECT_EQ(ab.width, 1280);     // only in a
   EXPECT_DOUBLE_EQ(ab.fps, 60);  // b over a
   EXPECT_EQ(ab.k, (std::vector<double>{1, 2, 3}));
   const Demo ba = load_options<Demo>(ConfigSources{{b, a}, {}});
@@ -218,8 +218,8 @@ TEST(ConfigLayers, SetTakesScalarsAndSequencesOverEveryFile) {
 
 TEST(ConfigLayers, EveryBadSetIsNamedWithTheFilesProblemsInOneLine) {
   const std::string a = write_file("bad_a.yaml", "camera:\n  fps: fast\n");
-  const std::string m = error_of(ConfigSources{
-      {a}, {"camera.width=-3", "file.k=[1, x]", "camera.colour=red", "nonsense", "file.loop=maybe"}});
+  const std::string m = error_of(
+      ConfigSources{{a}, {"camera.width=-3", "file.k=[1, x]", "camera.colour=red", "nonsense", "file.loop=maybe"}});
   EXPECT_NE(m.find("6 problems"), std::string::npos) << m;
   EXPECT_NE(m.find(a + ":2: camera.fps: expected a number, got 'fast'"), std::string::npos) << m;
   EXPECT_NE(m.find("--set file.k[1]: expected a number, got 'x'"), std::string::npos) << m;

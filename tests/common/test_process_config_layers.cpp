@@ -17,8 +17,8 @@ using wingman::testing::source_path;
 using wingman::testing::TempDir;
 
 struct Process {
-  std::string executable, config;      // its shipped config/<config>.yaml
-  std::string text_key, a, b;          // a string key (section.name) layered by two files, and their values
+  std::string executable, config;        // its shipped config/<config>.yaml
+  std::string text_key, a, b;            // a string key (section.name) layered by two files, and their values
   std::string number_key, set, printed;  // a key (section.name) set by --set, and its printed line
 };
 const std::vector<Process> kProcesses = {
@@ -33,6 +33,9 @@ const std::vector<Process> kProcesses = {
      "max_segment_mib: 77.0"},
     {"wingman-mavlink", "mavlink_bridge", "link.url", "udp://:14550", "udp://:14551", "link.baud", "57600",
      "baud: 57600"},
+#ifdef WINGMAN_WITH_SIM
+    {"wingman-sim", "sim", "input.setpoint_channel", "SETPOINT_A", "SETPOINT_B", "camera.width", "77", "width: 77"},
+#endif
 };
 
 void write(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
@@ -80,15 +83,5 @@ TEST(ProcessConfigLayers, EveryBadKeyOfEveryLayerIsOneLineNamingItsSource) {
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
   }
 }
-
-#ifdef WINGMAN_WITH_SIM
-// wingman-sim's loader reads one file (sim/main.cpp): several --config or a --set are a named error, not ignored.
-TEST(ProcessConfigLayers, TheSimulatorRefusesLayersItCannotRead) {
-  const auto r = run({bin_path("wingman-sim"), "--config", source_path("config/sim.yaml"), "--set", "render.enabled=false",
-                      "--print-config"});
-  EXPECT_EQ(r.exit_code, 2) << r.out;
-  EXPECT_TRUE(has(r.err, "this process reads one --config FILE and takes no --set")) << r.err;
-}
-#endif
 
 }  // namespace

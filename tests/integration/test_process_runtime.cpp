@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 #include <wingman/common/runtime.hpp>
-#include <wingman/image_t.hpp>
 #include <wingman/detections_t.hpp>
+#include <wingman/image_t.hpp>
 #include <wingman/status_t.hpp>
 
 #include <poll.h>
@@ -118,10 +118,10 @@ TEST(ProcessConfig, BadConfigExitsNonZeroWithOneLineNamingFileAndEveryBadKey) {
 // Issue 33, finding 6: every process ran on its defaults with exit 0 when --config named a directory.
 TEST(ProcessConfig, ADirectoryAsConfigIsAnErrorForEveryProcess) {
   TempDir dir;
-  for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl",
-                          "wingman-recorder",
+  for (const char* exe :
+       {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl", "wingman-recorder",
 #ifdef WINGMAN_WITH_SIM
-                          "wingman-sim"
+        "wingman-sim"
 #endif
        }) {
     const auto r = run({bin_path(exe), "--config", dir.path(), "--print-config"}, 10s);

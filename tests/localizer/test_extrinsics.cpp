@@ -183,7 +183,8 @@ TEST(Extrinsics, OwnPoseCovarianceIsTheCovarianceOfTheTargetUnderSampledPoseErro
     s.p_body_in_world += llt.matrixL() * Eigen::Vector3d(n(rng), n(rng), n(rng));
     const Eigen::Vector3d dtheta(std::sqrt(pose.var_rpy_body.x()) * n(rng), std::sqrt(pose.var_rpy_body.y()) * n(rng),
                                  std::sqrt(pose.var_rpy_body.z()) * n(rng));
-    s.q_body_to_world = pose.q_body_to_world * Eigen::Quaterniond(Eigen::AngleAxisd(dtheta.norm(), dtheta.normalized()));
+    s.q_body_to_world =
+        pose.q_body_to_world * Eigen::Quaterniond(Eigen::AngleAxisd(dtheta.norm(), dtheta.normalized()));
     const Eigen::Vector3d p = to_world(m, mount, s, 0, 0).p_target_in_world - w.p_target_in_world;
     mean += p;
     second += p * p.transpose();
@@ -193,7 +194,9 @@ TEST(Extrinsics, OwnPoseCovarianceIsTheCovarianceOfTheTargetUnderSampledPoseErro
   // Sampling error of a covariance entry is about sqrt(2/N) of its scale (0.3 % here); first-order error at
   // 0.03 rad is of order 1e-3 relative. 2 % of the largest entry covers both.
   EXPECT_LT((sample_cov - w.cov_p_in_world).cwiseAbs().maxCoeff(), 0.02 * w.cov_p_in_world.cwiseAbs().maxCoeff())
-      << "first order:\n" << w.cov_p_in_world << "\nsampled:\n" << sample_cov;
+      << "first order:\n"
+      << w.cov_p_in_world << "\nsampled:\n"
+      << sample_cov;
   // The attitude's share dominates at 30 m (0.03 rad of yaw is 0.9 m sideways), so the test would catch it missing.
   EXPECT_GT(w.cov_p_in_world.trace(), 3 * pose.cov_p_body_in_world.trace());
 }

@@ -167,9 +167,9 @@ TEST(OwnPoseAssembler, AnInvalidOdometryCovarianceKeepsThePoseAndSaysWhy) {
     float value;
     const char* says;
   };
-  for (const Case c : {Case{0, -1.0f, "negative variance"}, Case{18, -1e-4f, "negative variance"},
-                       Case{1, 0.5f, "beyond +-sqrt(var var)"}, Case{6, INFINITY, "not finite"},
-                       Case{20, NAN, "not finite"}}) {
+  for (const Case c :
+       {Case{0, -1.0f, "negative variance"}, Case{18, -1e-4f, "negative variance"},
+        Case{1, 0.5f, "beyond +-sqrt(var var)"}, Case{6, INFINITY, "not finite"}, Case{20, NAN, "not finite"}}) {
     o.pose_covariance.fill(0);
     o.pose_covariance[0] = o.pose_covariance[6] = o.pose_covariance[11] = 0.04f;
     o.pose_covariance[c.index] = c.value;

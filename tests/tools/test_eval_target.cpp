@@ -2,8 +2,8 @@
 // `wingman eval --follower-config/--follower-set/--scenario`: the formation target derived from the follower's
 // configuration (formation.offset_m) or, for the 1-D follow, from the scenario's start.
 #include <gtest/gtest.h>
-#include "test_support.hpp"
 #include <wingman/tools/eval_target.hpp>
+#include "test_support.hpp"
 
 #include <string>
 

@@ -98,7 +98,8 @@ TEST(Predict, AFolderOfMixedSizesGivesTheBoxesOfOneImageAtATime) {
     std::ostringstream out1, err1;
     ASSERT_EQ(run_predict(options({(folder / (name + ".png")).string()}, dir.file("alone_" + name)), out1, err1), 0)
         << err1.str();
-    std::ifstream together(dir.file("together/" + name + ".txt")), alone(dir.file("alone_" + name + "/" + name + ".txt"));
+    std::ifstream together(dir.file("together/" + name + ".txt")),
+        alone(dir.file("alone_" + name + "/" + name + ".txt"));
     ASSERT_TRUE(together.good()) << name;
     ASSERT_TRUE(alone.good()) << name;
     const std::string a((std::istreambuf_iterator<char>(together)), std::istreambuf_iterator<char>());

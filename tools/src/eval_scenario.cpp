@@ -17,10 +17,9 @@ FlightStart load_flight_start(const std::string& path, int follower_id, int lead
     if (v.id == leader_id) leader = &v;
   }
   if (follower == nullptr || leader == nullptr)
-    throw common::ConfigError(fmt::format("{}: no vehicle with id {} (the {}; --{}-id)", path,
-                                          follower == nullptr ? follower_id : leader_id,
-                                          follower == nullptr ? "follower" : "leader",
-                                          follower == nullptr ? "follower" : "leader"));
+    throw common::ConfigError(
+        fmt::format("{}: no vehicle with id {} (the {}; --{}-id)", path, follower == nullptr ? follower_id : leader_id,
+                    follower == nullptr ? "follower" : "leader", follower == nullptr ? "follower" : "leader"));
   return FlightStart{follower->p_initial_in_world, leader->p_initial_in_world};
 }
 

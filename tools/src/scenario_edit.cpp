@@ -62,7 +62,8 @@ void apply_set(YAML::Node root, const std::string& assignment) {
       std::string names;
       for (size_t j = 0; j < node.size(); ++j) {
         const YAML::Node entry = node[j];
-        const std::string name = entry.IsMap() && entry["name"] && entry["name"].IsScalar() ? entry["name"].Scalar() : "";
+        const std::string name =
+            entry.IsMap() && entry["name"] && entry["name"].IsScalar() ? entry["name"].Scalar() : "";
         if (name == p) next.reset(entry);
         names += (names.empty() ? "" : ", ") + name;
       }

@@ -472,10 +472,11 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->set = scenario->add_subcommand(
       "set", "Write a copy of a scenario with keys replaced, read back with wingman-sim's scenario loader");
   s_->set->add_option("file", c.file, "The scenario file to copy")->required();
-  s_->set->add_option("--set", c.sets,
-                      "KEY=VALUE, repeatable, in order: KEY a dotted path, a vehicle named by its name (seed=7, "
-                      "vehicles.camera.motion.frames_per_step=2, vehicles.target.initial.position=[0,-10,5]); VALUE "
-                      "a YAML scalar or flow sequence")
+  s_->set
+      ->add_option("--set", c.sets,
+                   "KEY=VALUE, repeatable, in order: KEY a dotted path, a vehicle named by its name (seed=7, "
+                   "vehicles.camera.motion.frames_per_step=2, vehicles.target.initial.position=[0,-10,5]); VALUE "
+                   "a YAML scalar or flow sequence")
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
   s_->set->add_option("--out", c.out, "The copy to write")->required();

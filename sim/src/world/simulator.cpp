@@ -178,7 +178,8 @@ void Simulator::advance_to(int64_t utime) {
 }
 
 void Simulator::set_own_pose_error(const OwnPoseErrorOptions& options) {
-  if (options.enabled()) own_pose_error_.emplace(options);
+  if (options.enabled())
+    own_pose_error_.emplace(options);
   else
     own_pose_error_.reset();
 }

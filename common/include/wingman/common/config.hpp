@@ -96,7 +96,7 @@ class ConfigLoader {
   void convert(const std::string& key, const YAML::Node& node, std::vector<int>& out);
   void convert(const std::string& key, const YAML::Node& node, std::vector<std::string>& out);
 
-  std::string source_name_;            // every source, for problems that no single key's source owns
+  std::string source_name_;             // every source, for problems that no single key's source owns
   std::map<std::string, Leaf> leaves_;  // dotted key -> its value from the last source that gave it
   const Leaf* current_ = nullptr;       // the leaf convert() is working on (names its source)
   std::set<std::string> known_;

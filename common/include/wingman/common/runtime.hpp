@@ -260,12 +260,6 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
                      const std::function<std::string(const ConfigSources& sources, bool print)>& load_config,
                      const std::function<int(Runtime&)>& body);
 
-/// The same for a process whose loader reads one file (`path`, "" = built-in defaults): several --config or a
-/// --set are a configuration error (exit 2) naming this.
-int run_process_impl(const ProcessInfo& info, int argc, char** argv,
-                     const std::function<std::string(const std::string& path, bool print)>& load_config,
-                     const std::function<int(Runtime&)>& body);
-
 /// run_process_impl for an `Options` struct with visit() and validate() (see ConfigLoader), loaded from the
 /// layered --config files and --set overrides.
 template <class Options>
@@ -275,8 +269,9 @@ int run_process(const ProcessInfo& info, int argc, char** argv,
   auto load = [&](const ConfigSources& sources, bool print) -> std::string {
     options = load_options<Options>(sources);
     if (!print) return "";
-    return print_options(options, info.executable + " effective configuration" +
-                                      (sources.empty() ? " (built-in defaults)" : " (from " + sources.describe() + ")"));
+    return print_options(options,
+                         info.executable + " effective configuration" +
+                             (sources.empty() ? " (built-in defaults)" : " (from " + sources.describe() + ")"));
   };
   return run_process_impl(info, argc, argv, std::function<std::string(const ConfigSources&, bool)>(load),
                           [&](Runtime& rt) { return body(rt, options); });

@@ -21,7 +21,7 @@ struct NedPose {
   Eigen::Vector3d p_body_in_ned = Eigen::Vector3d::Zero();           ///< metres north, east, down
   Eigen::Vector3d v_body_in_ned = Eigen::Vector3d::Zero();           ///< m/s north, east, down
   Eigen::Quaterniond q_frd_to_ned = Eigen::Quaterniond::Identity();  ///< FRD body -> NED
-  double position_std_m = -1;  ///< ODOMETRY: sqrt of the mean of its x, y, z variances; -1 unknown
+  double position_std_m = -1;   ///< ODOMETRY: sqrt of the mean of its x, y, z variances; -1 unknown
   bool has_covariance = false;  ///< ODOMETRY with a valid pose_covariance: the two below are set
   Eigen::Matrix3d cov_p_in_ned = Eigen::Matrix3d::Zero();  ///< covariance of p_body_in_ned, m^2
   Eigen::Vector3d var_rpy_frd = Eigen::Vector3d::Zero();   ///< variances of roll, pitch, yaw (FRD body axes), rad^2

@@ -41,12 +41,12 @@ struct SimCamera {
 
 /// One simulated camera frame.
 struct SimFrame {
-  int64_t index = 0;              ///< frame number k (the image's seq)
-  int64_t utime = 0;              ///< exposure time t_k = start_utime + round(k * 1e6 / rate), microseconds since epoch
+  int64_t index = 0;  ///< frame number k (the image's seq)
+  int64_t utime = 0;  ///< exposure time t_k = start_utime + round(k * 1e6 / rate), microseconds since epoch
   wingman::own_pose_t own_pose{};  ///< the camera vehicle's reported body pose at t_k (ENU world, FLU body)
-  MultirotorState own_reported;   ///< the same as a state (the pose error applied), for the MAVLink telemetry
-  wingman::ground_truth_t truth;  ///< every vehicle at t_k and every target's box (image_seq -1 without image)
-  cv::Mat bgr;                    ///< the rendered image (CV_8UC3); empty when rendering is off
+  MultirotorState own_reported;    ///< the same as a state (the pose error applied), for the MAVLink telemetry
+  wingman::ground_truth_t truth;   ///< every vehicle at t_k and every target's box (image_seq -1 without image)
+  cv::Mat bgr;                     ///< the rendered image (CV_8UC3); empty when rendering is off
   Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the camera at t_k (optical -> ENU)
 };
 
