@@ -88,34 +88,41 @@ ConfigLoader ConfigLoader::from_sources(const ConfigSources& sources) {
   return out;
 }
 
-void ConfigLoader::add_set(const std::string& assignment) {
+std::optional<SetAssignment> parse_set_assignment(const std::string& assignment, const std::string& example,
+                                                  std::string* error) {
   const auto eq = assignment.find('=');
   const std::string key = eq == std::string::npos ? "" : assignment.substr(0, eq);
   bool plain = !key.empty() && key.front() != '.' && key.back() != '.' && key.find("..") == std::string::npos;
   for (char c : key) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-');
   if (!plain) {
-    errors_.push_back(fmt::format(
-        "--set '{}': expected KEY=VALUE with KEY a dotted name (e.g. formation.offset_m=[-6,2,0])", assignment));
-    return;
+    *error = fmt::format("--set '{}': expected KEY=VALUE with KEY a dotted name (e.g. {})", assignment, example);
+    return std::nullopt;
   }
   const std::string text = assignment.substr(eq + 1);
-  const std::string source = "--set " + key;
-  if (const std::string bad = check_yaml_bounds(text, source); !bad.empty()) {
-    errors_.push_back(bad);
-    return;
+  if (std::string bad = check_yaml_bounds(text, "--set " + key); !bad.empty()) {
+    *error = std::move(bad);
+    return std::nullopt;
   }
-  YAML::Node value;
   try {
-    value = YAML::Load(text);
+    return SetAssignment{key, YAML::Load(text)};
   } catch (const YAML::Exception& e) {
-    errors_.push_back(fmt::format("--set {}: not valid YAML: {}", key, e.msg));
+    *error = fmt::format("--set {}: not valid YAML: {}", key, e.msg);
+    return std::nullopt;
+  }
+}
+
+void ConfigLoader::add_set(const std::string& assignment) {
+  std::string error;
+  const auto set = parse_set_assignment(assignment, "formation.offset_m=[-6,2,0]", &error);
+  if (!set) {
+    errors_.push_back(error);
     return;
   }
-  if (value.IsMap()) {  // --set section={a: 1, b: 2}: each key of the mapping
-    flatten(value, key, "--set");
+  if (set->value.IsMap()) {  // --set section={a: 1, b: 2}: each key of the mapping
+    flatten(set->value, set->key, "--set");
     return;
   }
-  leaves_[key] = Leaf{value, "--set", false};
+  leaves_[set->key] = Leaf{set->value, "--set", false};
 }
 
 void ConfigLoader::flatten(const YAML::Node& node, const std::string& prefix, const std::string& source) {

@@ -3,7 +3,6 @@
 #include "wingman/tools/scenario_edit.hpp"
 
 #include <wingman/common/config.hpp>
-#include <wingman/common/yaml_limits.hpp>
 #include <wingman/sim/scenario.hpp>
 
 #include <fmt/format.h>
@@ -19,7 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 using common::ConfigError;
 
-std::vector<std::string> split_key(const std::string& key) {
+std::vector<std::string> split_key(const std::string& key) {  // a valid dotted name (parse_set_assignment)
   std::vector<std::string> parts;
   std::istringstream ss(key);
   for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
@@ -36,23 +35,12 @@ bool is_entry_list(const YAML::Node& node) {
 
 // Sets one KEY=VALUE in `root` (a scenario's mapping).
 void apply_set(YAML::Node root, const std::string& assignment) {
-  const auto eq = assignment.find('=');
-  const std::string key = eq == std::string::npos ? "" : assignment.substr(0, eq);
+  std::string error;
+  const auto set = common::parse_set_assignment(assignment, "vehicles.camera.motion.frames_per_step=2", &error);
+  if (!set) throw ConfigError(error);
+  const std::string& key = set->key;
+  const YAML::Node& value = set->value;
   const std::vector<std::string> parts = split_key(key);
-  bool plain = !parts.empty() && key.back() != '.';
-  for (const auto& p : parts) plain = plain && !p.empty();
-  if (!plain)
-    throw ConfigError(fmt::format(
-        "--set '{}': expected KEY=VALUE with KEY a dotted name (e.g. vehicles.camera.motion.frames_per_step=2)",
-        assignment));
-  const std::string text = assignment.substr(eq + 1);
-  if (const std::string bad = common::check_yaml_bounds(text, "--set " + key); !bad.empty()) throw ConfigError(bad);
-  YAML::Node value;
-  try {
-    value = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("--set {}: not valid YAML: {}", key, e.msg));
-  }
   YAML::Node node = root;
   std::string at;  // the path walked so far
   for (size_t i = 0; i + 1 < parts.size(); ++i) {

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,19 @@ struct ConfigSources {
   /// "built-in defaults", "a.yaml", or "a.yaml, b.yaml, --set k=v" (for --print-config headers).
   std::string describe() const;
 };
+
+/// One `--set KEY=VALUE`, parsed: KEY a dotted name (letters, digits, '_', '-', '.'; no empty part), VALUE YAML
+/// (a scalar, a flow sequence or a flow mapping), bounded as every configuration text (check_yaml_bounds).
+struct SetAssignment {
+  std::string key;
+  YAML::Node value;
+};
+
+/// Parses `assignment`; returns nullopt and sets `*error` to one line naming it ("--set 'x': expected KEY=VALUE with
+/// KEY a dotted name (e.g. EXAMPLE)", "--set KEY: not valid YAML: ...") when it is not one. The one parser of --set
+/// for process configurations and scenario copies (`wingman scenario set`).
+std::optional<SetAssignment> parse_set_assignment(const std::string& assignment, const std::string& example,
+                                                  std::string* error);
 
 /// Reads an options struct from YAML files of sections (`section: {key: value}`), collecting every
 /// problem before failing once.
