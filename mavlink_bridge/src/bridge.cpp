@@ -4,6 +4,7 @@
 
 #include <wingman/mavlink/enums.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -98,7 +99,10 @@ void Bridge::publish_pose(const NedPose& pose, BridgeOutput& out) {
   int64_t utime = pose.time_us;
   if (!pose.epoch_time) {
     if (!time_sync_.synced()) {
-      refuse("pose_before_timesync", "own pose not published: no TIMESYNC answer from the autopilot yet");
+      // Held, not lost: the newest one is published (with its own measurement time) once the clock is known.
+      refuse("pose_before_timesync",
+             "own pose held: no TIMESYNC answer from the autopilot yet (the newest is published once one is used)");
+      pose_awaiting_clock_ = pose;
       return;
     }
     utime = time_sync_.to_epoch_us(pose.time_us);
@@ -127,9 +131,14 @@ void Bridge::on_frame(const Frame& f, int64_t mono_us, int64_t wall_ns, BridgeOu
       reply.target_component = f.compid;
       send(reply, out);
     } else if (from_autopilot) {
-      if (!time_sync_.on_response(t.tc1, t.ts1, wall_ns))
+      if (!time_sync_.on_response(t.tc1, t.ts1, wall_ns)) {
         refuse("timesync_sample_rejected",
                "a TIMESYNC answer came too late (time.timesync_max_rtt_s) and was not used");
+      } else if (pose_awaiting_clock_) {
+        const NedPose held = *pose_awaiting_clock_;
+        pose_awaiting_clock_.reset();
+        publish_pose(held, out);
+      }
     }
     return;
   }
@@ -220,7 +229,10 @@ void Bridge::tick(int64_t mono_us, int64_t wall_ns, BridgeOutput& out) {
   }
   if (autopilot_sysid_ != 0) {
     // TIMESYNC requests.
-    const int64_t ts_period_us = static_cast<int64_t>(std::llround(o_.timesync_period_s * 1e6));
+    // Until a sample is used (none yet, or each came too late), every kTimesyncAcquirePeriodUs at most: own poses
+    // wait for the clock.
+    int64_t ts_period_us = static_cast<int64_t>(std::llround(o_.timesync_period_s * 1e6));
+    if (!time_sync_.synced()) ts_period_us = std::min(ts_period_us, kTimesyncAcquirePeriodUs);
     if (last_timesync_tx_us_ < 0 || mono_us - last_timesync_tx_us_ >= ts_period_us) {
       Timesync t;
       t.ts1 = wall_ns;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 using namespace wingman::mavlink_bridge;
@@ -115,4 +116,62 @@ TEST(Bridge, OdometryCovarianceAndTheAutopilotsUnixClockAreReported) {
   EXPECT_NEAR(bridge.position_std_m(), 0.1, 1e-6);
   EXPECT_NE(bridge.detail().find("position std 0.100 m"), std::string::npos) << bridge.detail();
   EXPECT_NE(bridge.detail().find("autopilot Unix clock +2.500 s from ours"), std::string::npos) << bridge.detail();
+}
+
+TEST(Bridge, APoseBeforeTheClockIsKnownIsHeldAndPublishedWithItsOwnTimeOnceASampleIsUsed) {
+  Bridge bridge(BridgeOptions{}, nullptr);
+  BridgeOutput out;
+  mav::Heartbeat hb;
+  hb.autopilot = mav::kMavAutopilotPx4;
+  bridge.on_frame(frame_of(hb), 0, 0, out);
+  const int64_t wall0_ns = 1796428800LL * 1000000000LL;
+  auto timesync_requests = [](const BridgeOutput& o) {
+    std::vector<int64_t> ts1;
+    mav::Parser p;
+    for (const auto& f : o.frames)
+      p.feed(f.data(), f.size(), [&](const mav::Frame& fr) {
+        mav::Timesync t;
+        if (mav::decode(fr, t) && t.tc1 == 0) ts1.push_back(t.ts1);
+      });
+    return ts1;
+  };
+  // While no sample is used, requests every 100 ms (not time.timesync_period_s, 0.5 s).
+  for (int64_t t = 0; t <= 300; t += 10) bridge.tick(t * kMs, wall0_ns + t * 1000000, out);
+  EXPECT_EQ(timesync_requests(out).size(), 4u) << "at 0, 100, 200 and 300 ms";
+
+  // A pose measured at 5 s of the autopilot's boot clock, before any TIMESYNC answer: held, not published.
+  mav::Odometry o;
+  o.time_usec = 5000000;
+  o.frame_id = mav::kMavFrameLocalNed;
+  o.child_frame_id = mav::kMavFrameBodyFrd;
+  o.x = 1;
+  o.q = {1, 0, 0, 0};
+  o.pose_covariance[0] = NAN;
+  o.velocity_covariance[0] = NAN;
+  bridge.on_frame(frame_of(o), 300 * kMs, wall0_ns + 300000000, out);
+  EXPECT_TRUE(out.poses.empty());
+  EXPECT_EQ(bridge.refusals().count_of("pose_before_timesync"), 1);
+
+  // The autopilot's boot is at wall0 - 10 s: its clock reads 10.3 s when asked at wall0 + 300 ms.
+  const int64_t boot_offset_ns = 10LL * 1000000000LL;
+  mav::Timesync late;  // answered 80 ms later: longer than time.timesync_max_rtt_s (50 ms), not used
+  late.ts1 = wall0_ns + 300000000;
+  late.tc1 = late.ts1 + 40000000 - wall0_ns + boot_offset_ns;
+  bridge.on_frame(frame_of(late), 380 * kMs, wall0_ns + 380000000, out);
+  EXPECT_TRUE(out.poses.empty());
+  EXPECT_FALSE(bridge.time_sync().synced());
+  mav::Timesync good;  // a 2 ms round trip
+  good.ts1 = wall0_ns + 400000000;
+  good.tc1 = good.ts1 + 1000000 - wall0_ns + boot_offset_ns;
+  bridge.on_frame(frame_of(good), 402 * kMs, wall0_ns + 402000000, out);
+  ASSERT_EQ(out.poses.size(), 1u) << "the held pose, once the clock is known";
+  EXPECT_EQ(out.poses[0].utime, wall0_ns / 1000 - 10000000 + 5000000) << "its measurement time, on our clock";
+  EXPECT_EQ(bridge.poses_published(), 1);
+
+  // A second answer publishes nothing more; synced, the requests go at time.timesync_period_s.
+  bridge.on_frame(frame_of(good), 403 * kMs, wall0_ns + 403000000, out);
+  EXPECT_EQ(out.poses.size(), 1u);
+  out.frames.clear();
+  for (int64_t t = 410; t <= 1400; t += 10) bridge.tick(t * kMs, wall0_ns + t * 1000000, out);
+  EXPECT_EQ(timesync_requests(out).size(), 2u) << "at 0.8 and 1.3 s";
 }

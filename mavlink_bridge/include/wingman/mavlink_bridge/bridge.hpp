@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct BridgeOutput {
 /// mapped through TIMESYNC, never with the arrival time. Single-threaded.
 class Bridge {
  public:
+  /// TIMESYNC requests while no sample has been used yet: this often at most (time.timesync_period_s once synced).
+  static constexpr int64_t kTimesyncAcquirePeriodUs = 100000;
+
   /// `log(reason, message)` is called once per refusal reason (the process logs it as a warning).
   Bridge(const BridgeOptions& options, OffboardStreamer::Log log);
 
@@ -81,6 +85,8 @@ class Bridge {
   int64_t last_mode_request_us_ = -1;
   int64_t last_arm_request_us_ = -1;
   int64_t refusal_counted_for_us_ = -1;  ///< setpoint (its arrival) whose mode/arm refusals were counted
+  /// The newest own pose that came before the autopilot's clock was known (published when the first sample is used).
+  std::optional<NedPose> pose_awaiting_clock_;
   int64_t newest_pose_utime_ = 0;
   int64_t poses_ = 0;
   double position_std_m_ = -1;
