@@ -22,4 +22,14 @@ rm -rf "$work/set"; mkdir -p "$work"
 "$wingman" dataset synth --config "$src/config/datasets/box_relation.yaml" --meshes "$meshes" --count 160 --seed 43 \
   --out "$work/set" > "$work/synth.log" 2>&1 || { cat "$work/synth.log" >&2; echo "box_relation_guard: FAIL: render" >&2; exit 1; }
 "$wingman" model box-relation --data "$work/set" --check builtin:wingman-small --max-median-error 0.06 --max-mad 0.20 \
-  --min-targets 80
+  --min-targets 80 --samples "$work/samples.csv" | tee "$work/report.txt"
+# --samples: one row per target found, each with its frame radius (without propellers) below its bounding radius.
+found=$(sed -n 's/^[0-9]* images: \([0-9]*\) targets found.*/\1/p' "$work/report.txt")
+rows=$(($(wc -l < "$work/samples.csv") - 1))
+[ "$(head -1 "$work/samples.csv" | cut -d, -f1-5)" = "airframe,range_m,radius_m,frame_radius_m,elevation_deg" ] ||
+  { echo "box_relation_guard: FAIL: --samples header: $(head -1 "$work/samples.csv")" >&2; exit 1; }
+[ -n "$found" ] && [ "$rows" -eq "$found" ] ||
+  { echo "box_relation_guard: FAIL: --samples has $rows rows for ${found:-?} targets found" >&2; exit 1; }
+bad=$(awk -F, 'NR > 1 && !($4 > 0.1 && $4 < $3) {n++} END {print n + 0}' "$work/samples.csv")
+[ "$bad" -eq 0 ] || { echo "box_relation_guard: FAIL: $bad rows without 0.1 < frame_radius_m < radius_m" >&2; exit 1; }
+echo "box_relation_guard: --samples: $rows rows, frame radii within (0.1 m, bounding radius)"

@@ -10,6 +10,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <regex>
 
 namespace wingman::sim {
@@ -81,6 +82,13 @@ TEST(DroneModel, DefaultQuadHasTheLocalizersDefaultRadius) {
   EXPECT_NEAR(model.bounding_radius(), localizer::SphereLocalizerOptions{}.radius_m, 5e-4);
   EXPECT_NEAR(model.bounding_radius(), 0.348, 5e-4);
   EXPECT_LT(model.bounding_radius_at_rest(), model.bounding_radius());
+  // Without its propellers: the farthest vertex of the rigid part (0), a plain loop.
+  double frame = 0.0;
+  for (const DroneVertex& v : model.vertices())
+    if (v.part == 0) frame = std::max(frame, v.p_in_body.cast<double>().norm());
+  EXPECT_DOUBLE_EQ(model.frame_radius(), frame);
+  EXPECT_GT(model.frame_radius(), 0.2);
+  EXPECT_LT(model.frame_radius(), model.bounding_radius() - 0.05) << "the propellers reach beyond the frame";
   EXPECT_EQ(model.propellers().size(), 4u);
   EXPECT_EQ(model.name(), "quad");
 }
@@ -266,6 +274,9 @@ double glb_json_number(const std::string& path, const std::string& key) {
 TEST(MeshLoader, SharedAirframesHaveTheirStatedBoundingRadii) {
   const std::string missing = test::missing_shared("meshes");
   if (!missing.empty()) GTEST_SKIP() << "airframe meshes not available: " << missing << " is absent";
+  // The meshes' README's "r without props" (the frame radius), read from its table.
+  const std::map<std::string, double> r_frame = {
+      {"dji_f450.glb", 0.297}, {"holybro_x500v2.glb", 0.281}, {"tarot_t650.glb", 0.367}, {"3dr_iris.glb", 0.274}};
   for (const char* name : {"dji_f450.glb", "holybro_x500v2.glb", "tarot_t650.glb", "3dr_iris.glb"}) {
     DroneSpec spec;
     spec.frame = "mesh";
@@ -276,6 +287,7 @@ TEST(MeshLoader, SharedAirframesHaveTheirStatedBoundingRadii) {
     const double prop_axis = glb_json_number(spec.mesh_path, "motor_axis_radius_m");
     ASSERT_TRUE(std::isfinite(r_spin)) << name;
     EXPECT_NEAR(model.bounding_radius(), r_spin, 1e-3) << name;
+    EXPECT_NEAR(model.frame_radius(), r_frame.at(name), 1e-3) << name;
     ASSERT_EQ(model.propellers().size(), 4u) << name;
     double farthest_axis = 0.0;
     for (const Propeller& p : model.propellers()) farthest_axis = std::max(farthest_axis, p.axis_in_body.norm());

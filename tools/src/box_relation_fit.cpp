@@ -31,7 +31,10 @@ namespace fs = std::filesystem;
 struct Sample {
   std::string airframe;
   double range_m = 0, radius_m = 0;
+  double frame_radius_m = 0;  ///< without propellers; 0: the render did not say
+  double elevation_deg = 0;   ///< the camera seen from the target: above (+) or below (-) its horizontal plane
   double det_w = 0, det_h = 0, image_w = 0;
+  double sphere_w = 0, sphere_h = 0;
   double width_ratio = 0, height_ratio = 0;  // detected / sphere box
   localizer::PixelBox det;
   std::shared_ptr<const localizer::CameraModel> camera;
@@ -246,7 +249,15 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       s.airframe = airframe.find('.') != std::string::npos ? airframe : "procedural " + airframe;
       s.range_m = meta["target"]["range_m"].as<double>();
       s.radius_m = meta["target"]["bounding_radius_m"].as<double>();
+      if (const YAML::Node fr = meta["target"]["frame_radius_m"]; fr) s.frame_radius_m = fr.as<double>();
+      {
+        const YAML::Node pc = meta["T_cam_to_world"]["p"], pt = meta["target"]["T_body_to_world"]["p"];
+        const double dx = pc[0].as<double>() - pt[0].as<double>(), dy = pc[1].as<double>() - pt[1].as<double>(),
+                     dz = pc[2].as<double>() - pt[2].as<double>();
+        s.elevation_deg = std::atan2(dz, std::hypot(dx, dy)) * 180.0 / M_PI;
+      }
       s.det = det, s.det_w = det.w, s.det_h = det.h, s.image_w = W;
+      s.sphere_w = sphere.w, s.sphere_h = sphere.h;
       s.width_ratio = det.w / sphere.w, s.height_ratio = det.h / sphere.h;
       s.camera = camera;
       samples.push_back(std::move(s));
@@ -264,6 +275,17 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     }
   }
   if (samples.empty()) throw std::runtime_error("the detector found none of the targets: nothing to measure");
+  if (!rq.samples_csv.empty()) {
+    std::ofstream csv(rq.samples_csv);
+    if (!csv) throw std::runtime_error(rq.samples_csv + ": cannot write the samples (--samples)");
+    csv << "airframe,range_m,radius_m,frame_radius_m,elevation_deg,image_w,det_w,det_h,sphere_w,sphere_h,width_ratio,"
+           "height_ratio\n";
+    for (const Sample& s : samples)
+      csv << fmt::format("\"{}\",{:.4f},{:.4f},{:.4f},{:.2f},{:g},{:.3f},{:.3f},{:.3f},{:.3f},{:.5f},{:.5f}\n",
+                         s.airframe, s.range_m, s.radius_m, s.frame_radius_m, s.elevation_deg, s.image_w, s.det_w,
+                         s.det_h, s.sphere_w, s.sphere_h, s.width_ratio, s.height_ratio);
+    if (!csv) throw std::runtime_error(rq.samples_csv + ": write failed (--samples)");
+  }
 
   localizer::BoxRelation relation;
   if (!rq.check.empty()) {

@@ -451,8 +451,10 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
                   fmt::join(cam.coefficients(), ", "))
            << fmt::format("  \"T_cam_to_world\": {{\"p\": {}, \"q_wxyz\": {}}},\n",
                           vec_json(T_cam_to_world.translation()), quat_json(T_cam_to_world.linear()))
-           << fmt::format("  \"target\": {{\"airframe\": {}, \"spec\": {}, \"bounding_radius_m\": {:.9g},\n",
-                          quoted(model->name()), spec_json(spec), model->bounding_radius())
+           << fmt::format(
+                  "  \"target\": {{\"airframe\": {}, \"spec\": {}, \"bounding_radius_m\": {:.9g}, "
+                  "\"frame_radius_m\": {:.9g},\n",
+                  quoted(model->name()), spec_json(spec), model->bounding_radius(), model->frame_radius())
            << fmt::format("    \"T_body_to_world\": {{\"p\": {}, \"q_wxyz\": {}}}, \"prop_angle_rad\": {:.9g},\n",
                           vec_json(target.T_body_to_world.translation()), quat_json(target.T_body_to_world.linear()),
                           target.prop_angle_rad)

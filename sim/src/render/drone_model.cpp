@@ -61,6 +61,7 @@ DroneModel::DroneModel(std::vector<DroneVertex> vertices, std::vector<uint32_t> 
     bounding_radius_at_rest_ = std::max(bounding_radius_at_rest_, p.norm());
     if (v.part == 0) {
       bounding_radius_ = std::max(bounding_radius_, p.norm());
+      frame_radius_ = std::max(frame_radius_, p.norm());
     } else {
       // A propeller vertex at rho from its axis (the axis d from the origin) sweeps out to sqrt((d + rho)^2 + z^2).
       const Eigen::Vector2d axis = propellers_[v.part - 1].axis_in_body;

@@ -76,6 +76,10 @@ class DroneModel {
 
   /// Largest vertex distance from the body origin with the propellers at rest (angle 0), metres.
   double bounding_radius_at_rest() const { return bounding_radius_at_rest_; }
+  /// Radius of the smallest sphere about the body origin that holds the drone without its propellers (the frame:
+  /// body, arms, motors, gear; the meshes' README's "r without props"), metres. What a detector sees of a drone whose
+  /// spinning propellers are faint discs; at most bounding_radius().
+  double frame_radius() const { return frame_radius_; }
 
   /// The model's distinct vertex positions (duplicates from split normals and colours removed), in the body frame,
   /// with propeller k turned by direction_k * prop_angle_rad about its axis: the points the truth box projects.
@@ -100,6 +104,7 @@ class DroneModel {
   std::vector<uint32_t> point_triangles_;  // indices() mapped to distinct positions
   double bounding_radius_ = 0.0;
   double bounding_radius_at_rest_ = 0.0;
+  double frame_radius_ = 0.0;
 };
 
 }  // namespace wingman::sim

@@ -37,7 +37,10 @@ struct BoxRelationRequest {
   double edge_noise_rel = 0.1;
   /// A detection belongs to the target when its IoU with the target's outline box reaches this.
   double min_iou = 0.3;
-  int max_images = 0;        ///< 0: all
+  int max_images = 0;  ///< 0: all
+  /// Also write every matched target as one CSV row here (airframe, true range, bounding and frame radius, the
+  /// line of sight's elevation, the detected and sphere boxes, the ratios); "" = none.
+  std::string samples_csv;
   std::string command_line;  ///< written into the file as measured_with
 };
 
