@@ -29,7 +29,8 @@ std::string NonDroneCounts::summary() const {
     by_class_text +=
         fmt::format("{}{} {}", by_class_text.empty() ? "" : ", ", common::detection_class_name(class_id), n);
   }
-  return fmt::format("non-drone boxes not tracked: {} ({})", total, by_class_text);
+  return fmt::format("non-drone boxes {}: {} ({})", tracked ? "tracked by their drone score" : "not tracked", total,
+                     by_class_text);
 }
 
 Localizer::Localizer(const LocalizerOptions& options, CameraModel camera)
@@ -96,12 +97,14 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
 
   LocalizerOutput result;
   std::vector<CameraMeasurement> measurements;
+  const bool track_every_class = options_.class_decision == "track";
+  result.non_drone.tracked = track_every_class;
   for (size_t i = 0; i < d.detections.size(); ++i) {
     const auto& det = d.detections[i];
-    if (det.class_id != common::kDroneClassId) {  // a distractor class of a multi-class model: never a target
+    if (det.class_id != common::kDroneClassId) {  // a distractor class of a multi-class model
       ++result.non_drone.total;
       ++result.non_drone.by_class[det.class_id];
-      continue;
+      if (!track_every_class) continue;  // decided per box: never a target
     }
     const PixelBox box{det.cx, det.cy, det.w, det.h};
     const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d.image_width);
@@ -110,9 +113,11 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
       result.rejections.push_back(fmt::format("detections_t.detections[{}]: {}", i, r.reason));
       continue;
     }
-    r.measurement.confidence = det.confidence;
+    // Decided per track: the tracker's evidence is the box's drone score (the same as its confidence for a drone box).
+    r.measurement.confidence = track_every_class ? det.drone_score : det.confidence;
     measurements.push_back(r.measurement);
   }
+  non_drone_boxes_.tracked = track_every_class;
   non_drone_boxes_.total += result.non_drone.total;
   for (const auto& [class_id, n] : result.non_drone.by_class) non_drone_boxes_.by_class[class_id] += n;
 

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -89,6 +90,48 @@ TEST(Localizer, ANonDroneBoxIsCountedBeforeItsGeometryIsLookedAt) {
   const LocalizerOutput drone = loc.on_detections(detections(kT0 + 33333, 0, {outside}));
   EXPECT_EQ(drone.rejections.size(), 1u);
   EXPECT_EQ(drone.non_drone.total, 0);
+}
+
+TEST(Localizer, DecidedPerTrackADroneThatSomeFramesCallABirdIsConfirmedAndABirdIsNot) {
+  // A distant drone: every other frame the model's best class is bird (confidence 0.6) with a drone score of 0.45;
+  // a real bird: class bird, drone score 0.05. Per box (the default) the drone has 6 drone boxes in 12 frames, short
+  // of the birth rule's 10; per track it has 12 hits with a mean drone score of (0.9 + 0.45) / 2 >= 0.4 (the
+  // confirmation bar), and the bird's 0.05 never reaches it.
+  const Eigen::Vector3d p_drone(10.0, 1.0, 0.5), p_bird(8.0, -2.0, 1.0);
+  for (const std::string decision : {"box", "track"}) {
+    LocalizerOptions o;
+    o.class_decision = decision;
+    Localizer loc(o, camera());
+    LocalizerOutput out;
+    for (int k = 0; k < 12; ++k) {
+      const int64_t t = kT0 + 33333 * k;
+      loc.on_own_pose(own_pose(t));
+      wingman::detection_t drone = kScene.sphere_box(p_drone);
+      if (k % 2 == 1) drone.class_id = kBird, drone.confidence = 0.6f, drone.drone_score = 0.45f;
+      out = loc.on_detections(detections(t, 0, {kScene.sphere_box(p_bird, kBird), drone}));
+      EXPECT_TRUE(out.rejections.empty()) << out.rejections.front();
+    }
+    ASSERT_TRUE(out.targets.has_value());
+    if (decision == "box") {
+      EXPECT_EQ(out.targets->num_targets, 0) << "6 drone boxes in 12 frames: not confirmed";
+      EXPECT_EQ(loc.non_drone_boxes().summary(), "non-drone boxes not tracked: 18 (bird 18)");
+      continue;
+    }
+    ASSERT_EQ(out.targets->num_targets, 1) << "the drone, not the bird";
+    const wingman::target_t& t = out.targets->targets[0];
+    EXPECT_LT(
+        (Eigen::Vector3d(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]) - p_drone).norm(),
+        0.05);
+    EXPECT_EQ(loc.non_drone_boxes().summary(), "non-drone boxes tracked by their drone score: 18 (bird 18)");
+  }
+}
+
+TEST(LocalizerOptions, AnUnknownClassDecisionIsNamed) {
+  LocalizerOptions o;
+  o.class_decision = "frame";
+  const auto p = o.validate();
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_NE(p[0].find("classes.decision"), std::string::npos) << p[0];
 }
 
 TEST(NonDroneCounts, SummaryIsEmptyWithoutNonDroneBoxes) { EXPECT_EQ(NonDroneCounts{}.summary(), ""); }

@@ -194,7 +194,7 @@ void ClipTracker::add_frame(int frame_index, const std::vector<detector::Box>& b
   localizer_->on_own_pose(pose);
 
   // Every box as wingman-detector publishes it (detector::to_detection: unclipped, every class); the Localizer tracks
-  // class 0 (drone) only and counts the others.
+  // class 0 (drone) only and counts the others, or with classes.decision "track" tracks every box.
   wingman::detections_t d{};
   d.utime = utime;
   d.seq = frame_index;
@@ -202,13 +202,14 @@ void ClipTracker::add_frame(int frame_index, const std::vector<detector::Box>& b
   d.image_width = camera_.width();
   d.image_height = camera_.height();
   d.source = wingman::detections_t::SOURCE_CNN;
-  std::vector<const detector::Box*> drone;
+  std::vector<const detector::Box*> drone;  // the boxes the Localizer tracks
+  const bool track_every_class = options_.class_decision == "track";
   for (const detector::Box& b : boxes) {
     d.detections.push_back(detector::to_detection(b));
-    if (b.class_id == common::kDroneClassId) drone.push_back(&b);
+    if (b.class_id == common::kDroneClassId) ++drone_boxes_;
+    if (b.class_id == common::kDroneClassId || track_every_class) drone.push_back(&b);
   }
   d.num_detections = static_cast<int32_t>(d.detections.size());
-  drone_boxes_ += static_cast<int64_t>(drone.size());
 
   const localizer::LocalizerOutput out = localizer_->on_detections(d);
   other_class_boxes_ += out.non_drone.total;

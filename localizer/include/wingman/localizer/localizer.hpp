@@ -27,9 +27,11 @@ namespace wingman::localizer {
 struct NonDroneCounts {
   int64_t total = 0;                ///< boxes with class_id != 0
   std::map<int, int64_t> by_class;  ///< class_id -> boxes, for the classes seen
+  bool tracked = false;             ///< classes.decision: track (they were tracked by their drone score)
 
   /// "" when total is 0, else one line for the status detail, e.g.
-  /// "non-drone boxes not tracked: 12 (airplane 3, bird 9)" (names: common::detection_class_name()).
+  /// "non-drone boxes not tracked: 12 (airplane 3, bird 9)" (names: common::detection_class_name()), or with
+  /// `tracked` "non-drone boxes tracked by their drone score: 12 (...)".
   std::string summary() const;
 };
 
@@ -62,11 +64,12 @@ class Localizer {
   /// (out of order, duplicate, dated too far ahead); the caller drops and counts it.
   void on_own_pose(const wingman::own_pose_t& pose);
 
-  /// Localizes and tracks one detections message. Only drones are localized and tracked: a box with
-  /// class_id != 0 (common::kDroneClassId) is left out and counted in LocalizerOutput::non_drone and
-  /// non_drone_boxes(). Boxes of SOURCE_CNN go through target.box_relation, ground-truth boxes are the sphere's.
-  /// Throws std::invalid_argument naming the field for a message that cannot be used at all (other camera, other
-  /// image size, out of order, a model_id the box relation was not measured for); the caller drops and counts it.
+  /// Localizes and tracks one detections message. A box with class_id != 0 (common::kDroneClassId) is counted in
+  /// LocalizerOutput::non_drone and non_drone_boxes(), and with classes.decision "box" left out (only drones are
+  /// localized and tracked); with "track" every box is tracked with its drone score as its confidence. Boxes of
+  /// SOURCE_CNN go through target.box_relation, ground-truth boxes are the sphere's. Throws std::invalid_argument
+  /// naming the field for a message that cannot be used at all (other camera, other image size, out of order, a
+  /// model_id the box relation was not measured for); the caller drops and counts it.
   LocalizerOutput on_detections(const wingman::detections_t& detections);
 
   /// The non-drone boxes of every message since construction that passed the camera, image size and order checks.

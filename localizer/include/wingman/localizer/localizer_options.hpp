@@ -53,6 +53,13 @@ struct LocalizerOptions {
   /// Publish a targets_t with no targets for detections that leave no confirmed track (subscribers see the
   /// pipeline is alive, and lockstep simulation gets one targets_t per image).
   bool publish_empty = true;
+  /// Where a multi-class model's class is decided (detection_t.class_id, drone_score):
+  /// "box" (default): a box whose class is not drone is left out before tracking (counted, not tracked);
+  /// "track": every box is localized and tracked with its drone score (objectness x P(drone)) as its confidence, so
+  /// the tracker's confirmation bar (tracker.confirm_min_confidence, on the mean of a track's last N hits) decides
+  /// drone or not over the track's frames: a distant drone that one frame calls a bird still gathers its evidence.
+  /// For a single-class model (drone_score = confidence) the two are the same.
+  std::string class_decision = "box";
   CameraOptions camera;
   SphereLocalizerOptions sphere;
   ExtrinsicsOptions extrinsics;
@@ -71,6 +78,9 @@ struct LocalizerOptions {
       "without a fresh own pose, publish camera-frame targets (world_valid false) instead of nothing");
     v("output.publish_empty", publish_empty,
       "publish an empty targets_t when detections leave no confirmed track (one targets_t per detections_t)");
+    v("classes.decision", class_decision,
+      "box: boxes of other classes than drone are not tracked; track: every box is tracked with its drone score as "
+      "its confidence and the tracker's confirmation bar decides per track");
     camera.visit(v);
     sphere.visit(v);
     extrinsics.visit(v);
