@@ -10,7 +10,7 @@
 #   --etc         folder of the process configurations camera_driver.yaml, detector.yaml, localizer.yaml,
 #                 follower_ctrl.yaml, mavlink_bridge.yaml, recorder.yaml (default: config/ of this checkout; installed: /usr/local/etc/wingman)
 #   --log-dir     folder of the processes' logs and the recorder's recordings/ (created; default:
-#                 build/supervisor/log; installed: /var/log/wingman)
+#                 build/supervisor/log; installed: /var/log/supervisor and /var/log/wingman/recordings)
 #   --lcm-url     LCM URL of the bus (default: the file's, udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304)
 #   --out         write the rendered program file here (default: stdout, or DIR/wingman.conf with --standalone)
 #   --standalone  also write DIR/supervisord.conf: a supervisord that runs without root, with its socket, pid file
@@ -61,6 +61,7 @@ render() {
   sed -e "s|/usr/local/bin/|$(esc "$bin")/|g" \
       -e "s|/usr/local/etc/wingman/|$(esc "$etc")/|g" \
       -e "s|/var/log/wingman/|$(esc "$log_dir")/|g" \
+      -e "s|/var/log/supervisor/|$(esc "$log_dir")/|g" \
       -e "s|/usr/local/share/wingman/supervisor/|$(esc "$src/config/supervisor")/|g" \
       ${url:+-e "s|udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304|$(esc "$url")|g"} \
       "$template"

@@ -113,7 +113,10 @@ cp "$src/config/mavlink_bridge.yaml" "$etc/mavlink_bridge.yaml"
 "$src/tools/supervise.sh" --bin "$bin" --etc "$etc" --lcm-url "$url" --standalone "$tmp/sup" > /dev/null
 conf="$tmp/sup/supervisord.conf" suplog="$tmp/sup/supervisord.log"
 # The rendered file is the shipped one with the paths substituted: same lines otherwise.
-if ! diff <(sed -e "s|$bin/|/usr/local/bin/|g" -e "s|$etc/|/usr/local/etc/wingman/|g" -e "s|$tmp/sup/log/|/var/log/wingman/|g" \
+# (The log folder stands for both the recorder's directory, /var/log/wingman/, and supervisord's, /var/log/supervisor/.)
+if ! diff <(sed -e "s|$bin/|/usr/local/bin/|g" -e "s|$etc/|/usr/local/etc/wingman/|g" \
+               -e "s|^directory=$tmp/sup/log/|directory=/var/log/wingman/|" \
+               -e "s|$tmp/sup/log/recordings|/var/log/wingman/recordings|g" -e "s|$tmp/sup/log/|/var/log/supervisor/|g" \
                -e "s|$src/config/supervisor/|/usr/local/share/wingman/supervisor/|g" \
                -e "s|$url|udpm://239.255.76.67:7667?ttl=0\&recv_buf_size=4194304|g" "$tmp/sup/wingman.conf") \
           "$src/config/supervisor/wingman.conf" > "$tmp/render.diff"; then
