@@ -3,7 +3,8 @@
 # Checks config/systemd/ with `systemd-analyze verify`: the units are rendered for the build tree (the executables'
 # folder substituted for /usr/local/bin, as for an install there) and any warning or error fails the test. Also
 # checks that each unit runs its process with its configuration, restarts it always, stops it with SIGTERM and
-# that wingman.target wants all six. Exits 77 (skipped) when systemd-analyze is not installed.
+# that wingman.target wants all six, and that `systemd-analyze security --offline=true` rates each unit's sandbox at
+# an overall exposure of at most 3.0 (printed per unit). Exits 77 (skipped) when systemd-analyze is not installed.
 # Usage: tests/reliability/systemd_units_test.sh SRC_DIR BIN_DIR
 set -euo pipefail
 src=$(cd "$1" && pwd) bin=$(cd "$2" && pwd)
@@ -34,5 +35,19 @@ if ! systemd-analyze verify --man=no "$tmp"/wingman.target "$tmp"/wingman-*.serv
    [ -s "$tmp/verify.txt" ]; then
   fail "systemd-analyze verify:"; cat "$tmp/verify.txt"
 fi
+# The sandbox: "Overall exposure level for UNIT: N.N LABEL" (0 best, 10 worst; docs/reliability.md, "systemd").
+max_exposure=3.0
+for exe in $(printf '%s\n' "${!cfg[@]}" | sort); do
+  [ -r "$tmp/$exe.service" ] || continue
+  out=$(systemd-analyze security --offline=true --no-pager "$tmp/$exe.service" 2>&1) || true
+  score=$(sed -nE "s/.*Overall exposure level for $exe\.service: ([0-9]+\.[0-9]+).*/\1/p" <<<"$out")
+  if [ -z "$score" ]; then
+    fail "$exe.service: no exposure level from systemd-analyze security:"; echo "$out" | tail -n 5
+  elif awk -v s="$score" -v m="$max_exposure" 'BEGIN { exit !(s > m) }'; then
+    fail "$exe.service: exposure $score > $max_exposure:"; grep '✗' <<<"$out" || true
+  else
+    echo "$exe.service: exposure $score (at most $max_exposure)"
+  fi
+done
 [ "$failures" -eq 0 ] || exit 1
 echo "systemd_units_test: ${#cfg[@]} units and wingman.target verified ($(systemd-analyze --version | head -n 1))"
