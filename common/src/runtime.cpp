@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Process runtime: command line, config, LCM endpoints, heartbeats, signals and error reporting.
 #include "wingman/common/runtime.hpp"
+#include "wingman/common/version.hpp"
 
 #include "wingman/common/time.hpp"
 
@@ -388,6 +389,7 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
   app.add_flag("--print-config", ro.print_config, "Print the effective configuration as YAML and exit");
+  app.set_version_flag("--version", prog + " " + version(), "Print the version (and the commit built from) and exit");
   app.add_option("--lcm-url", ro.lcm_url, "LCM URL for input and output (default: LCM_DEFAULT_URL or LCM's default)");
   app.add_option("--lcm-in", ro.lcm_in,
                  "LCM URL to read from, e.g. file:///tmp/in.lcmlog?speed=0 (default: --lcm-url)");
@@ -406,6 +408,8 @@ int run_process_impl(const ProcessInfo& info, int argc, char** argv,
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);

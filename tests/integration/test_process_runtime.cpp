@@ -21,6 +21,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <regex>
 #include <thread>
 
 namespace {
@@ -127,6 +128,28 @@ TEST(ProcessConfig, ADirectoryAsConfigIsAnErrorForEveryProcess) {
     const auto r = run({bin_path(exe), "--config", dir.path(), "--print-config"}, 10s);
     EXPECT_EQ(r.exit_code, 2) << exe;
     EXPECT_EQ(first_line(r.err), std::string(exe) + ": error: " + dir.path() + ": is a directory, not a config file");
+  }
+}
+
+// Issue 34: every executable answers --version with the project's version and the commit it was built from, the
+// same for all (one build), on stdout, exit 0.
+TEST(ProcessCli, EveryExecutableAnswersVersionWithTheSameBuildsVersion) {
+  const std::regex line(R"(^(\S+) ([0-9]+\.[0-9]+\.[0-9]+ \(git [^)\s]+\))$)");
+  std::string first;
+  for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl",
+                          "wingman-recorder", "wingman-mavlink", "wingman",
+#ifdef WINGMAN_WITH_SIM
+                          "wingman-sim"
+#endif
+       }) {
+    const auto r = run({bin_path(exe), "--version"}, 10s);
+    EXPECT_EQ(r.exit_code, 0) << exe << ": " << r.err;
+    std::smatch m;
+    const std::string out = first_line(r.out);
+    ASSERT_TRUE(std::regex_match(out, m, line)) << exe << ": '" << out << "'";
+    EXPECT_EQ(m[1].str(), exe);
+    if (first.empty()) first = m[2].str();
+    EXPECT_EQ(m[2].str(), first) << exe;
   }
 }
 

@@ -21,6 +21,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
+#include <wingman/common/version.hpp>
 
 #include <iostream>
 #include <tuple>
@@ -29,6 +30,8 @@ int main(int argc, char** argv) {
   using namespace wingman::tools;
   CLI::App app{"Wingman tools: replay logs through the pipeline, monitor and inspect it", "wingman"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("wingman ") + wingman::common::version(),
+                       "Print the version (and the commit built from) and exit");
 
   ReplayOptions replay;
   auto* r = app.add_subcommand(
