@@ -3,8 +3,8 @@
 # `wingman report` in headless Chromium: writes a synthetic flight log, renders its report to a PNG and dumps the DOM.
 #
 # Usage: report_chromium_test.sh WINGMAN WRITE_REPORT_FLIGHT OUT_DIR
-# Passes when the page loads without console errors, every chart <svg id=...> has data elements, every camera frame
-# decodes, and the screenshot is not blank. OUT_DIR keeps report.html, report.png and dom.html for a look.
+# Passes when the page loads without console errors, the headline's six figures are above the charts, every chart
+# <svg id=...> has data, every frame decodes as a thumbnail, the screenshot not blank. OUT_DIR keeps page, PNG, DOM.
 # Exits 77 (skipped) when chromium is not installed (Debian: chromium; tools/install_deps.sh installs it).
 set -euo pipefail
 
@@ -50,6 +50,19 @@ read -r _ width height < <(head -c 64 "$work/shot.ppm" | tr -s ' \n' ' ' | cut -
 colours=$(ppmhist -noheader "$work/shot.ppm" | wc -l)
 [ "$colours" -ge 50 ] || fail "screenshot has only $colours colours: blank?"
 
+# The headline first: six figures before the first chart; the fixture has no formation target, so that one alone
+# is "not measured".
+dom=$(tr '\n' ' ' <"$out/dom.html")
+head_at=$(grep -ob '<table id="headline"' <<<"$dom" | head -n1 | cut -d: -f1 || true)
+svg_at=$(grep -ob '<svg ' <<<"$dom" | head -n1 | cut -d: -f1 || true)
+[ -n "$head_at" ] || fail "no headline table in the DOM"
+[ "$head_at" -lt "$svg_at" ] || fail "the headline is not above the charts"
+rows=$(grep -o '<tr data-key="[a-z_]*" data-measured="[01]"' <<<"$dom" | wc -l)
+[ "$rows" = 6 ] || fail "$rows headline figures, expected 6"
+unmeasured=$(grep -o 'data-key="[a-z_]*" data-measured="0"' <<<"$dom" | cut -d'"' -f2 | tr '\n' ' ')
+[ "$unmeasured" = "formation_rms " ] || fail "not measured: '$unmeasured', expected only formation_rms"
+echo "report_chromium: headline with $rows figures above the charts"
+
 # Every chart, with data elements, in the DOM as the browser parsed it.
 tr '\n' ' ' <"$out/dom.html" | sed 's/<svg /\n<svg /g; s/<\/svg>/<\/svg>\n/g' >"$work/svgs.txt"
 for id in topdown errors error-by-range box-width latency; do
@@ -64,4 +77,6 @@ frames=$(grep -o '<img class="frame"' "$out/dom.html" | wc -l)
 decoded=$(grep -o 'data-decoded="1"' "$out/dom.html" | wc -l)
 [ "$frames" -ge 1 ] || fail "no camera frames in the report"
 [ "$decoded" = "$frames" ] || fail "$decoded of $frames camera frames decoded"
+thumbs=$(grep -o '<img class="frame" width="320" height="180"' "$out/dom.html" | wc -l)
+[ "$thumbs" = "$frames" ] || fail "$thumbs of $frames camera frames are 320x180 thumbnails (the log's are 480x270)"
 echo "report_chromium: $frames frames decoded; screenshot $out/report.png ($colours colours)"

@@ -15,7 +15,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace wingman::tools {
@@ -687,6 +689,113 @@ TEST(Report, DrawsFramesOfEveryPixelFormatAndEveryChart) {
   for (const char* remote : {"src=\"http", "href=\"http", "<link", "<script src", "url(http"}) {
     EXPECT_EQ(html.find(remote), std::string::npos) << remote;  // nothing is fetched: the page opens offline
   }
+  EXPECT_EQ(html.find("no-images"), std::string::npos);
+}
+
+/// The headline row `key` of the page (its <tr> up to </tr>); "" when absent.
+std::string headline_row(const std::string& html, const std::string& key) {
+  const size_t at = html.find("<tr data-key=\"" + key + "\"");
+  return at == std::string::npos ? "" : html.substr(at, html.find("</tr>", at) - at);
+}
+
+TEST(Report, HeadlineShowsTheEvalsNumbersBeforeEverythingElse) {
+  testing::TempDir dir;
+  EvalOptions o;
+  o.log = write_flight(dir);
+  o.has_formation = true;
+  o.formation_offset_in_world = {0.0, -10.0, 0.0};
+  o.formation_height_m = 5.0;
+  o.settle_s = 0.45;
+  const EvalResult r = evaluate_log(o);
+  const auto h = report_headline(r);
+  ASSERT_EQ(h.size(), 6u);
+  std::map<std::string, HeadlineItem> by_key;
+  for (const auto& i : h) {
+    EXPECT_TRUE(i.measured) << i.key << ": " << i.detail;
+    by_key[i.key] = i;
+  }
+  // The eval's numbers (hand-computed in the Eval tests above), and as the page shows them.
+  EXPECT_EQ(by_key["localization_rms"].values, std::vector<double>{r.localization.rms});
+  EXPECT_NEAR(r.localization.rms, std::sqrt(0.125), 1e-9);
+  EXPECT_EQ(by_key["localization_rms"].text, "0.354 m");
+  EXPECT_EQ(by_key["localization_rms"].thesis.rfind("2.86 m", 0), 0u);
+  EXPECT_EQ(by_key["formation_rms"].values, std::vector<double>{r.formation_horizontal.rms});
+  EXPECT_NEAR(r.formation_horizontal.rms, std::sqrt((0.25 + 0.36 + 0.49 + 0.64 + 0.81) / 5), 1e-9);
+  EXPECT_EQ(by_key["formation_rms"].text, "0.714 m");
+  EXPECT_EQ(by_key["formation_rms"].thesis, "");
+  EXPECT_EQ(by_key["detection_rate"].values, (std::vector<double>{8, 9}));
+  EXPECT_EQ(by_key["detection_rate"].text, "8 of 9 frames (88.9 %)");
+  EXPECT_EQ(by_key["false_targets"].values, (std::vector<double>{1, 1}));
+  EXPECT_EQ(by_key["false_targets"].text, "1 in 1 track id(s)");
+  EXPECT_EQ(by_key["track_ids"].values, (std::vector<double>{1, 0}));
+  EXPECT_EQ(by_key["track_ids"].text, "1, 0 id switch(es)");
+  ASSERT_GT(r.latency_ms.n, 0);
+  EXPECT_EQ(by_key["latency"].values, (std::vector<double>{r.latency_ms.p50, r.latency_ms.p99}));
+  char latency[64];
+  std::snprintf(latency, sizeof latency, "%.1f ms / %.1f ms", r.latency_ms.p50, r.latency_ms.p99);
+  EXPECT_EQ(by_key["latency"].text, latency);
+  EXPECT_EQ(by_key["latency"].thesis.rfind("about 0.7 s", 0), 0u);
+
+  const std::string html = html_report(r, o, {});
+  const size_t table = html.find("<table id=\"headline\"");
+  ASSERT_NE(table, std::string::npos);
+  EXPECT_LT(table, html.find("<svg"));
+  EXPECT_LT(table, html.find("<pre"));
+  EXPECT_NE(headline_row(html, "localization_rms").find(">0.354 m<"), std::string::npos);
+  EXPECT_NE(headline_row(html, "localization_rms").find("2.86 m"), std::string::npos);
+  EXPECT_NE(headline_row(html, "detection_rate").find(">8 of 9 frames (88.9 %)<"), std::string::npos);
+  EXPECT_NE(headline_row(html, "formation_rms").find("&mdash;"), std::string::npos);  // no thesis figure
+  EXPECT_EQ(html.find("not measured"), std::string::npos);
+
+  // Without a formation target the formation error is not measured, not 0.
+  o.has_formation = false;
+  const EvalResult r2 = evaluate_log(o);
+  const auto h2 = report_headline(r2);
+  EXPECT_FALSE(h2[1].measured);
+  EXPECT_EQ(h2[1].text, "not measured");
+  EXPECT_TRUE(h2[1].values.empty());
+  const std::string row = headline_row(html_report(r2, o, {}), "formation_rms");
+  EXPECT_NE(row.find("data-measured=\"0\""), std::string::npos) << row;
+  EXPECT_NE(row.find(">not measured<"), std::string::npos) << row;
+  EXPECT_EQ(row.find(" m<"), std::string::npos) << row;
+}
+
+TEST(Report, ThumbnailsOfALogWithLargeImagesAreScaledDown) {
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event("GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5)}), u));
+    cv::Mat bgr(720, 1280, CV_8UC3, cv::Scalar(200, 170, 120));
+    image_t img{};
+    img.utime = u;
+    img.width = 1280;
+    img.height = 720;
+    img.pixel_format = image_t::BGR8;
+    img.stride = static_cast<int32_t>(bgr.step[0]);
+    img.data.assign(bgr.data, bgr.data + bgr.total() * bgr.elemSize());
+    img.size = static_cast<int32_t>(img.data.size());
+    events.push_back(make_event("IMAGE_CAM0", img, u));
+  }
+  EvalOptions o;
+  o.log = dir.file("large.lcmlog");
+  testing::write_log(o.log, events);
+  const EvalResult r = evaluate_log(o);  // the default: report_frames = 6
+  const auto frames = draw_report_frames(r, o);
+  ASSERT_EQ(frames.size(), 6u);
+  for (const auto& f : frames) {
+    EXPECT_EQ(f.width, kReportThumbnailWidth);
+    EXPECT_EQ(f.height, kReportThumbnailWidth * 720 / 1280);
+    EXPECT_LT(f.jpeg_b64.size(), 40000u);  // a thumbnail, not the frame
+  }
+  const std::string html = html_report(r, o, frames);
+  const size_t at = html.find("<div id=\"frames\">");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_LT(at, html.find("<svg"));  // right under the headline
+  size_t n = 0;
+  const std::string thumb = "<img class=\"frame\" width=\"320\" height=\"180\"";
+  for (size_t p = html.find(thumb); p != std::string::npos; p = html.find(thumb, p + 1)) ++n;
+  EXPECT_EQ(n, 6u);
   EXPECT_EQ(html.find("no-images"), std::string::npos);
 }
 
