@@ -34,6 +34,8 @@ std::vector<std::string> TrackerOptions::validate() const {
     p.push_back(problem("tracker.accel_noise", accel_noise, "must be finite and >= 0"));
   if (!(gate_chi2 > 0) || !std::isfinite(gate_chi2))
     p.push_back(problem("tracker.gate_chi2", gate_chi2, "must be finite and > 0"));
+  if (!(merge_after_s >= 0) || !std::isfinite(merge_after_s))
+    p.push_back(problem("tracker.merge_after_s", merge_after_s, "must be finite and >= 0"));
   if (birth_hits < 1) p.push_back(problem("tracker.birth_hits", birth_hits, "must be >= 1"));
   if (birth_window < birth_hits)
     p.push_back(
@@ -259,7 +261,7 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
     t.id = next_id_++;
     ++stats_.confirmations;
   }
-  merge_duplicates();
+  merge_duplicates(utime);
 
   // Detections no track took start tentative tracks.
   for (size_t j = 0; j < z.size(); ++j) {
@@ -315,12 +317,21 @@ bool Tracker::duplicates_a_confirmed_track(const Track& t) const {
   return false;
 }
 
-void Tracker::merge_duplicates() {
+void Tracker::merge_duplicates(int64_t utime) {
+  const int64_t after_us = static_cast<int64_t>(std::llround(options_.merge_after_s * 1e6));
+  std::map<std::pair<int32_t, int32_t>, int64_t> agreeing;  // the pairs that agree now (the others start again)
   for (size_t i = 0; i < tracks_.size(); ++i) {
     for (size_t j = i + 1; j < tracks_.size(); ++j) {
       Track& a = tracks_[i];
       Track& b = tracks_[j];
       if (a.id <= 0 || b.id <= 0 || !same_target(a, b)) continue;  // tentative, already merged, or distinct
+      const std::pair<int32_t, int32_t> key{std::min(a.id, b.id), std::max(a.id, b.id)};
+      const auto it = agreeing_since_.find(key);
+      const int64_t since = it == agreeing_since_.end() ? utime : it->second;
+      if (utime - since < after_us) {  // not yet: two targets crossing agree only while they pass
+        agreeing[key] = since;
+        continue;
+      }
       Track& older = a.id < b.id ? a : b;
       Track& younger = a.id < b.id ? b : a;
       const int32_t id = older.id;
@@ -332,6 +343,7 @@ void Tracker::merge_duplicates() {
       ++stats_.merges;
     }
   }
+  agreeing_since_ = std::move(agreeing);
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.id < 0; }), tracks_.end());
 }
 

@@ -8,13 +8,13 @@
 #include <Eigen/Cholesky>
 
 #include <cmath>
-#include <cstdio>
 #include <random>
 
 namespace {
 
 using wingman::localizer::Tracker;
 using wingman::localizer::TrackerOptions;
+using wingman::localizer::TrackerStats;
 using wingman::localizer::TrackOutput;
 using wingman::localizer::WorldMeasurement;
 
@@ -273,43 +273,64 @@ TEST(Tracker, ABurstOfFalsePositivesCreatesNoConfirmedTrack) {
   EXPECT_EQ(out[0].track_id, 1);
 }
 
-TEST(Tracker, TwoCrossingTargetsKeepTheirIds) {
-  // A flies east, B north; both pass (20, 0, 5) at t = 4 s at 3 m/s, 90 degrees apart. Noise seed 5
-  // (range sigma 1 m along the line of sight, i.e. along A's path). Which output is which target: by
-  // position while they are over 3 m apart (|t - 4| > 0.7 s). At the crossing itself the detections of
-  // both lie within each other's noise and neither track's velocity is a fair witness (it differs
-  // between compilers' rounding), so there only two confirmed tracks are required; the ids after the
-  // crossing must be those before it.
-  Detections det(5);
-  Tracker t(three_of_five());
+/// Two targets crossing: A flies east, B north; both pass (20, 0, 5) at t = 4 s at 3 m/s, 90 degrees apart, seen from
+/// the origin (range noise 5 %, about 1 m, along A's path; noise seed `seed`), 3-of-5 birth with `options`. Returns
+/// the frames, from the first with both tracks confirmed, where the track nearer to A is not the id A had first (or
+/// fewer than two tracks are out), and the tracker's stats.
+std::pair<int, TrackerStats> crossing_id_errors(unsigned seed, TrackerOptions options) {
+  Detections det(seed);
+  Tracker t(options);
   const Eigen::Vector3d v_a(3, 0, 0), v_b(0, 3, 0);
   auto a = [&](double s) -> Eigen::Vector3d { return Eigen::Vector3d(20, 0, 5) + v_a * (s - 4); };
   auto b = [&](double s) -> Eigen::Vector3d { return Eigen::Vector3d(20, 0, 5) + v_b * (s - 4); };
-  int id_a = 0, id_b = 0;
+  int id_a = 0, id_b = 0, errors = 0;
   for (int k = 0; k <= 80; ++k) {
     const double s = k * 0.1;
     std::vector<WorldMeasurement> z{det(b(s)), det(a(s))};
-    ASSERT_TRUE(t.update(frame_utime(k), z));
+    if (!t.update(frame_utime(k), z)) return {1000, t.stats()};
     const auto out = t.confirmed(frame_utime(k));
     if (k < 2) continue;
-    ASSERT_EQ(out.size(), 2u) << "frame " << k;
-    if (std::abs(s - 4) <= 0.7) continue;  // the crossing: see above
-    const bool first_is_a = (out[0].p_target_in_world - a(s)).norm() < (out[1].p_target_in_world - a(s)).norm();
+    if (out.size() != 2u) {
+      ++errors;
+      continue;
+    }
+    // Which output is which target: the pairing with the smaller sum of state distances (position in m, velocity in
+    // m/s over one second): the velocities tell the two apart where the positions meet.
+    const auto d = [&](const TrackOutput& o, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
+      return (o.p_target_in_world - p).squaredNorm() + (o.v_target_in_world - v).squaredNorm();
+    };
+    const bool first_is_a = d(out[0], a(s), v_a) + d(out[1], b(s), v_b) < d(out[0], b(s), v_b) + d(out[1], a(s), v_a);
     const int now_a = first_is_a ? out[0].track_id : out[1].track_id;
     const int now_b = first_is_a ? out[1].track_id : out[0].track_id;
-    if (id_a == 0) {
-      id_a = now_a;
-      id_b = now_b;
-    }
-    EXPECT_EQ(now_a, id_a) << "frame " << k << " t " << s << "\n"
-                           << out[0].track_id << ": p " << out[0].p_target_in_world.transpose() << " v "
-                           << out[0].v_target_in_world.transpose() << "\n"
-                           << out[1].track_id << ": p " << out[1].p_target_in_world.transpose() << " v "
-                           << out[1].v_target_in_world.transpose();
-    EXPECT_EQ(now_b, id_b) << "frame " << k;
+    if (id_a == 0) id_a = now_a, id_b = now_b;
+    if (now_a != id_a || now_b != id_b) ++errors;
   }
-  EXPECT_EQ(t.stats().confirmations, 2);
-  EXPECT_EQ(t.stats().merges, 0);
+  return {errors, t.stats()};
+}
+
+TEST(Tracker, TwoCrossingTargetsKeepTheirIds) {
+  // Judged in every frame, through the crossing too: where the positions meet, the velocities tell the tracks apart;
+  // the two tracks agree in state while they pass, and tracker.merge_after_s keeps them from being merged.
+  const auto [errors, stats] = crossing_id_errors(5, three_of_five());
+  EXPECT_EQ(errors, 0);
+  EXPECT_EQ(stats.confirmations, 2);
+  EXPECT_EQ(stats.merges, 0);
+}
+
+TEST(Tracker, CrossingTargetsKeepTheirIdsOverFortySeedsAndWouldBeMergedWithoutMergeAfter) {
+  TrackerOptions at_once = three_of_five();
+  at_once.merge_after_s = 0;
+  int failed = 0, failed_at_once = 0, merges_at_once = 0;
+  for (unsigned seed = 1; seed <= 40; ++seed) {
+    failed += crossing_id_errors(seed, three_of_five()).first > 0;
+    const auto [e, stats] = crossing_id_errors(seed, at_once);
+    failed_at_once += e > 0;
+    merges_at_once += static_cast<int>(stats.merges);
+  }
+  EXPECT_EQ(failed, 0) << "of 40 seeds";
+  // The same crossings merged at once (the rule before): measured 2 of 40 lost an id to a merge.
+  EXPECT_GT(failed_at_once, 0);
+  EXPECT_GT(merges_at_once, 0);
 }
 
 TEST(Tracker, DuplicateDetectionsOfOneTargetGiveOneTrack) {
