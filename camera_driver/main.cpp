@@ -16,7 +16,7 @@ int run(common::Runtime& rt, const cd::CameraDriverOptions& options) {
   cd::CameraDriver driver(options.output, cd::make_source(options, std::make_shared<cd::SystemV4l2Io>(),
                                                           std::make_shared<cd::SystemClock>()));
   driver.open();  // a missing device or unreadable file throws: one line, exit 1
-  return cd::run_driver_loop(rt, driver, options.output.channel);
+  return cd::run_driver_loop(rt, driver, options.output.channel, options.preview);
 }
 
 }  // namespace

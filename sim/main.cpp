@@ -215,6 +215,9 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   simulator.set_own_pose_error(o.own_pose_error);
 
   if (o.render) status.declare_output(o.image_channel);
+  camera_driver::PreviewMaker preview(o.preview);
+  const std::string preview_channel = o.preview.channel_for(o.image_channel);
+  if (o.render && o.preview.enabled) status.declare_output(preview_channel);
   const bool via_mavlink = o.autopilot == "mavlink";
   if (via_mavlink && rt.input_is_file())
     throw std::runtime_error(
@@ -335,6 +338,8 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     }
     if (!frame.bgr.empty()) {
       rt.publish(o.image_channel, sim::to_image_message(frame.bgr, frame.utime, frame.index, camera.camera_id));
+      if (const auto p = preview.offer_bgr(frame.bgr, frame.utime, frame.index, camera.camera_id))
+        rt.publish(preview_channel, *p);
     }
     if (o.detections.from_ground_truth) {
       rt.publish(o.detections_channel, sim::truth_detections(frame.truth, frame.index, camera.model,

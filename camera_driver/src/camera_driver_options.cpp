@@ -29,6 +29,7 @@ std::vector<std::string> CameraDriverOptions::validate() const {
   for (auto& s : v4l2.validate()) p.push_back(std::move(s));
   for (auto& s : file.validate(source_kind == "file")) p.push_back(std::move(s));
   for (auto& s : output.validate()) p.push_back(std::move(s));
+  for (auto& s : preview.validate()) p.push_back(std::move(s));
   return p;
 }
 

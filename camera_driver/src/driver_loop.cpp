@@ -9,9 +9,13 @@
 
 namespace wingman::camera_driver {
 
-int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string& channel) {
+int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string& channel,
+                    const PreviewOptions& preview_options) {
   common::StatusTracker& status = rt.status();
   status.declare_output(channel);
+  PreviewMaker preview(preview_options);
+  const std::string preview_channel = preview_options.channel_for(channel);
+  if (preview_options.enabled) status.declare_output(preview_channel);
   status.set_state(status_t::STATE_OK, driver.describe());
   rt.publish_heartbeat();
 
@@ -36,6 +40,8 @@ int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         status.set_last_processed_seq(step.image.seq);
         status.record_latency_ms(step.convert_ms + publish_ms);
+        // The preview after the frame: the detector has it already.
+        if (const auto p = preview.offer(step.image)) rt.publish(preview_channel, *p);
         break;
       }
       case ReadStatus::kDisconnected:
@@ -62,8 +68,10 @@ int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string
     }
   }
   const SourceStats& s = driver.source().stats();
-  spdlog::info("{}: {} frames published, {} dropped, {} lost in sequence gaps, {} reconnects", stop_reason,
-               driver.frames_out(), s.dropped + driver.driver_drops(), s.lost_in_gaps, s.reconnects);
+  spdlog::info("{}: {} frames published, {} dropped, {} lost in sequence gaps, {} reconnects; {} previews on {}{}",
+               stop_reason, driver.frames_out(), s.dropped + driver.driver_drops(), s.lost_in_gaps, s.reconnects,
+               preview.made(), preview_channel,
+               preview.failures() ? fmt::format(" ({} frames could not be previewed)", preview.failures()) : "");
   return rt.shutdown(stop_reason);
 }
 

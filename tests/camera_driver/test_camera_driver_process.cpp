@@ -51,6 +51,7 @@ wingman::testing::RunResult run_driver(const TempDir& dir, const std::string& ya
 
 struct LogContents {
   std::vector<wingman::image_t> images;
+  std::vector<wingman::image_t> previews;  ///< PREVIEW_CAM0
   std::vector<wingman::status_t> statuses;
 };
 
@@ -62,6 +63,10 @@ LogContents decode_log(const std::string& path) {
       wingman::image_t img;
       EXPECT_GE(img.decode(ev.data.data(), 0, size), 0);
       out.images.push_back(img);
+    } else if (ev.channel == "PREVIEW_CAM0") {
+      wingman::image_t img;
+      EXPECT_GE(img.decode(ev.data.data(), 0, size), 0);
+      out.previews.push_back(img);
     } else if (ev.channel == "STATUS_CAMERA_DRIVER") {
       wingman::status_t s;
       EXPECT_GE(s.decode(ev.data.data(), 0, size), 0);
@@ -98,6 +103,33 @@ TEST(CameraDriverProcess, PlaysAVideoInFastModeIntoALogAndExitsZero) {
   ASSERT_FALSE(log.statuses.empty());
   EXPECT_EQ(log.statuses.back().state, int8_t{wingman::status_t::STATE_STOPPING});
   EXPECT_EQ(log.statuses.back().last_processed_seq, 5);
+}
+
+TEST(CameraDriverProcess, PublishesAPreviewOnceASecondOfMessageTimeOnItsOwnChannel) {
+  TempDir dir;
+  testing::write_gray_video(dir.file("clip.avi"), 25, 640, 480, 10.0);  // 2.5 s at 10 frames/s
+  const auto r =
+      run_driver(dir, file_config(dir.file("clip.avi"), "mode: fast, start_utime: " + std::to_string(kStartUtime)));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const LogContents log = decode_log(dir.file("out.lcmlog"));
+  ASSERT_EQ(log.images.size(), 25u);
+  ASSERT_EQ(log.previews.size(), 3u) << "at 0, 1 and 2 s";
+  for (size_t i = 0; i < log.previews.size(); ++i) {
+    const auto& p = log.previews[i];
+    EXPECT_EQ(p.utime, kStartUtime + static_cast<int64_t>(i) * 1'000'000);
+    EXPECT_EQ(p.seq, static_cast<int64_t>(i) * 10);
+    EXPECT_EQ(p.pixel_format, int8_t{wingman::image_t::MJPEG});
+    EXPECT_EQ(p.width, 320);
+    EXPECT_EQ(p.height, 240);
+    EXPECT_EQ(common::validate_message(p), "");
+  }
+  EXPECT_THAT(r.err, HasSubstr("3 previews on PREVIEW_CAM0"));
+  // Off: none.
+  TempDir off;
+  testing::write_gray_video(off.file("clip.avi"), 5, 64, 48, 10.0);
+  ASSERT_EQ(run_driver(off, file_config(off.file("clip.avi"), "mode: fast") + "preview: {enabled: false}\n").exit_code,
+            0);
+  EXPECT_TRUE(decode_log(off.file("out.lcmlog")).previews.empty());
 }
 
 TEST(CameraDriverProcess, MaxFramesStopsALoopingSource) {

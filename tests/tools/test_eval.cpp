@@ -799,6 +799,73 @@ TEST(Report, ThumbnailsOfALogWithLargeImagesAreScaledDown) {
   EXPECT_EQ(html.find("no-images"), std::string::npos);
 }
 
+/// Standard base64 (the report's thumbnails) to bytes: a plain decoder for the test.
+std::vector<uint8_t> unbase64(const std::string& s) {
+  const std::string a = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::vector<uint8_t> out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (const char c : s) {
+    const size_t v = a.find(c);
+    if (v == std::string::npos) continue;  // '=' padding
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<uint8_t>((acc >> bits) & 0xff));
+    }
+  }
+  return out;
+}
+
+TEST(Report, WithoutFullImagesTheFramesAreTheCamerasPreviewsWithBoxesScaledToThem) {
+  // A flight log as tools/fly.sh records it: no IMAGE_CAM0, one 320x180 preview a second on PREVIEW_CAM0, detections
+  // in the 1280x720 image's pixels: a 200-px box centred at (640, 360) is a 50-px box centred at (160, 90).
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 30; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event("GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5)}), u));
+    events.push_back(make_event("DETECTIONS_CAM0", detections_msg(u, k, {box(640, 360, 200, false)}, 1280, 720), u));
+    if (k % 10 != 0) continue;
+    cv::Mat small(180, 320, CV_8UC3, cv::Scalar(200, 170, 120));
+    std::vector<uint8_t> jpeg;
+    cv::imencode(".jpg", small, jpeg);
+    image_t p{};
+    p.utime = u;
+    p.seq = k;
+    p.width = 320;
+    p.height = 180;
+    p.pixel_format = image_t::MJPEG;
+    p.data = jpeg;
+    p.size = static_cast<int32_t>(jpeg.size());
+    events.push_back(make_event("PREVIEW_CAM0", p, u));
+  }
+  EvalOptions o;
+  o.log = dir.file("previews.lcmlog");
+  testing::write_log(o.log, events);
+  const EvalResult r = evaluate_log(o);
+  EXPECT_TRUE(r.image_utimes.empty());
+  ASSERT_EQ(r.preview_utimes.size(), 3u);
+  const auto frames = draw_report_frames(r, o);
+  ASSERT_EQ(frames.size(), 3u);
+  for (const auto& f : frames) {
+    EXPECT_EQ(f.width, 320);
+    EXPECT_EQ(f.height, 180);
+    const std::vector<uint8_t> bytes = unbase64(f.jpeg_b64);
+    const cv::Mat img = cv::imdecode(bytes, cv::IMREAD_COLOR);
+    ASSERT_EQ(img.cols, 320);
+    // The box's left edge (x 135) is drawn red over the background; the image centre inside the box is background.
+    const cv::Vec3b edge = img.at<cv::Vec3b>(90, 135), inside = img.at<cv::Vec3b>(90, 160);
+    EXPECT_GT(edge[2], 150);
+    EXPECT_LT(edge[0], 120) << "red (BGR 40, 39, 214), not the background (200, 170, 120)";
+    EXPECT_NEAR(inside[0], 200, 12);
+  }
+  const std::string html = html_report(r, o, frames);
+  EXPECT_NE(html.find("3 of the log's 3 previews"), std::string::npos);
+  EXPECT_EQ(html.find("no-images"), std::string::npos);
+}
+
 TEST(Report, UnwritableOutputNamesTheFile) {
   testing::TempDir dir;
   EvalOptions o;

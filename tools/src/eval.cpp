@@ -285,6 +285,13 @@ EvalResult evaluate_log(const EvalOptions& o) {
       for (int i = 0; i < 8; ++i) u = (u << 8) | p[i];
       r.image_utimes.push_back(static_cast<int64_t>(u));
       image_event_at.emplace(static_cast<int64_t>(u), ev->timestamp);
+    } else if (ev->channel == o.preview_channel &&
+               lcm_fingerprint(ev->data, ev->datalen) == static_cast<uint64_t>(wingman::image_t::getHash()) &&
+               ev->datalen >= 16) {
+      const auto* p = static_cast<const uint8_t*>(ev->data) + 8;
+      uint64_t u = 0;
+      for (int i = 0; i < 8; ++i) u = (u << 8) | p[i];
+      r.preview_utimes.push_back(static_cast<int64_t>(u));
     }
   }
   progress.done();
@@ -447,6 +454,7 @@ EvalResult evaluate_log(const EvalOptions& o) {
   for (const auto& d : detections) {
     auto& frame = r.frames[d.utime];
     for (const auto& b : d.boxes) frame.detections.push_back({b.cx, b.cy, b.w, b.h, d.camera_id, b.zoom_refined != 0});
+    if (d.image_width > 0) frame.image_width = d.image_width;
     r.detections_total += static_cast<int64_t>(d.boxes.size());
     const auto boxes = truth_boxes_at.find(d.utime);
     if (boxes == truth_boxes_at.end()) {

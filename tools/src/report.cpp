@@ -505,7 +505,10 @@ std::vector<HeadlineItem> report_headline(const EvalResult& r) {
 
 std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptions& o) {
   std::vector<ReportFrame> out;
-  const size_t n = r.image_utimes.size();
+  // The full images when the log has them, else the camera's previews (small JPEGs, boxes scaled to them).
+  const bool previews = r.image_utimes.empty();
+  const std::string& channel = previews ? o.preview_channel : o.image_channel;
+  const size_t n = previews ? r.preview_utimes.size() : r.image_utimes.size();
   if (n == 0 || o.report_frames <= 0) return out;
   std::set<size_t> wanted;  // indices among the image events, spread evenly
   const size_t k = std::min(n, static_cast<size_t>(o.report_frames));
@@ -515,7 +518,7 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
   size_t index = 0;
   while (const common::LcmLogEvent* ev = file.read_next()) {
     progress.tick();
-    if (ev->channel != o.image_channel ||
+    if (ev->channel != channel ||
         lcm_fingerprint(ev->data, ev->datalen) != static_cast<uint64_t>(wingman::image_t::getHash()))
       continue;
     const size_t i = index++;
@@ -524,11 +527,17 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
     if (img.decode(ev->data, 0, ev->datalen) < 0) continue;
     cv::Mat bgr = detector::image_to_bgr(img, nullptr);
     if (bgr.empty()) continue;
+    const auto fi = r.frames.find(img.utime);
+    // Boxes are in the source image's pixels: a preview is that image scaled down (its detections say how wide).
+    const double source_w =
+        previews ? (fi != r.frames.end() && fi->second.image_width > 0 ? fi->second.image_width : 0.0) : bgr.cols;
     // Scaled down first, then drawn on: lines and text stay legible on the thumbnail.
-    const double scale = bgr.cols > kReportThumbnailWidth ? static_cast<double>(kReportThumbnailWidth) / bgr.cols : 1.0;
-    if (scale < 1.0) {
+    const double shrink =
+        bgr.cols > kReportThumbnailWidth ? static_cast<double>(kReportThumbnailWidth) / bgr.cols : 1.0;
+    const double scale = source_w > 0 ? shrink * bgr.cols / source_w : 0.0;
+    if (shrink < 1.0) {
       cv::resize(bgr, bgr,
-                 cv::Size(kReportThumbnailWidth, std::max(1, static_cast<int>(std::lround(bgr.rows * scale)))), 0, 0,
+                 cv::Size(kReportThumbnailWidth, std::max(1, static_cast<int>(std::lround(bgr.rows * shrink)))), 0, 0,
                  cv::INTER_AREA);
     }
     const int thick = bgr.cols >= 240 ? 2 : 1;
@@ -537,8 +546,7 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
       return cv::Rect(cv::Point(px(b.cx - b.w / 2), px(b.cy - b.h / 2)),
                       cv::Point(px(b.cx + b.w / 2), px(b.cy + b.h / 2)));
     };
-    const auto fi = r.frames.find(img.utime);
-    if (fi != r.frames.end()) {
+    if (fi != r.frames.end() && scale > 0) {
       for (const auto& b : fi->second.truth_boxes) {
         if (b.camera_id != img.camera_id || !b.flag) continue;
         const bool leader = b.vehicle_id == o.leader_id;
@@ -589,12 +597,17 @@ std::string html_report(const EvalResult& r, const EvalOptions& o, const std::ve
                       escape_html(o.log), r.duration_s, r.truth_frames, escape_html(r.detection_source));
   html += headline_table(report_headline(r));
   html += "<h2>Camera frames</h2>\n";
-  if (r.image_utimes.empty()) {
+  if (r.image_utimes.empty() && r.preview_utimes.empty()) {
     html += "<p id=\"no-images\">This log has no camera images on <code>" + escape_html(o.image_channel) +
-            "</code>: the flight ran without rendering, or its recorder left the images out (<code>tools/fly.sh"
-            "</code> records them only with <code>--record-images</code>).</p>\n";
+            "</code> and no previews on <code>" + escape_html(o.preview_channel) +
+            "</code>: the flight ran without rendering (<code>tools/fly.sh</code> records the camera's 1 Hz preview "
+            "always, the full images only with <code>--record-images</code>).</p>\n";
   } else {
-    html += fmt::format("<p>{} of the log's {} images, evenly spaced. ", frames.size(), r.image_utimes.size()) +
+    html += (r.image_utimes.empty()
+                 ? fmt::format("<p>{} of the log's {} previews (<code>{}</code>: the camera's monitoring preview, "
+                               "about 1 per second; the full images are not in the log), evenly spaced. ",
+                               frames.size(), r.preview_utimes.size(), escape_html(o.preview_channel))
+                 : fmt::format("<p>{} of the log's {} images, evenly spaced. ", frames.size(), r.image_utimes.size())) +
             key("#00c800", "truth box (leader, with its matched track id)") + key("#a0a0a0", "truth box (other)") +
             key("#d62728", "detection, single pass") + key("#ff7f0e", "detection, zoom-in") +
             "</p>\n<div id=\"frames\">\n";

@@ -66,8 +66,9 @@ std::vector<std::string> SimOptions::validate() const {
   channel("output.detections_channel", detections_channel);
   if (autopilot != "lcm" && autopilot != "mavlink")
     p.push_back(problem("autopilot", autopilot, "must be lcm or mavlink"));
-  for (const auto& part : {camera.validate(), extrinsics.validate(), detections.validate(), sync.validate(),
-                           render_options.validate(), mavlink.validate(), own_pose_error.validate()}) {
+  for (const auto& part :
+       {camera.validate(), extrinsics.validate(), detections.validate(), sync.validate(), render_options.validate(),
+        mavlink.validate(), own_pose_error.validate(), preview.validate()}) {
     p.insert(p.end(), part.begin(), part.end());
   }
   return p;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wingman/camera_driver/file_source.hpp"
+#include "wingman/camera_driver/preview.hpp"
 #include "wingman/camera_driver/v4l2_source.hpp"
 
 #include <cstdint>
@@ -36,6 +37,8 @@ struct CameraDriverOptions {
   FileSourceOptions file;
   /// Publishing settings (section output).
   OutputOptions output;
+  /// The monitoring preview (section preview): small JPEG frames at 1 Hz on PREVIEW_CAM0 by default.
+  PreviewOptions preview;
 
   template <class V>
   void visit(V& v) {
@@ -64,6 +67,7 @@ struct CameraDriverOptions {
     v("output.decode_mjpeg", output.decode_mjpeg,
       "decode MJPEG frames and publish BGR8 (true) or publish them undecoded (false)");
     v("output.max_frames", output.max_frames, "exit 0 after publishing this many frames; 0 = no limit");
+    preview.visit(v);
   }
 
   /// Every problem, each naming its key; empty when valid. Both source sections are checked (so a

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wingman/camera_driver/camera_driver.hpp"
+#include "wingman/camera_driver/preview.hpp"
 
 #include <wingman/common/runtime.hpp>
 
@@ -20,7 +21,8 @@ constexpr int kDriverReadTimeoutMs = 50;
 /// (e.g. "device /dev/video0 ... ENODEV, reconnecting") from the moment the camera is lost until it is back; then OK
 /// again, the detail counting disconnects and reconnects. A heartbeat is published at once on each of these changes,
 /// not only at the status period. Frames lost in gaps or dropped are counted as source drops; nothing is published
-/// while the camera is gone.
-int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string& channel);
+/// while the camera is gone. After a frame, its preview (PreviewMaker, when due) goes to preview.channel_for(channel).
+int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string& channel,
+                    const PreviewOptions& preview = PreviewOptions{});
 
 }  // namespace wingman::camera_driver

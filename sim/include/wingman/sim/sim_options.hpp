@@ -6,6 +6,7 @@
 #include "wingman/sim/own_pose_error.hpp"
 #include "wingman/sim/render_options.hpp"
 
+#include <wingman/camera_driver/preview.hpp>
 #include <wingman/localizer/extrinsics.hpp>
 
 #include <cstdint>
@@ -121,6 +122,9 @@ struct SimOptions {
   TruthDetectionOptions detections;
   SyncOptions sync;
   RenderOptions render_options;
+  /// The monitoring preview of the rendered camera, as wingman-camera-driver publishes it (PREVIEW_CAM0, 1 Hz of
+  /// simulated time, 320 px JPEG): flight logs keep it (they leave IMAGE_* out), lcm-spy shows it.
+  camera_driver::PreviewOptions preview;
 
   template <class V>
   void visit(V& v) {
@@ -140,6 +144,7 @@ struct SimOptions {
     sync.visit(v);
     v("render.enabled", render, "render and publish images (false: no images, no EGL; boxes projected from models)");
     render_options.visit(v);
+    preview.visit(v);
   }
   std::vector<std::string> validate() const;
 };

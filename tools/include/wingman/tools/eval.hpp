@@ -27,6 +27,9 @@ struct EvalOptions {
   std::string targets_channel = "TARGETS";             ///< targets_t channel
   std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t channel
   std::string image_channel = "IMAGE_CAM0";            ///< image_t channel (latency reference, report frames)
+  /// The camera's monitoring preview (small JPEG image_t, 1 Hz: camera_driver/preview.hpp): the report's frames when
+  /// the log has no full images (flight logs leave IMAGE_* out).
+  std::string preview_channel = "PREVIEW_CAM0";
   int follower_id = 0;  ///< vehicle_truth_t.vehicle_id of the camera vehicle (the follower)
   int leader_id = 1;    ///< vehicle_truth_t.vehicle_id of the vehicle the formation is kept on
   /// Desired follower position minus leader position, world frame (ENU), metres; the z component is ignored when
@@ -176,10 +179,12 @@ struct EvalResult {
       int vehicle_id = -1;  ///< truth: vehicle id; detection: -1
     };
     std::vector<Box> truth_boxes, detections;
+    int image_width = 0;       ///< width of the source image the boxes are in (detections_t.image_width), 0 unknown
     int leader_track_id = -1;  ///< track id of the leader's matched target with this source_utime, -1 none
   };
   std::map<int64_t, FrameInfo> frames;  ///< by utime (ground truth and detections of camera 0)
   std::vector<int64_t> image_utimes;    ///< utimes of the image_t events on image_channel, log order
+  std::vector<int64_t> preview_utimes;  ///< utimes of the image_t events on preview_channel, log order
   int64_t first_truth_utime = 0;        ///< t = 0 of the time series
 
   std::string report() const;  ///< lines for people
