@@ -382,8 +382,17 @@ TEST(SimProcess, RenderedImagesArePublishedLikeTheCameraDriversAfterPoseAndTruth
                       "--lcm-out", f.out_url()},
                      120s);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto events = without_status(read_log(f.out));
-  ASSERT_EQ(events.size(), 3u * 3);
+  auto events = without_status(read_log(f.out));
+  // The camera's monitoring preview follows the first frame's image (1 per second of simulated time: one in 0.1 s),
+  // as the camera driver's does.
+  ASSERT_EQ(events.size(), 3u * 3 + 1);
+  ASSERT_EQ(events[3].channel, "PREVIEW_CAM0");
+  const auto preview = decode<wingman::image_t>(events[3]);
+  EXPECT_EQ(int{preview.pixel_format}, int{wingman::image_t::MJPEG});
+  EXPECT_EQ(preview.width, 320);
+  EXPECT_EQ(preview.height, 180);
+  EXPECT_EQ(preview.utime, decode<wingman::image_t>(events[2]).utime);
+  events.erase(events.begin() + 3);
   for (int64_t k = 0; k < 3; ++k) {
     ASSERT_EQ(events[3 * k].channel, "OWN_POSE");
     ASSERT_EQ(events[3 * k + 1].channel, "GROUND_TRUTH");

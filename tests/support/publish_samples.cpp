@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
-// wingman-publish-samples: publishes (or logs) one valid sample of every message type on its pipeline channel.
+// wingman-publish-samples: publishes (or logs) one valid sample of every message type on its pipeline channel, and the
+// camera's monitoring preview (PREVIEW_CAM0, made by camera_driver::PreviewMaker from the sample image).
 #include "wingman/common/message_validation.hpp"
 #include "wingman/common/time.hpp"
+
+#include <wingman/camera_driver/preview.hpp>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -111,6 +114,12 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   }
   image.size = static_cast<int32_t>(image.data.size());
   out.push_back(encode_sample("IMAGE_CAM0", image));
+  {
+    wingman::camera_driver::PreviewMaker preview{wingman::camera_driver::PreviewOptions{}};
+    const auto p = preview.offer(image);
+    if (!p) throw std::logic_error("the sample image gives no preview");
+    out.push_back(encode_sample("PREVIEW_CAM0", *p));
+  }
 
   wingman::detections_t detections;
   detections.utime = utime;
@@ -259,7 +268,7 @@ int run(const PublishSamplesOptions& options) {
         if (log.writeEvent(&ev) != 0) throw std::runtime_error(fmt::format("cannot write to {}", options.log_path));
       }
     }
-    std::cerr << fmt::format("wingman-publish-samples: wrote {} rounds of 7 channels to {}\n", options.repeat,
+    std::cerr << fmt::format("wingman-publish-samples: wrote {} rounds of 8 channels to {}\n", options.repeat,
                              options.log_path);
     return 0;
   }

@@ -24,9 +24,9 @@ using ::testing::Not;
 using wingman::tools::spy_command;
 using wingman::tools::SpyOptions;
 
-/// The seven channels wingman-publish-samples writes, one per message type.
-const std::vector<std::string> kPipelineChannels = {"IMAGE_CAM0", "DETECTIONS_CAM0", "OWN_POSE",    "TARGETS",
-                                                    "SETPOINT",   "STATUS_SAMPLE",   "GROUND_TRUTH"};
+/// The eight channels wingman-publish-samples writes: one per message type, and the camera's preview.
+const std::vector<std::string> kPipelineChannels = {"IMAGE_CAM0", "PREVIEW_CAM0", "DETECTIONS_CAM0", "OWN_POSE",
+                                                    "TARGETS",    "SETPOINT",     "STATUS_SAMPLE",   "GROUND_TRUTH"};
 
 /// Exit code and combined stdout+stderr of a shell command.
 struct CommandResult {
@@ -173,11 +173,14 @@ TEST(SpyDecode, EveryPipelineChannelDecodesWithTheClasspathOfWingmanSpy) {
   const SpyJava spy = spy_java_from_dry_run();
   const CommandResult check = run_decode_check(spy, log, kPipelineChannels);
   EXPECT_EQ(check.exit_code, 0) << "classpath " << spy.classpath << "\n" << check.output;
-  const std::vector<std::pair<std::string, std::string>> expected_types = {
-      {"IMAGE_CAM0", "wingman.image_t"},         {"DETECTIONS_CAM0", "wingman.detections_t"},
-      {"OWN_POSE", "wingman.own_pose_t"},        {"TARGETS", "wingman.targets_t"},
-      {"SETPOINT", "wingman.setpoint_t"},        {"STATUS_SAMPLE", "wingman.status_t"},
-      {"GROUND_TRUTH", "wingman.ground_truth_t"}};
+  const std::vector<std::pair<std::string, std::string>> expected_types = {{"IMAGE_CAM0", "wingman.image_t"},
+                                                                           {"PREVIEW_CAM0", "wingman.image_t"},
+                                                                           {"DETECTIONS_CAM0", "wingman.detections_t"},
+                                                                           {"OWN_POSE", "wingman.own_pose_t"},
+                                                                           {"TARGETS", "wingman.targets_t"},
+                                                                           {"SETPOINT", "wingman.setpoint_t"},
+                                                                           {"STATUS_SAMPLE", "wingman.status_t"},
+                                                                           {"GROUND_TRUTH", "wingman.ground_truth_t"}};
   for (const auto& [channel, type] : expected_types) {
     const std::vector<std::string> words = split_words(line_of(check.output, channel));
     ASSERT_EQ(words.size(), 4u) << channel << " in:\n" << check.output;
