@@ -277,6 +277,38 @@ std::string write_switches(const testing::TempDir& dir) {
   return path;
 }
 
+TEST(Eval, CountsTrackIdsAndSwitchesOfEveryVehicleNotOnlyTheLeaders) {
+  // Two targets (a crossing scenario): the leader (1) keeps track 3; vehicle 2, 5 m beside it, is track 4 for four
+  // frames, then track 5: 2 ids, 1 switch.
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event(
+        "GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5), vehicle(2, 5, 10, 5)}), u));
+    events.push_back(make_event(
+        "TARGETS", targets_msg(u, {world_target(3, 0, 10, 5, u), world_target(k < 4 ? 4 : 5, 5, 10, 5, u)}), u));
+  }
+  EvalOptions o;
+  o.log = dir.file("two.lcmlog");
+  testing::write_log(o.log, events);
+  const EvalResult r = evaluate_log(o);
+  ASSERT_EQ(r.ids_by_vehicle.size(), 2u);
+  EXPECT_EQ(r.ids_by_vehicle.at(1).track_ids, 1);
+  EXPECT_EQ(r.ids_by_vehicle.at(1).id_switches, 0);
+  EXPECT_EQ(r.ids_by_vehicle.at(2).track_ids, 2);
+  EXPECT_EQ(r.ids_by_vehicle.at(2).id_switches, 1);
+  EXPECT_EQ(r.track_ids_on_leader, 1);
+  EXPECT_NE(
+      r.report().find("track ids per vehicle: vehicle 1: 1 id(s), 0 switch(es); vehicle 2: 2 id(s), 1 switch(es)"),
+      std::string::npos)
+      << r.report();
+  EXPECT_NE(r.json().find("\"ids_by_vehicle\": {\"1\": {\"track_ids\": 1, \"id_switches\": 0}, \"2\": "
+                          "{\"track_ids\": 2, \"id_switches\": 1}}"),
+            std::string::npos)
+      << r.json();
+}
+
 TEST(Eval, CountsLeaderIdSwitchesAndFalseTracks) {
   testing::TempDir dir;
   EvalOptions o;

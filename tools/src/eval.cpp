@@ -371,6 +371,9 @@ EvalResult evaluate_log(const EvalOptions& o) {
   BinnedAcc by_range(o.range_bins_m);
   std::set<int> leader_tracks, false_tracks;
   std::map<size_t, std::pair<double, int>> leader_in_message;  // targets_t index -> (distance, track id)
+  // The same for every vehicle: vehicle id -> targets_t index -> (distance, track id); vehicle id -> track ids.
+  std::map<int, std::map<size_t, std::pair<double, int>>> vehicle_in_message;
+  std::map<int, std::set<int>> vehicle_tracks;
   const Track* follower = truth.count(o.follower_id) ? &truth.at(o.follower_id) : nullptr;
   for (const auto& [u, message, t] : estimates) {
     const Eigen::Vector3d p_est(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);
@@ -411,6 +414,11 @@ EvalResult evaluate_log(const EvalOptions& o) {
       los_along.add(along);
       los_across.add((e - along * los).norm());
     }
+    vehicle_tracks[best_id].insert(t.track_id);
+    {
+      auto [it, fresh] = vehicle_in_message[best_id].emplace(message, std::make_pair(best, t.track_id));
+      if (!fresh && best < it->second.first) it->second = {best, t.track_id};
+    }
     if (best_id == o.leader_id) {
       leader_tracks.insert(t.track_id);
       r.leader_estimate.push_back({secs(u), p_est});
@@ -432,6 +440,15 @@ EvalResult evaluate_log(const EvalOptions& o) {
   for (const auto& [message, match] : leader_in_message) {
     if (previous_id >= 0 && match.second != previous_id) ++r.leader_id_switches;
     previous_id = match.second;
+  }
+  for (const auto& [vehicle, messages] : vehicle_in_message) {
+    EvalResult::VehicleIds& v = r.ids_by_vehicle[vehicle];
+    v.track_ids = static_cast<int64_t>(vehicle_tracks[vehicle].size());
+    int previous = -1;
+    for (const auto& [message, match] : messages) {
+      if (previous >= 0 && match.second != previous) ++v.id_switches;
+      previous = match.second;
+    }
   }
 
   // Latency, from the exposure (the earlier of the image and the ground truth of that step, as the logger saw
@@ -559,6 +576,13 @@ std::string EvalResult::report() const {
                    target_estimates, false_targets, track_ids_on_leader, leader_id_switches);
   s += fmt::format("false tracks: {:.3f} false targets per second, {} distinct false track id(s)\n",
                    false_targets_per_s, false_track_ids);
+  if (ids_by_vehicle.size() > 1) {  // several targets: each one's identities
+    std::string line;
+    for (const auto& [vehicle, v] : ids_by_vehicle)
+      line += fmt::format("{}vehicle {}: {} id(s), {} switch(es)", line.empty() ? "" : "; ", vehicle, v.track_ids,
+                          v.id_switches);
+    s += "track ids per vehicle: " + line + "\n";
+  }
   s += "localization error (estimate - truth):\n";
   s += stats_line("3-D", localization);
   s += stats_line("x (east)", localization_axis[0]);
@@ -591,12 +615,24 @@ std::string EvalResult::report() const {
   return s;
 }
 
+namespace {
+/// {"<vehicle id>": {"track_ids": n, "id_switches": n}, ...}
+std::string ids_json(const std::map<int, EvalResult::VehicleIds>& ids) {
+  std::string j = "{";
+  for (const auto& [vehicle, v] : ids)
+    j += fmt::format("{}\"{}\": {{\"track_ids\": {}, \"id_switches\": {}}}", j.size() > 1 ? ", " : "", vehicle,
+                     v.track_ids, v.id_switches);
+  return j + "}";
+}
+}  // namespace
+
 std::string EvalResult::json() const {
   return fmt::format(
       "{{\"detection_source\": \"{}\", \"duration_s\": {:.3f}, \"truth_frames\": {}, \"frames_leader_visible\": {}, "
       "\"frames_leader_detected\": {}, \"false_boxes_leader_visible\": {}, \"frames_leader_visible_with_false_box\": "
       "{}, \"target_estimates\": {}, \"false_targets\": {}, \"false_targets_per_s\": "
       "{:.6f}, \"false_track_ids\": {}, \"track_ids_on_leader\": {}, \"leader_id_switches\": {}, "
+      "\"ids_by_vehicle\": {}, "
       "\"localization\": {}, \"localization_x\": {}, \"localization_y\": {}, \"localization_z\": {}, "
       "\"along_line_of_sight\": {}, \"across_line_of_sight\": {}, \"localization_by_range\": {}, "
       "\"formation_horizontal\": {}, \"formation_vertical\": {}, \"latency\": {}, \"inference_latency\": {}, "
@@ -606,14 +642,14 @@ std::string EvalResult::json() const {
       "{}, \"non_drone_boxes\": {}}}",
       detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected,
       false_boxes_leader_visible, frames_leader_visible_with_false_box, target_estimates, false_targets,
-      false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches, stats_json(localization),
-      stats_json(localization_axis[0]), stats_json(localization_axis[1]), stats_json(localization_axis[2]),
-      stats_json(along_line_of_sight), stats_json(across_line_of_sight), bins_json(localization_by_range, false),
-      stats_json(formation_horizontal), stats_json(formation_vertical), percentiles_json(latency_ms),
-      percentiles_json(inference_latency_ms), fraction_json(box_width_single), fraction_json(box_width_zoom),
-      bins_json(box_width_single_by_range, true), bins_json(box_width_zoom_by_range, true),
-      detection_bins_json(detection_by_range), detections_total, detections_outside_truth, detection_frames,
-      false_boxes, frames_with_false_box, non_drone_boxes);
+      false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches, ids_json(ids_by_vehicle),
+      stats_json(localization), stats_json(localization_axis[0]), stats_json(localization_axis[1]),
+      stats_json(localization_axis[2]), stats_json(along_line_of_sight), stats_json(across_line_of_sight),
+      bins_json(localization_by_range, false), stats_json(formation_horizontal), stats_json(formation_vertical),
+      percentiles_json(latency_ms), percentiles_json(inference_latency_ms), fraction_json(box_width_single),
+      fraction_json(box_width_zoom), bins_json(box_width_single_by_range, true),
+      bins_json(box_width_zoom_by_range, true), detection_bins_json(detection_by_range), detections_total,
+      detections_outside_truth, detection_frames, false_boxes, frames_with_false_box, non_drone_boxes);
 }
 
 std::string EvalResult::csv() const {

@@ -106,6 +106,13 @@ struct EvalResult {
   /// Changes of the leader's track id: in each targets_t (log order) the target matched to the leader nearest to
   /// it gives the id; every change from one message with a leader target to the next one with one counts.
   int64_t leader_id_switches = 0;
+  /// Every truth vehicle but the follower that a world target was matched to, the leader included: distinct track
+  /// ids and id switches, counted as for the leader (several targets: crossings keep or swap identities).
+  struct VehicleIds {
+    int64_t track_ids = 0;
+    int64_t id_switches = 0;
+  };
+  std::map<int, VehicleIds> ids_by_vehicle;
   ErrorStats localization;                      ///< |p_est - p_truth|, 3-D, metres
   std::array<ErrorStats, 3> localization_axis;  ///< per world axis (x, y, z): RMS, mean |e|, max |e|
   ErrorStats along_line_of_sight;               ///< error component along the follower-to-target line
