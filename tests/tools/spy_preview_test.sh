@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # The camera in lcm-spy (issue 34): wingman-camera-driver plays a real 1280x720 frame at 10 Hz for 5 s over udpm, and
-# BusCheck (Java LCM, the receiver and classpath of lcm-spy) listens: PREVIEW_CAM0 must arrive (at least 4 previews,
-# 1 Hz) and decode as wingman.image_t. Prints what Java LCM got of IMAGE_CAM0 beside it (Java LCM 1.3.1 ignores
+# BusCheck (Java LCM, the receiver and classpath of lcm-spy) listens for 15 s: PREVIEW_CAM0 must arrive (at least 4
+# previews, 1 Hz) and decode as wingman.image_t. Prints what Java LCM got of IMAGE_CAM0 beside it (Java LCM 1.3.1 ignores
 # recv_buf_size: the 2.7 MB frames are mostly lost; not asserted). Run inside tools/netns_run.sh.
 # Usage: spy_preview_test.sh SRC_DIR CAMERA_DRIVER JAVA_CLASS_DIR LCM_JAR TYPES_JAR
 set -euo pipefail
@@ -29,10 +29,10 @@ with open(sys.argv[1], "wb") as f:
 ' "$tmp/frame.ppm"
 printf 'source: {kind: file}\nfile: {path: "%s", mode: realtime, fps: 10, loop: true}\noutput: {max_frames: 50}\n' \
   "$tmp/frame.ppm" > "$tmp/camera.yaml"
-java -cp "$lcm_jar:$types_jar:$classes" BusCheck "$url" 8 > "$tmp/bus.txt" 2> "$tmp/bus.err" &
+java -cp "$lcm_jar:$types_jar:$classes" BusCheck "$url" 15 > "$tmp/bus.txt" 2> "$tmp/bus.err" &
 java_pid=$!
-for _ in $(seq 100); do grep -q "BusCheck: listening" "$tmp/bus.txt" 2>/dev/null && break; sleep 0.1; done
-grep -q "BusCheck: listening" "$tmp/bus.txt" || { cat "$tmp/bus.err" >&2; fail "BusCheck did not start within 10 s"; }
+for _ in $(seq 300); do grep -q "BusCheck: listening" "$tmp/bus.txt" 2>/dev/null && break; sleep 0.1; done
+grep -q "BusCheck: listening" "$tmp/bus.txt" || { cat "$tmp/bus.err" >&2; fail "BusCheck did not start within 30 s"; }
 timeout 30 "$driver" --config "$tmp/camera.yaml" --lcm-url "$url" 2> "$tmp/driver.err" ||
   { cat "$tmp/driver.err" >&2; fail "the camera driver failed"; }
 wait "$java_pid" || { cat "$tmp/bus.err" >&2; fail "BusCheck failed"; }
