@@ -34,6 +34,8 @@ std::vector<std::string> TrackerOptions::validate() const {
     p.push_back(problem("tracker.accel_noise", accel_noise, "must be finite and >= 0"));
   if (!(gate_chi2 > 0) || !std::isfinite(gate_chi2))
     p.push_back(problem("tracker.gate_chi2", gate_chi2, "must be finite and > 0"));
+  if (!(ambiguity_chi2 >= 0) || !std::isfinite(ambiguity_chi2))
+    p.push_back(problem("tracker.ambiguity_chi2", ambiguity_chi2, "must be finite and >= 0"));
   if (!(merge_after_s >= 0) || !std::isfinite(merge_after_s))
     p.push_back(problem("tracker.merge_after_s", merge_after_s, "must be finite and >= 0"));
   if (birth_hits < 1) p.push_back(problem("tracker.birth_hits", birth_hits, "must be >= 1"));
@@ -92,7 +94,7 @@ size_t Tracker::num_held() const {
 size_t Tracker::num_confirmed() const { return tracks_.size() - num_tentative(); }
 
 void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
-                        std::vector<int>& track_to_z) const {
+                        std::vector<int>& track_to_z, Eigen::MatrixXd* cost_out) const {
   track_to_z.assign(tracks.size(), -1);
   if (tracks.empty() || z.empty()) return;
   Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(tracks.size()),
@@ -112,6 +114,7 @@ void Tracker::associate(std::vector<Track*>& tracks, const std::vector<WorldMeas
   track_to_z = association_ == AssociationMethod::kGreedy ? greedy_assign(cost) : hungarian(cost);
   for (int j : track_to_z)
     if (j >= 0) z_used[static_cast<size_t>(j)] = true;
+  if (cost_out) *cost_out = std::move(cost);
 }
 
 void Tracker::hit(Track& t, const WorldMeasurement& z) {
@@ -212,13 +215,42 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
         index.push_back(i);
       }
     std::vector<int> track_to_z;
-    associate(group, z, z_used, track_to_z);
-    for (size_t k = 0; k < group.size(); ++k)
-      if (track_to_z[k] >= 0) {
-        hit(*group[k], z[static_cast<size_t>(track_to_z[k])]);
-        track_hit[index[k]] = true;
-        ++stats_.associated;
+    Eigen::MatrixXd cost;
+    associate(group, z, z_used, track_to_z, &cost);
+    // Two confirmed tracks that could as well have each other's detections (targets crossing): a coin toss, which
+    // would swap their identities half the time; both coast instead (the frame counts for their life).
+    std::vector<bool> coast(group.size(), false);
+    if (confirmed_pass && options_.ambiguity_chi2 > 0) {
+      const auto c = [&](size_t track, int det) { return cost(static_cast<Eigen::Index>(track), det); };
+      for (size_t a = 0; a < group.size(); ++a)
+        for (size_t b = a + 1; b < group.size(); ++b) {
+          const int i = track_to_z[a], j = track_to_z[b];
+          if (i < 0 || j < 0 || is_forbidden(c(a, j)) || is_forbidden(c(b, i))) continue;
+          if ((c(a, j) + c(b, i)) - (c(a, i) + c(b, j)) < options_.ambiguity_chi2) coast[a] = coast[b] = true;
+        }
+      const int64_t max_coast_us = static_cast<int64_t>(std::llround(options_.max_prediction_s * 1e6));
+      for (size_t k = 0; k < group.size(); ++k) {
+        Track& t = *group[k];
+        if (!coast[k]) {
+          t.coasting_since_utime = -1;
+        } else if (t.coasting_since_utime < 0) {
+          t.coasting_since_utime = utime;
+        } else if (utime - t.coasting_since_utime > max_coast_us) {
+          coast[k] = false;  // coasted long enough (two targets flying together): the optimal assignment again
+        }
       }
+    }
+    for (size_t k = 0; k < group.size(); ++k) {
+      if (track_to_z[k] < 0) continue;
+      track_hit[index[k]] = true;
+      if (coast[k]) {
+        group[k]->last_hit_utime = utime;
+        ++stats_.ambiguous;
+        continue;
+      }
+      hit(*group[k], z[static_cast<size_t>(track_to_z[k])]);
+      ++stats_.associated;
+    }
   }
 
   // Book-keeping and deletion of the existing tracks.

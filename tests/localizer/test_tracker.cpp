@@ -2,6 +2,9 @@
 // Tracker: options, frame order, M-of-N birth, death, ids, false-positive burst, crossing targets,
 // accuracy (raw vs sliding window vs Kalman) and lag compensation on simulated detections.
 #include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
 #include <wingman/common/config.hpp>
 #include <wingman/localizer/tracker.hpp>
 
@@ -317,20 +320,23 @@ TEST(Tracker, TwoCrossingTargetsKeepTheirIds) {
   EXPECT_EQ(stats.merges, 0);
 }
 
-TEST(Tracker, CrossingTargetsKeepTheirIdsOverFortySeedsAndWouldBeMergedWithoutMergeAfter) {
-  TrackerOptions at_once = three_of_five();
-  at_once.merge_after_s = 0;
-  int failed = 0, failed_at_once = 0, merges_at_once = 0;
+TEST(Tracker, CrossingTargetsKeepTheirIdsOverFortySeedsAndDidNotBefore) {
+  // The rule before: the optimal assignment in every frame, tracks merged as soon as they agree.
+  TrackerOptions before = three_of_five();
+  before.merge_after_s = 0;
+  before.ambiguity_chi2 = 0;
+  TrackerOptions now = three_of_five();
+  if (const char* m = std::getenv("WINGMAN_CROSSING_AMBIGUITY")) now.ambiguity_chi2 = std::atof(m);
+  if (const char* m = std::getenv("WINGMAN_CROSSING_MERGE_AFTER")) now.merge_after_s = std::atof(m);
+  int failed = 0, failed_before = 0;
   for (unsigned seed = 1; seed <= 40; ++seed) {
-    failed += crossing_id_errors(seed, three_of_five()).first > 0;
-    const auto [e, stats] = crossing_id_errors(seed, at_once);
-    failed_at_once += e > 0;
-    merges_at_once += static_cast<int>(stats.merges);
+    failed += crossing_id_errors(seed, now).first > 0;
+    failed_before += crossing_id_errors(seed, before).first > 0;
   }
-  EXPECT_EQ(failed, 0) << "of 40 seeds";
-  // The same crossings merged at once (the rule before): measured 2 of 40 lost an id to a merge.
-  EXPECT_GT(failed_at_once, 0);
-  EXPECT_GT(merges_at_once, 0);
+  std::printf("crossings of 40 seeds with ids wrong: %d now, %d with the rule before\n", failed, failed_before);
+  EXPECT_EQ(failed, 0);
+  // Measured 2 of 40 (two merges) with GCC, 2 of 40 (swaps at the crossing) with clang and ASan.
+  EXPECT_GT(failed_before, 0);
 }
 
 TEST(Tracker, DuplicateDetectionsOfOneTargetGiveOneTrack) {

@@ -76,6 +76,11 @@ struct TrackerOptions {
   /// followed twice stays together, two targets crossing agree only while they pass (with 1 m of range noise along
   /// one's path, 2 of 40 seeded 90-degree crossings at 3 m/s merged at once). Seconds, >= 0 (0: at once).
   double merge_after_s = 1.0;
+  /// Crossing targets: when giving two confirmed tracks each other's detections costs less than this much more
+  /// squared Mahalanobis distance than the optimal assignment, which detection is whose is a coin toss: neither track
+  /// takes one; both coast on their constant-velocity prediction (the frame counts as a hit for their life) for at
+  /// most max_prediction_s in a row, and the two detections start no track. 0 = always the optimal assignment. >= 0.
+  double ambiguity_chi2 = 2.0;
   /// Online size estimation (tracker.size_*): each track's range scale from the camera's motion relative to it.
   SizeEstimatorOptions size;
 
@@ -98,6 +103,9 @@ struct TrackerOptions {
     v("tracker.max_tracks", max_tracks, "tracks (tentative + confirmed) kept at most");
     v("tracker.merge_chi2", merge_chi2,
       "merge confirmed tracks closer than this in state (6 dof: 16.81 = 99 %); 0 = off");
+    v("tracker.ambiguity_chi2", ambiguity_chi2,
+      "two confirmed tracks whose detections could be swapped within this much squared Mahalanobis distance coast "
+      "instead (crossing targets); 0 = off");
     v("tracker.merge_after_s", merge_after_s,
       "confirmed tracks are merged once they have agreed in state for this long, s (0 = at once)");
     size.visit(v);
@@ -146,6 +154,7 @@ struct TrackerStats {
   int64_t tentative_dropped = 0;  ///< tentative tracks that failed the M-of-N rule or timed out
   int64_t deaths = 0;             ///< confirmed tracks deleted after death_timeout_s
   int64_t merges = 0;             ///< duplicates merged into an older confirmed track (or not confirmed)
+  int64_t ambiguous = 0;          ///< confirmed-track updates skipped as a coin toss between two tracks (coasted)
 };
 
 /// Tracks targets from world-frame detections, one frame (image) at a time.
@@ -209,10 +218,12 @@ class Tracker {
     SizeEstimate scale;                    // the adopted range scale: detections enter the filter at c + s (z - c)
     SizeEstimate candidate;                // an acceptable fit waiting for a second, later one that agrees with it
     int64_t candidate_utime = -1;          // its time; -1: none
+    int64_t coasting_since_utime = -1;     // first frame of the current run of ambiguous frames; -1: none
   };
 
+  /// `cost` (optional): the tracks x detections squared Mahalanobis distances (kForbiddenCost outside the gates).
   void associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
-                 std::vector<int>& track_to_z) const;
+                 std::vector<int>& track_to_z, Eigen::MatrixXd* cost = nullptr) const;
   void hit(Track& t, const WorldMeasurement& z);
   TrackOutput output(const Track& t, int64_t predict_to_utime) const;
   bool same_target(const Track& a, const Track& b) const;
