@@ -309,6 +309,31 @@ TEST(Eval, CountsTrackIdsAndSwitchesOfEveryVehicleNotOnlyTheLeaders) {
       << r.json();
 }
 
+TEST(EvalCli, JsonDashPrintsTheJsonAsJsonStdoutDoesAndReportTakesOut) {
+  // One meaning per flag: --json FILE writes the JSON, --json - prints it (val too); report's file is --out like
+  // the other verbs' (-o and --output still work).
+  testing::TempDir dir;
+  const std::string log = write_switches(dir), wingman = std::string(WINGMAN_DEFAULT_BIN_DIR) + "/wingman";
+  const auto dash = testing::run({wingman, "eval", log, "--json", "-", "--quiet"});
+  const auto flag = testing::run({wingman, "eval", log, "--json-stdout", "--quiet"});
+  ASSERT_EQ(dash.exit_code, 0) << dash.err;
+  ASSERT_EQ(flag.exit_code, 0) << flag.err;
+  EXPECT_EQ(dash.out.rfind("{\"detection_source\": ", 0), 0u) << dash.out;
+  EXPECT_EQ(dash.out, flag.out);
+  EXPECT_FALSE(std::ifstream("-").good()) << "no file named -";
+  const auto file = testing::run({wingman, "eval", log, "--json", dir.file("e.json"), "--quiet"});
+  ASSERT_EQ(file.exit_code, 0) << file.err;
+  std::stringstream written;
+  written << std::ifstream(dir.file("e.json")).rdbuf();
+  EXPECT_EQ(written.str(), dash.out);
+  for (const char* out_flag : {"--out", "-o", "--output"}) {
+    const std::string html = dir.file(std::string("r") + out_flag + ".html");
+    const auto rep = testing::run({wingman, "report", log, out_flag, html, "--quiet"});
+    ASSERT_EQ(rep.exit_code, 0) << out_flag << ": " << rep.err;
+    EXPECT_TRUE(std::ifstream(html).good()) << out_flag;
+  }
+}
+
 TEST(Eval, CountsLeaderIdSwitchesAndFalseTracks) {
   testing::TempDir dir;
   EvalOptions o;

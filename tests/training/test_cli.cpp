@@ -37,6 +37,10 @@ TEST(WingmanVal, JsonOfSavedPredictionsHasTheHandComputedAp) {
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("\"ap\": 0.666667"), std::string::npos) << r.out;
+  // --json - is the same as --json alone (as for wingman eval).
+  const auto dash = wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--json", "-"});
+  ASSERT_EQ(dash.exit_code, 0) << dash.err;
+  EXPECT_EQ(dash.out, r.out);
   const auto table =
       wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--conf", "0.05"});
   ASSERT_EQ(table.exit_code, 0) << table.err;

@@ -182,14 +182,15 @@ int main(int argc, char** argv) {
   auto* ev = app.add_subcommand(
       "eval", "Localization, tracking, latency and box errors of a simulated flight's log against its ground truth");
   add_eval_options(ev, eval, eval_offset, eval_target, eval_quiet);
-  ev->add_option("--json", eval.json_path, "Also write the result as JSON to this file");
-  ev->add_flag("--json-stdout", eval_json_stdout, "Print JSON instead of the table");
+  ev->add_option("--json", eval.json_path,
+                 "Also write the result as JSON to this file; - prints it instead of the table");
+  ev->add_flag("--json-stdout", eval_json_stdout, "Print JSON instead of the table (the same as --json -)");
   ev->add_option("--csv", eval.csv_path, "Write the per-target time series (t, track, range, estimate, truth, error)");
   ev->add_option("--report", eval.report_path, "Write a self-contained HTML report to this file");
   auto* rp = app.add_subcommand(
       "report", "One self-contained HTML page about a simulated flight: charts and camera frames (opens offline)");
   add_eval_options(rp, report, report_offset, report_target, report_quiet);
-  rp->add_option("-o,--output", report.report_path, "HTML file to write")->required();
+  rp->add_option("-o,--out,--output", report.report_path, "HTML file to write")->required();
   rp->add_option("--json", report.json_path, "Also write the result as JSON to this file");
   rp->add_option("--csv", report.csv_path, "Also write the per-target time series as CSV to this file");
 
@@ -272,6 +273,10 @@ int main(int argc, char** argv) {
           return 2;
         }
         o->has_formation = true;
+      }
+      if (cmd == ev && o->json_path == "-") {  // --json -: the JSON on stdout, as --json-stdout
+        o->json_path.clear();
+        eval_json_stdout = true;
       }
       if (!quiet) o->progress = &std::cerr;
       const EvalResult result = evaluate_log(*o);

@@ -224,8 +224,8 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                 "A truth within this many pixels of the image's border touches the edge (default 1)");
   v->add_option("--list", s.val_list, "List this many of the largest truths not found, per criterion (default 10)");
   s.val_json = v->add_option("--json", s.val_json_path,
-                             "Alone: print one JSON object (with the PR curves and every truth not found) instead of "
-                             "the table; --json FILE: print the table and write the JSON to FILE")
+                             "Alone or --json -: print one JSON object (with the PR curves and every truth not found) "
+                             "instead of the table; --json FILE: print the table and write the JSON to FILE")
                    ->expected(0, 1);
   training::SequenceEvalOptions& so = s.sequences;
   v->add_flag(
@@ -303,7 +303,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       });
       err << fmt::format("wingman val: {} clips in {:.0f} s\n", r.clips.size(),
                          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      const bool json_stdout = s.val_json->count() > 0 && s.val_json_path.empty();
+      const bool json_stdout = s.val_json->count() > 0 && (s.val_json_path.empty() || s.val_json_path == "-");
       if (!json_stdout && !s.val_json_path.empty()) {
         std::ofstream f(s.val_json_path);
         f << r.json() << "\n";
@@ -322,7 +322,7 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
             if (done % 100 == 0 || done == total) err << fmt::format("wingman val: {}/{} images\n", done, total);
           },
           [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
-      const bool json_stdout = s.val_json->count() > 0 && s.val_json_path.empty();
+      const bool json_stdout = s.val_json->count() > 0 && (s.val_json_path.empty() || s.val_json_path == "-");
       if (!json_stdout && !s.val_json_path.empty()) {
         std::ofstream f(s.val_json_path);
         f << m.json() << "\n";
