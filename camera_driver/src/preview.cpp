@@ -3,6 +3,7 @@
 #include "wingman/camera_driver/preview.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/detector/preprocess.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -75,37 +76,8 @@ std::optional<wingman::image_t> PreviewMaker::offer_bgr(const cv::Mat& bgr, int6
 
 std::optional<wingman::image_t> PreviewMaker::offer(const wingman::image_t& f) {
   if (!due(f.utime)) return std::nullopt;
-  cv::Mat bgr;
-  const auto bytes = const_cast<uint8_t*>(f.data.data());
-  const size_t n = f.data.size();
-  const bool rows_fit =
-      f.width > 0 && f.height > 0 && f.stride > 0 && static_cast<size_t>(f.stride) * static_cast<size_t>(f.height) <= n;
-  switch (f.pixel_format) {
-    case wingman::image_t::MJPEG:
-      // Decoded at a quarter or an eighth of its size when that is still wider than the preview: cheaper.
-      if (n > 0) {
-        const int flag = f.width >= 8 * o_.max_width   ? cv::IMREAD_REDUCED_COLOR_8
-                         : f.width >= 4 * o_.max_width ? cv::IMREAD_REDUCED_COLOR_4
-                         : f.width >= 2 * o_.max_width ? cv::IMREAD_REDUCED_COLOR_2
-                                                       : cv::IMREAD_COLOR;
-        bgr = cv::imdecode(cv::Mat(1, static_cast<int>(n), CV_8UC1, bytes), flag);
-      }
-      break;
-    case wingman::image_t::BGR8:
-      if (rows_fit && f.stride >= 3 * f.width) bgr = cv::Mat(f.height, f.width, CV_8UC3, bytes, f.stride);
-      break;
-    case wingman::image_t::GRAY8:
-      if (rows_fit && f.stride >= f.width)
-        cv::cvtColor(cv::Mat(f.height, f.width, CV_8UC1, bytes, f.stride), bgr, cv::COLOR_GRAY2BGR);
-      break;
-    case wingman::image_t::YUYV:
-      if (rows_fit && f.width % 2 == 0 && f.stride >= 2 * f.width)
-        cv::cvtColor(cv::Mat(f.height, f.width, CV_8UC2, bytes, f.stride), bgr, cv::COLOR_YUV2BGR_YUYV);
-      break;
-    default:
-      break;
-  }
-  return encode(bgr, f.utime, f.seq, f.camera_id);
+  // The detector's conversion (every pixel format, each field checked): an impossible frame gives an empty Mat.
+  return encode(detector::image_to_bgr(f, nullptr), f.utime, f.seq, f.camera_id);
 }
 
 }  // namespace wingman::camera_driver

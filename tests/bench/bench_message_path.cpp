@@ -5,6 +5,7 @@
 // Run: build/tests/bench_message_path --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 #include <wingman/camera_driver/camera_driver.hpp>
+#include <wingman/camera_driver/preview.hpp>
 #include <wingman/common/latest_worker.hpp>
 #include <wingman/common/message_validation.hpp>
 
@@ -90,6 +91,40 @@ void BM_DecodeMjpeg(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_DecodeMjpeg)->Apply(Args);
+
+// The monitoring preview (camera_driver::PreviewMaker), one made per iteration (each frame dated 1 s after the last):
+// state.range(2) 0 for a BGR8 frame, 1 for MJPEG; the driver makes one a second, the other frames return at once.
+void BM_MakePreview(benchmark::State& state) {
+  const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
+  cv::Mat img(h, w, CV_8UC3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) img.at<cv::Vec3b>(y, x) = cv::Vec3b(x & 0xff, y & 0xff, (x + y) & 0xff);
+  wingman::image_t frame{};
+  frame.width = w;
+  frame.height = h;
+  if (state.range(2) == 1) {
+    frame.pixel_format = wingman::image_t::MJPEG;
+    cv::imencode(".jpg", img, frame.data);
+  } else {
+    frame.pixel_format = wingman::image_t::BGR8;
+    frame.stride = 3 * w;
+    frame.data.assign(img.data, img.data + img.total() * img.elemSize());
+  }
+  frame.size = static_cast<int32_t>(frame.data.size());
+  cd::PreviewMaker maker(cd::PreviewOptions{});
+  for (auto _ : state) {
+    frame.utime += 1000000;
+    const auto p = maker.offer(frame);
+    if (!p) state.SkipWithError("no preview");
+    benchmark::DoNotOptimize(p);
+  }
+}
+BENCHMARK(BM_MakePreview)
+    ->Args({640, 480, 0})
+    ->Args({1280, 720, 0})
+    ->Args({640, 480, 1})
+    ->Args({1280, 720, 1})
+    ->Unit(benchmark::kMicrosecond);
 
 // What the real-time detector's worker does with a frame, besides detecting: keeps its header, frees its pixels.
 int64_t keep_header(wingman::image_t& img) {
