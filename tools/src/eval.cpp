@@ -24,6 +24,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -40,6 +41,17 @@ bool decode(const common::LcmLogEvent& ev, Msg* m) {
   if (lcm_fingerprint(ev.data, ev.datalen) != static_cast<uint64_t>(Msg::getHash())) return false;
   if (m->decode(ev.data, 0, ev.datalen) < 0) return false;
   return common::validate_message(*m).empty();
+}
+
+/// The utime of an image_t event without decoding its pixels (right after the fingerprint, big-endian); nullopt when
+/// the event is not an image_t.
+std::optional<int64_t> image_utime(const common::LcmLogEvent& ev) {
+  if (ev.datalen < 16 || lcm_fingerprint(ev.data, ev.datalen) != static_cast<uint64_t>(wingman::image_t::getHash()))
+    return std::nullopt;
+  const auto* p = static_cast<const uint8_t*>(ev.data) + 8;
+  uint64_t u = 0;
+  for (int i = 0; i < 8; ++i) u = (u << 8) | p[i];
+  return static_cast<int64_t>(u);
 }
 
 /// Index of the range bin of `range` (upper edges `edges`; the last bin is open).
@@ -276,22 +288,14 @@ EvalResult evaluate_log(const EvalOptions& o) {
           ++r.non_drone_boxes;
       }
       detections.push_back({d.utime, d.camera_id, d.image_width, std::move(drones)});
-    } else if (ev->channel == o.image_channel &&
-               lcm_fingerprint(ev->data, ev->datalen) == static_cast<uint64_t>(wingman::image_t::getHash()) &&
-               ev->datalen >= 16) {
-      // Only the utime (right after the fingerprint, big-endian); the pixels are read by the report when needed.
-      const auto* p = static_cast<const uint8_t*>(ev->data) + 8;
-      uint64_t u = 0;
-      for (int i = 0; i < 8; ++i) u = (u << 8) | p[i];
-      r.image_utimes.push_back(static_cast<int64_t>(u));
-      image_event_at.emplace(static_cast<int64_t>(u), ev->timestamp);
-    } else if (ev->channel == o.preview_channel &&
-               lcm_fingerprint(ev->data, ev->datalen) == static_cast<uint64_t>(wingman::image_t::getHash()) &&
-               ev->datalen >= 16) {
-      const auto* p = static_cast<const uint8_t*>(ev->data) + 8;
-      uint64_t u = 0;
-      for (int i = 0; i < 8; ++i) u = (u << 8) | p[i];
-      r.preview_utimes.push_back(static_cast<int64_t>(u));
+    } else if (ev->channel == o.image_channel || ev->channel == o.preview_channel) {
+      // Only the utime: the pixels are read by the report when needed.
+      if (const std::optional<int64_t> u = image_utime(*ev); u && ev->channel == o.image_channel) {
+        r.image_utimes.push_back(*u);
+        image_event_at.emplace(*u, ev->timestamp);
+      } else if (u) {
+        r.preview_utimes.push_back(*u);
+      }
     }
   }
   progress.done();
