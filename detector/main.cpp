@@ -5,6 +5,7 @@
 #include "wingman/detector/model_loader.hpp"
 #include "wingman/detector/preprocess.hpp"
 #include "wingman/detector/sized_detector.hpp"
+#include "wingman/detector/track_windows.hpp"
 
 #include <wingman/common/latest_worker.hpp>
 #include <wingman/common/runtime.hpp>
@@ -18,7 +19,9 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -130,6 +133,14 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
                      net.height, image.width, image.height),
          ""});
   };
+  // Tracker-driven windows: the localizer's predictions, and a second network at the crop size.
+  std::unique_ptr<detector::WindowDetector> window_detector;
+  if (o.windows.enabled)
+    window_detector = std::make_unique<detector::WindowDetector>(o.windows, o.detection, model, make_backend);
+  std::mutex windows_mutex;  // the newest windows: written by the LCM thread, read where frames are detected
+  std::optional<track_windows_t> newest_windows;
+  int32_t image_camera_id = -1;  // the camera of the frames seen (a windows message for another is a counted drop)
+  detector::WindowStats window_stats;
   detector::SizedDetector pipeline(o.detection, std::move(model), input_size, make_backend, on_build);
 
   // Publishes the detections of frame `img` (its header is enough) and marks it processed.
@@ -161,6 +172,21 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     Detected d;
     d.boxes = pipeline.detect(bgr);
+    if (window_detector) {
+      std::optional<track_windows_t> windows;
+      {
+        std::lock_guard<std::mutex> lock(windows_mutex);
+        windows = newest_windows;
+      }
+      if (windows) {
+        const cv::Size size(bgr.cols, bgr.rows);
+        const double net_px_per_image_px = static_cast<double>(pipeline.net_size_for(size).width) /
+                                           detector::detection_region(size, o.detection.subsquare).width;
+        const std::vector<detector::Window> search =
+            detector::windows_to_search(*windows, img.utime, size, img.camera_id, net_px_per_image_px, o.windows);
+        if (!search.empty()) d.boxes = window_detector->detect(bgr, std::move(d.boxes), search, &window_stats);
+      }
+    }
     d.latency_us = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
     return d;
   };
@@ -186,6 +212,21 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   };
   auto accounted = [&] { drops_accounted = rt.status().input_drops(o.input_channel); };
   ImageClock clock(o.time);
+  if (window_detector) {
+    rt.subscribe<track_windows_t>(o.windows.channel, [&](const track_windows_t& w) {
+      if (image_camera_id >= 0 && w.camera_id != image_camera_id)
+        throw std::invalid_argument(
+            fmt::format("track_windows_t.camera_id = {}: the frames are camera {}", w.camera_id, image_camera_id));
+      std::lock_guard<std::mutex> lock(windows_mutex);
+      newest_windows = w;
+    });
+  }
+  auto log_windows = [&] {
+    if (window_detector)
+      spdlog::info("windows: {} searched in {} crops, {} found their track's drone", window_stats.windows,
+                   window_stats.crops, window_stats.found);
+  };
+  auto note_camera = [&](const image_t& img) { image_camera_id = img.camera_id; };
 
   if (o.mode == "replay" || rt.input_is_file()) {
     // Every frame, in order, inside its handler: deterministic, and lockstep-friendly.
@@ -194,6 +235,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
         [&](const image_t& img) {
           count_gap(img);
           accounted();
+          note_camera(img);
           try {
             clock.admit(img);  // a frame dated ahead or out of order is a counted drop: never detected
             const Detected d = detect(img);
@@ -204,7 +246,9 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
           }
         },
         validate);
-    return rt.spin();
+    const int rc = rt.spin();
+    log_windows();
+    return rc;
   }
   // Real time: a worker thread detects while this thread keeps reading the bus, so no frame waits in a socket
   // buffer while a detection (or the build of a network for a new frame size) runs: every frame is received,
@@ -237,6 +281,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       [&](const image_t& img) {
         count_gap(img);
         accounted();
+        note_camera(img);
         try {
           clock.admit(img);  // a frame dated ahead or out of order is a counted drop: never detected
         } catch (...) {
@@ -284,6 +329,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
                                                           o.input_channel, waiting->seq));
   }
   collect();
+  log_windows();
   return rt.shutdown();
 }
 

@@ -23,6 +23,7 @@ localizer::CameraModel make_camera(const localizer::CameraOptions& o) {
 int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
   localizer::Localizer loc(o, make_camera(o.camera));
   rt.status().declare_output(o.output_channel);
+  if (o.windows.publish) rt.status().declare_output(o.windows.channel);
   // A time resync (one input re-anchored the clock) is worth a log line each time.
   const auto log_notes = [&] {
     for (const std::string& note : loc.take_notes()) spdlog::warn("{}", note);
@@ -46,6 +47,7 @@ int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
     } else {
       rt.status().set_state(status_t::STATE_OK, detail);
     }
+    if (out.windows) rt.publish(o.windows.channel, *out.windows);  // before the targets: see LocalizerOutput
     if (out.targets) rt.publish(o.output_channel, *out.targets);
   });
   return rt.spin();

@@ -239,7 +239,7 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
         o.detections_channel, o.detections.box, o.detections.noise_px);
   }
 
-  const bool lockstep = o.sync.mode == "lockstep" && simulator.takes_setpoints();
+  const bool lockstep = o.sync.mode == "lockstep" && (simulator.takes_setpoints() || o.sync.scripted_lockstep);
   const bool realtime = o.sync.mode == "realtime";
   int64_t newest_setpoint_utime = -1;
   bool input_ended = false;
@@ -285,7 +285,9 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   spdlog::info("scenario '{}' ({}): {} frames at {} Hz from utime {}, {} vehicles; sync {}{}", scenario.name,
                scenario.source, simulator.frame_count(), o.camera.rate_hz, scenario.start_utime,
                scenario.vehicles.size(), o.sync.mode,
-               o.sync.mode == "lockstep" && !lockstep ? " (the camera vehicle is scripted: nothing to wait for)" : "");
+               o.sync.mode == "lockstep" && !lockstep
+                   ? " (the camera vehicle is scripted: nothing to wait for; sync.scripted_lockstep waits anyway)"
+                   : "");
   const std::string gt_note = o.detections.from_ground_truth ? "; detections from ground truth" : "";
   status.set_state(status_t::STATE_OK, "scenario " + scenario.name + " starting" + gt_note);
   rt.publish_heartbeat();

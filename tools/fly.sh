@@ -7,7 +7,7 @@
 #
 # Usage: tools/fly.sh [--scenario NAME|FILE] [--out DIR] [--duration S] [--detections cnn|truth]
 #                     [--render|--no-render] [--record-images] [--truth-box sphere|silhouette] [--zoom-in]
-#                     [--flip-fusion] [--coarse-pass] [--localizer-config FILE] [--follower-config FILE]
+#                     [--flip-fusion] [--coarse-pass] [--windows] [--localizer-config FILE] [--follower-config FILE]
 #                     [--render-config FILE] [--autopilot lcm|mavlink] [--firmware px4|ardupilot]
 #                     [--own-pose-error M,RAD[,TAU]]
 #   --scenario       config/scenarios/NAME.yaml or a file (default formation_2d)
@@ -25,6 +25,9 @@
 #   --zoom-in        the detector re-detects each box in a full-resolution crop (Algorithm 2's zoom-in)
 #   --flip-fusion    the detector also detects in the mirrored frame and fuses both passes' boxes (docs/detector.md)
 #   --coarse-pass    the detector also detects at half the network input and fuses its large boxes (close drones)
+#   --windows        tracker-driven windows: the localizer publishes where its tracks will be in the next frame and
+#                    the detector searches there at full resolution when the single pass would see them too small
+#                    (windows.* of both; docs/detector.md); the simulator keeps lockstep with a scripted camera too
 #   --localizer-config  the localizer's config (default: config/flights/NAME.localizer.yaml if any, else the
 #                    defaults: the leader's bounding radius, and the shipped model's box relation for cnn boxes)
 #   --follower-config   the follower's config (default: config/flights/NAME.follower_ctrl.yaml if any, else the
@@ -45,7 +48,7 @@ src=$(pwd)
 bin="${WINGMAN_BIN_DIR:-$src/build/bin}"
 
 scenario=formation_2d out="" duration="" render=auto record_images=false truth_box=sphere detections=cnn
-zoom_in=false flip_fusion=false coarse_pass=false localizer_config="" follower_config="" render_config=""
+zoom_in=false flip_fusion=false coarse_pass=false windows=false localizer_config="" follower_config="" render_config=""
 autopilot=lcm firmware=px4 own_pose_error=""
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -56,6 +59,7 @@ while [ $# -gt 0 ]; do
     --zoom-in) zoom_in=true; shift ;;
     --flip-fusion) flip_fusion=true; shift ;;
     --coarse-pass) coarse_pass=true; shift ;;
+    --windows) windows=true; shift ;;
     --localizer-config) localizer_config=$(realpath "$2"); shift 2 ;;
     --follower-config) follower_config=$(realpath "$2"); shift 2 ;;
     --render-config) render_config=$(realpath "$2"); shift 2 ;;
@@ -102,6 +106,7 @@ if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   [ "$zoom_in" != true ] || again+=(--zoom-in)
   [ "$flip_fusion" != true ] || again+=(--flip-fusion)
   [ "$coarse_pass" != true ] || again+=(--coarse-pass)
+  [ "$windows" != true ] || again+=(--windows)
   [ -z "$localizer_config" ] || again+=(--localizer-config "$localizer_config")
   [ -z "$follower_config" ] || again+=(--follower-config "$follower_config")
   [ -z "$render_config" ] || again+=(--render-config "$render_config")
@@ -144,6 +149,7 @@ scenario_seed=$("$bin/wingman" scenario get "$scenario_file" seed)  # read and c
 # flight_cfg PROCESS: sets cfg_args to (--config FILE) where that file exists, else to nothing.
 flight_cfg() { local f="$src/config/flights/$name.$1.yaml"; cfg_args=(); if [ -r "$f" ]; then cfg_args=(--config "$f"); fi; }
 if [ -n "$localizer_config" ]; then localizer_args=(--config "$localizer_config"); else flight_cfg localizer; localizer_args=("${cfg_args[@]}"); fi
+[ "$windows" != true ] || localizer_args+=(--set windows.publish=true)
 if [ -n "$follower_config" ]; then follower_args=(--config "$follower_config"); else flight_cfg follower_ctrl; follower_args=("${cfg_args[@]}"); fi
 # wingman eval reads the same follower configuration (its --follower-config) and the scenario for its target.
 follower_eval_args=(); [ ${#follower_args[@]} -eq 0 ] || follower_eval_args=(--follower-config "${follower_args[1]}")
@@ -154,7 +160,7 @@ wait_for="[detector, localizer, follower_ctrl]"
 [ "$autopilot" = lcm ] || wait_for="[detector, localizer, follower_ctrl, mavlink_bridge]"
 # The simulator: its defaults with these keys over them (--set, read by its config loader, as for every process).
 sim_sets=(--set "scenario.file=$scenario_file"
-  --set "sync={mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: $wait_for, startup_timeout_s: 60.0}"
+  --set "sync={mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: $wait_for, startup_timeout_s: 60.0, scripted_lockstep: $windows}"
   --set "detections={from_ground_truth: $truth_detections, box: $truth_box, noise_px: 1.0, seed: $scenario_seed}"
   --set "render.enabled=$render" --set "autopilot=$autopilot"
   --set "mavlink={firmware: $firmware, streams: [odometry, attitude_quaternion, local_position_ned]}"
@@ -165,7 +171,8 @@ sim_sets=(--set "scenario.file=$scenario_file"
 detector_args=(--set input.mode=replay)
 if [ "$detections" = cnn ]; then
   detector_args+=(--set "model.cfg=\"$model_cfg\"" --set "model.weights=\"$model_weights\"" --set "detection.zoom_in=$zoom_in"
-                  --set "detection.flip_fusion=$flip_fusion" --set "detection.coarse_pass=$coarse_pass")
+                  --set "detection.flip_fusion=$flip_fusion" --set "detection.coarse_pass=$coarse_pass"
+                  --set "windows.enabled=$windows")
 else
   detector_args+=(--set 'model.weights=""')
 fi

@@ -176,6 +176,26 @@ const WireStruct kTargets{"targets_t",
                            {"frame", Wire::kI8},
                            {"num_targets", Wire::kI32},
                            {"targets", Wire::kStruct, 0, "num_targets", &kTarget}}};
+const WireStruct kTrackWindow{"track_window_t",
+                              {{"track_id", Wire::kI32},
+                               {"confirmed", Wire::kBool},
+                               {"cx", Wire::kF32},
+                               {"cy", Wire::kF32},
+                               {"vx", Wire::kF32},
+                               {"vy", Wire::kF32},
+                               {"w", Wire::kF32},
+                               {"h", Wire::kF32},
+                               {"sigma_px", Wire::kF32},
+                               {"range_m", Wire::kF32},
+                               {"confidence", Wire::kF32}}};
+const WireStruct kTrackWindows{"track_windows_t",
+                               {{"utime", Wire::kI64},
+                                {"utime_predicted", Wire::kI64},
+                                {"camera_id", Wire::kI32},
+                                {"image_width", Wire::kI32},
+                                {"image_height", Wire::kI32},
+                                {"num_windows", Wire::kI32},
+                                {"windows", Wire::kStruct, 0, "num_windows", &kTrackWindow}}};
 
 const std::map<std::string, const WireStruct*>& schemas() {
   static const std::map<std::string, const WireStruct*> all = {{"channel_stats_t", &kChannelStats},
@@ -188,6 +208,8 @@ const std::map<std::string, const WireStruct*>& schemas() {
                                                                {"status_t", &kStatus},
                                                                {"target_t", &kTarget},
                                                                {"targets_t", &kTargets},
+                                                               {"track_window_t", &kTrackWindow},
+                                                               {"track_windows_t", &kTrackWindows},
                                                                {"truth_box_t", &kTruthBox},
                                                                {"vehicle_truth_t", &kVehicleTruth}};
   return all;

@@ -187,6 +187,30 @@ std::string validate_message(const wingman::targets_t& m) {
   return "";
 }
 
+std::string validate_message(const wingman::track_windows_t& m) {
+  if (auto e = check_utime("track_windows_t", m.utime); !e.empty()) return e;
+  if (m.utime_predicted < m.utime)
+    return fmt::format("track_windows_t.utime_predicted = {}: must be >= utime ({})", m.utime_predicted, m.utime);
+  if (m.image_width <= 0 || m.image_height <= 0)
+    return fmt::format("track_windows_t.image_width x image_height = {}x{}: must be positive", m.image_width,
+                       m.image_height);
+  if (m.num_windows != static_cast<int32_t>(m.windows.size()) || m.num_windows < 0)
+    return fmt::format("track_windows_t.num_windows = {}: does not match {} windows", m.num_windows, m.windows.size());
+  for (size_t i = 0; i < m.windows.size(); ++i) {
+    const auto& w = m.windows[i];
+    const float values[] = {w.cx, w.cy, w.vx, w.vy, w.w, w.h, w.sigma_px, w.range_m, w.confidence};
+    for (const float v : values)
+      if (!std::isfinite(v)) return fmt::format("track_windows_t.windows[{}]: every number must be finite", i);
+    if (!(w.w > 0) || !(w.h > 0) || !(w.range_m > 0))
+      return fmt::format("track_windows_t.windows[{}]: w = {}, h = {}, range_m = {}: must be > 0", i, w.w, w.h,
+                         w.range_m);
+    if (w.sigma_px < 0) return fmt::format("track_windows_t.windows[{}].sigma_px = {}: must be >= 0", i, w.sigma_px);
+    if (w.confidence < 0 || w.confidence > 1)
+      return fmt::format("track_windows_t.windows[{}].confidence = {}: must be in [0, 1]", i, w.confidence);
+  }
+  return "";
+}
+
 std::string validate_message(const wingman::setpoint_t& m) {
   if (auto e = check_utime("setpoint_t", m.utime); !e.empty()) return e;
   if (auto e = check_frame("setpoint_t", m.frame); !e.empty()) return e;

@@ -92,6 +92,7 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);
   if (admission.resynced()) {  // its tracks live in the old times
     tracker_ = Tracker(options_.tracker);
+    previous_detections_utime_ = -1;
     notes_.push_back(admission.problem + "; the tracker restarts (new track ids)");
   }
 
@@ -139,6 +140,8 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
   if (!tracker_.update(d.utime, world, &why)) {
     throw std::invalid_argument("detections_t.utime = " + std::to_string(d.utime) + ": " + why);
   }
+  if (options_.windows.publish) result.windows = track_windows(d, *pose);
+  previous_detections_utime_ = d.utime;
 
   // Lag compensation: predict to the newest time we know of (own poses arrive with little delay).
   const int64_t predict_to = std::max(d.utime, newest_pose_utime_);
@@ -168,6 +171,38 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
   out.num_targets = static_cast<int32_t>(out.targets.size());
   if (out.num_targets > 0 || options_.publish_empty) result.targets = std::move(out);
   return result;
+}
+
+wingman::track_windows_t Localizer::track_windows(const wingman::detections_t& d, const PoseSample& pose) const {
+  // The next exposure: one frame interval (the last one seen, at most 0.5 s) after this one.
+  constexpr int64_t kMaxInterval_us = 500000;
+  const int64_t interval_us = previous_detections_utime_ >= 0 && d.utime - previous_detections_utime_ <= kMaxInterval_us
+                                  ? d.utime - previous_detections_utime_
+                                  : 0;
+  wingman::track_windows_t out{};
+  out.utime = d.utime;
+  out.utime_predicted = d.utime + interval_us;
+  out.camera_id = d.camera_id;
+  out.image_width = d.image_width;
+  out.image_height = d.image_height;
+  // The camera then: the pose at this exposure moved on with the body's velocity (its rotation held).
+  const double dt = static_cast<double>(interval_us) * 1e-6;
+  const Eigen::Matrix3d R_body_to_world = pose.q_body_to_world.normalized().toRotationMatrix();
+  CameraAtExposure cam;
+  cam.R_cam_to_world = R_body_to_world * extrinsics_.R_cam_to_body;
+  cam.v_cam_in_world = pose.v_body_in_world;
+  cam.p_cam_in_world = R_body_to_world * extrinsics_.p_cam_in_body + pose.p_body_in_world + dt * pose.v_body_in_world;
+  const bool ground_truth = d.source == wingman::detections_t::SOURCE_GROUND_TRUTH;
+  const BoxRelation sphere = BoxRelation::sphere();
+  for (const TrackOutput& t : tracker_.predicted_tracks(out.utime_predicted)) {
+    if (static_cast<int>(out.windows.size()) >= options_.windows.max_windows) break;
+    // The box relation holds for full-resolution re-detections too (measured: docs/detector.md, "Tracker-driven
+    // windows").
+    if (auto w = predict_track_window(t, options_.sphere.radius_m, camera_, cam, ground_truth ? sphere : cnn_relation_))
+      out.windows.push_back(*w);
+  }
+  out.num_windows = static_cast<int32_t>(out.windows.size());
+  return out;
 }
 
 wingman::targets_t Localizer::camera_frame_targets(const wingman::detections_t& d,

@@ -27,7 +27,7 @@ std::vector<std::string> LocalizerOptions::validate() const {
   if (class_decision != "box" && class_decision != "track")
     p.push_back(problem("classes.decision", class_decision, "must be box or track"));
   for (const auto& part : {camera.validate(), sphere.validate(), extrinsics.validate(), pose.validate(),
-                           tracker.validate(), time.validate()}) {
+                           tracker.validate(), windows.validate(), time.validate()}) {
     p.insert(p.end(), part.begin(), part.end());
   }
   return p;

@@ -379,9 +379,10 @@ void Tracker::merge_duplicates(int64_t utime) {
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.id < 0; }), tracks_.end());
 }
 
-TrackOutput Tracker::output(const Track& t, int64_t predict_to_utime) const {
+TrackOutput Tracker::output(const Track& t, int64_t predict_to_utime, bool kalman) const {
   TrackOutput o;
   o.track_id = t.id;
+  o.confirmed = t.id > 0;
   o.camera_id = t.last.camera_id;
   o.size_scale = t.scale.scale;
   o.size_scale_sigma = t.scale.sigma;
@@ -393,7 +394,7 @@ TrackOutput Tracker::output(const Track& t, int64_t predict_to_utime) const {
   o.source_utime = t.last_hit_utime;
   o.age_s = std::max(0.0, us_to_s(predict_to_utime - t.birth_utime));
 
-  if (mode_ == TrackerMode::kSlidingWindow) {
+  if (mode_ == TrackerMode::kSlidingWindow && !kalman) {
     // Thesis: the mean of the last n_f measurements, published as current (it lags by about
     // (n_f - 1) / 2 frames times the speed). Velocity by finite difference across the window.
     const double n = static_cast<double>(t.window.size());
@@ -448,6 +449,20 @@ std::vector<TrackOutput> Tracker::confirmed(int64_t predict_to_utime) const {
   }
   if (newest) out.push_back(output(*newest, predict_to_utime));
   std::sort(out.begin(), out.end(), [](const TrackOutput& a, const TrackOutput& b) { return a.track_id < b.track_id; });
+  return out;
+}
+
+std::vector<TrackOutput> Tracker::predicted_tracks(int64_t predict_to_utime) const {
+  std::vector<TrackOutput> out;
+  for (const Track& t : tracks_) {
+    if (t.id < 0) continue;  // merged away
+    out.push_back(output(t, predict_to_utime, true));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const TrackOutput& a, const TrackOutput& b) {
+    if (a.confirmed != b.confirmed) return a.confirmed;
+    if (a.confirmed) return a.track_id < b.track_id;
+    return a.confidence > b.confidence;
+  });
   return out;
 }
 

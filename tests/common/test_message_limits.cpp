@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <wingman/common/message_limits.hpp>
 #include <wingman/detections_t.hpp>
+#include <wingman/track_windows_t.hpp>
 
 #include <cstdint>
 #include <limits>
@@ -82,6 +83,10 @@ TEST(CheckEncoded, MatchesTheGeneratedEncoderOfEveryType) {
   g.boxes.resize(1);
   g.num_boxes = 1;
   expect_walk_matches_encoder(g);
+  track_windows_t w{};
+  w.windows.resize(2);
+  w.num_windows = 2;
+  expect_walk_matches_encoder(w);
 }
 
 TEST(CheckEncoded, RejectsAnImageClaimingMoreBytesThanItCarriesBeforeDecoding) {

@@ -188,3 +188,52 @@ TEST(ValidateSourceFlags, UnknownDetectionSourceIsRejectedInEveryMessageThatCarr
 }
 
 }  // namespace
+
+namespace {
+
+wingman::track_windows_t good_windows() {
+  wingman::track_windows_t m{};
+  m.utime = 1000;
+  m.utime_predicted = 34333;
+  m.image_width = 1280;
+  m.image_height = 720;
+  wingman::track_window_t w{};
+  w.cx = 600;
+  w.cy = 300;
+  w.w = 12;
+  w.h = 8;
+  w.sigma_px = 3;
+  w.range_m = 25;
+  w.confidence = 0.7f;
+  m.windows = {w};
+  m.num_windows = 1;
+  return m;
+}
+
+}  // namespace
+
+TEST(ValidateTrackWindows, NamesTheFieldOfEveryBadValue) {
+  using wingman::common::validate_message;
+  EXPECT_EQ(validate_message(good_windows()), "");
+  auto m = good_windows();
+  m.utime_predicted = 999;
+  EXPECT_NE(validate_message(m).find("track_windows_t.utime_predicted = 999"), std::string::npos);
+  m = good_windows();
+  m.image_width = 0;
+  EXPECT_NE(validate_message(m).find("track_windows_t.image_width x image_height = 0x720"), std::string::npos);
+  m = good_windows();
+  m.num_windows = 2;
+  EXPECT_NE(validate_message(m).find("track_windows_t.num_windows = 2"), std::string::npos);
+  m = good_windows();
+  m.windows[0].vx = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(validate_message(m).find("track_windows_t.windows[0]: every number must be finite"), std::string::npos);
+  m = good_windows();
+  m.windows[0].w = 0;
+  EXPECT_NE(validate_message(m).find("track_windows_t.windows[0]: w = 0"), std::string::npos);
+  m = good_windows();
+  m.windows[0].sigma_px = -1;
+  EXPECT_NE(validate_message(m).find("track_windows_t.windows[0].sigma_px = -1"), std::string::npos);
+  m = good_windows();
+  m.windows[0].confidence = 1.5f;
+  EXPECT_NE(validate_message(m).find("track_windows_t.windows[0].confidence = 1.5"), std::string::npos);
+}

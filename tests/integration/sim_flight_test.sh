@@ -8,8 +8,11 @@
 # process and its shipped CNN model instead; `pose_error` flies 30 s with ground-truth boxes while the follower's
 # reported pose is wrong by a drifting error (tools/fly.sh --own-pose-error 0.3,0.01: 0.3 m per position axis,
 # 0.01 rad per rotation, 2-s correlation), reported with its covariance, which the localizer must take into account
-# (pose.use_covariance) to keep the track and the formation. Extra arguments go to tools/fly.sh (for runs by hand).
-# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered|pose_error] [fly.sh arguments...]
+# (pose.use_covariance) to keep the track and the formation; `windows` flies fly_away_far (a leader flying away from
+# 14 to 38 m, 13 s, rendered, the shipped CNN) with the tracker-driven windows (tools/fly.sh --windows) and checks that
+# the leader is detected and tracked beyond the single pass's range. Extra arguments go to tools/fly.sh (for runs by
+# hand).
+# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered|pose_error|windows] [fly.sh arguments...]
 set -euo pipefail
 src="$1"; bin="$2"; kind="${3:-flight}"
 shift $(( $# < 3 ? $# : 3 ))
@@ -28,6 +31,36 @@ if [ "$kind" = rendered ]; then
   grep -q '"detection_source": "cnn"' "$out/eval.json" || fail "eval.json: detection_source is not cnn"
   echo "sim_flight_test: ok"
   exit 0
+fi
+if [ "$kind" = windows ]; then
+  log=$(WINGMAN_BIN_DIR="$bin" timeout 900 tools/fly.sh --scenario fly_away_far --windows --out "$out" "$@" 2>&1) ||
+    { echo "$log"; fail "the flight failed"; }
+  echo "$log"
+  grep -Eq "\[sim\] info: 390 frames in .*0 lockstep timeouts" <<<"$log" ||
+    fail "the simulator did not fly 390 frames in lockstep without a timeout (sync.scripted_lockstep)"
+  PYENV_VERSION=system python3 - "$out/eval.json" "$out/targets.csv" <<'PY'
+import csv, json, sys
+r = json.load(open(sys.argv[1]))
+problems = []
+def check(ok, what):
+    if not ok: problems.append(what)
+# Bounds (docs/results.md, "Tracker-driven windows"): fly_away_far, seed 6, lockstep, the shipped CNN.
+bins = {b["lo_m"]: b for b in r["detection_by_range"]}
+far = bins[20.0]
+rate = far["detected"] / max(far["visible"], 1)
+check(far["visible"] >= 150, f"{far['visible']} frames with the leader at 20-30 m, expected >= 150")
+check(rate >= WINDOWS_MIN_RATE_20_30, f"leader detected in {rate:.2f} of its frames at 20-30 m")
+check(r["track_ids_on_leader"] <= WINDOWS_MAX_IDS, f"{r['track_ids_on_leader']} track ids on the leader")
+# The farthest true range at which a target matched to the leader was published.
+rows = [row for row in csv.DictReader(open(sys.argv[2])) if row["vehicle_id"] == "1"]
+farthest = max((float(row["range_m"]) for row in rows), default=0.0)
+check(farthest >= WINDOWS_MIN_TRACKED_M, f"the leader tracked to {farthest:.1f} m only")
+print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
+print(f"sim_flight_test: measured detection at 20-30 m {rate:.3f}, leader tracked to {farthest:.1f} m, "
+      f"{r['track_ids_on_leader']} id(s), {r['false_targets']} false targets")
+sys.exit(1 if problems else 0)
+PY
+  exit
 fi
 if [ "$kind" = pose_error ]; then
   log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario formation_2d --duration 30 --detections truth \

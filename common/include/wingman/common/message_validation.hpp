@@ -9,6 +9,7 @@
 #include <wingman/setpoint_t.hpp>
 #include <wingman/status_t.hpp>
 #include <wingman/targets_t.hpp>
+#include <wingman/track_windows_t.hpp>
 
 #include <string>
 
@@ -29,6 +30,9 @@ std::string validate_message(const wingman::targets_t& msg);
 std::string validate_message(const wingman::setpoint_t& msg);
 std::string validate_message(const wingman::status_t& msg);
 std::string validate_message(const wingman::ground_truth_t& msg);
+/// Also: utime_predicted >= utime, image size > 0, every window's numbers finite, w, h, range_m > 0, sigma_px >= 0,
+/// confidence in [0, 1].
+std::string validate_message(const wingman::track_windows_t& msg);
 
 /// Bytes per pixel of a raw image_t pixel format (GRAY8 1, BGR8 3, YUYV 2), 0 for MJPEG or unknown.
 int bytes_per_pixel(int8_t pixel_format);

@@ -4,6 +4,7 @@
 
 #include "wingman/detector/detection_pipeline.hpp"
 #include "wingman/detector/opencl_options.hpp"
+#include "wingman/detector/track_windows.hpp"
 
 #include <wingman/common/time_sanity.hpp>
 
@@ -40,6 +41,7 @@ struct DetectorOptions {
   /// cfg's [net] size; WxH: that size.
   std::string input_size = "auto";
   DetectorPipelineOptions detection;
+  WindowOptions windows;  ///< tracker-driven windows (windows.*)
   OpenClOptions opencl;
   /// Time sanity of the images (time.*): an image dated more than max_ahead_s after the newest accepted image, or
   /// not after the previous one, is dropped and counted (never detected, its time never passed on); after
@@ -64,6 +66,7 @@ struct DetectorOptions {
       "network input: auto (the cfg's longer side, the other fitted to the images' aspect, a multiple of 32), cfg "
       "(the cfg's size) or WxH (multiples of 32)");
     detection.visit(v);
+    windows.visit(v);
     opencl.visit(v);
     time.visit(v);
   }

@@ -13,6 +13,7 @@
 #include <wingman/detections_t.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/targets_t.hpp>
+#include <wingman/track_windows_t.hpp>
 
 #include <cstdint>
 #include <map>
@@ -46,6 +47,10 @@ struct LocalizerOutput {
   bool camera_frame_only = false;  ///< no own pose fresh enough at the image's exposure time
   /// The message's boxes with class_id != 0, left out before localization (not rejections).
   NonDroneCounts non_drone;
+  /// With windows.publish and a fresh own pose: where every track will be in this camera's next image (published
+  /// before the targets, so that in lockstep the detector has them before the next frame). Empty windows are
+  /// published too (the detector then knows its tracks are gone).
+  std::optional<wingman::track_windows_t> windows;
 };
 
 /// Turns detections into tracked targets (Algorithm: eq. 24 / tangent planes per box, then the
@@ -84,6 +89,8 @@ class Localizer {
   std::string tracker_summary() const;
 
  private:
+  /// The windows of the tracks after detections `d`, the camera at `pose` (the own pose at d.utime).
+  wingman::track_windows_t track_windows(const wingman::detections_t& d, const PoseSample& pose) const;
   wingman::targets_t camera_frame_targets(const wingman::detections_t& d,
                                           const std::vector<CameraMeasurement>& measurements) const;
 
@@ -97,6 +104,7 @@ class Localizer {
   int own_pose_input_;
   int detections_input_;
   int64_t newest_pose_utime_ = -1;
+  int64_t previous_detections_utime_ = -1;  ///< the last accepted detections_t's utime (frame interval for windows)
   NonDroneCounts non_drone_boxes_;
   std::vector<std::string> notes_;  ///< take_notes()
 };

@@ -5,6 +5,7 @@
 #include "wingman/localizer/extrinsics.hpp"
 #include "wingman/localizer/pose_buffer.hpp"
 #include "wingman/localizer/sphere_localizer.hpp"
+#include "wingman/localizer/track_windows.hpp"
 #include "wingman/localizer/tracker.hpp"
 
 #include <wingman/common/time_sanity.hpp>
@@ -65,6 +66,7 @@ struct LocalizerOptions {
   ExtrinsicsOptions extrinsics;
   PoseBufferOptions pose;
   TrackerOptions tracker;
+  TrackWindowOptions windows;  ///< tracker-driven windows (windows.*)
   /// Time sanity of the inputs (time.*): how far ahead of the newest accepted time a message may be dated, and when
   /// the clock re-anchors (common/time_sanity.hpp).
   common::TimeSanityOptions time;
@@ -86,6 +88,7 @@ struct LocalizerOptions {
     extrinsics.visit(v);
     pose.visit(v);
     tracker.visit(v);
+    windows.visit(v);
     time.visit(v);
   }
   std::vector<std::string> validate() const;

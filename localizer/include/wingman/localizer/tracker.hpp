@@ -119,10 +119,11 @@ struct TrackerOptions {
   AssociationMethod association_enum() const;
 };
 
-/// One confirmed track as published.
+/// One confirmed track as published (or, from Tracker::predicted_tracks(), a tentative one too).
 struct TrackOutput {
-  int32_t track_id = 0;                                         ///< 1, 2, ... in order of confirmation; never reused
-  int32_t camera_id = 0;                                        ///< camera of the last detection used
+  int32_t track_id = 0;   ///< 1, 2, ... in order of confirmation; never reused; 0 for a tentative track
+  bool confirmed = true;  ///< false: a tentative track (predicted_tracks() only)
+  int32_t camera_id = 0;  ///< camera of the last detection used
   Eigen::Vector3d p_target_in_world = Eigen::Vector3d::Zero();  ///< at predicted_utime, m
   Eigen::Vector3d v_target_in_world = Eigen::Vector3d::Zero();  ///< m/s
   Eigen::Matrix3d cov_p = Eigen::Matrix3d::Identity();          ///< covariance of p_target_in_world, m^2
@@ -186,6 +187,11 @@ class Tracker {
   /// newest hit.
   std::vector<TrackOutput> confirmed(int64_t predict_to_utime) const;
 
+  /// Every track held, confirmed (by track_id) then tentative (track_id 0, confirmed false; most confident first),
+  /// with its constant-velocity Kalman state predicted to `predict_to_utime` whatever the mode (at most
+  /// max_prediction_s past the state): where each will be at the next exposure (tracker-driven windows).
+  std::vector<TrackOutput> predicted_tracks(int64_t predict_to_utime) const;
+
   /// Tentative tracks that have their M hits but are held back by confirm_min_confidence right now.
   size_t num_held() const;
   /// Tentative (not yet confirmed) tracks held.
@@ -225,7 +231,8 @@ class Tracker {
   void associate(std::vector<Track*>& tracks, const std::vector<WorldMeasurement>& z, std::vector<bool>& z_used,
                  std::vector<int>& track_to_z, Eigen::MatrixXd* cost = nullptr) const;
   void hit(Track& t, const WorldMeasurement& z);
-  TrackOutput output(const Track& t, int64_t predict_to_utime) const;
+  /// `kalman`: the Kalman state whatever the mode (predicted_tracks()).
+  TrackOutput output(const Track& t, int64_t predict_to_utime, bool kalman = false) const;
   bool same_target(const Track& a, const Track& b) const;
   /// The mean confidence of t's last birth_window hits reaches confirm_min_confidence (always true when it is 0).
   bool confident_enough(const Track& t) const;

@@ -84,6 +84,10 @@ struct SyncOptions {
   /// [detector, localizer, follower_ctrl].
   std::vector<std::string> wait_for;
   double startup_timeout_s = 30.0;  ///< longest wall-clock wait for `wait_for`, s (> 0); then exit 1
+  /// lockstep with a scripted camera vehicle (which takes no setpoints): still wait for each frame's SETPOINT (the
+  /// follower publishes one per targets_t), so that a scripted flight through a live pipeline is deterministic too
+  /// (the tracker-driven windows of the next frame come from this frame's tracks). false: nothing to wait for.
+  bool scripted_lockstep = false;
 
   template <class V>
   void visit(V& v) {
@@ -93,6 +97,8 @@ struct SyncOptions {
     v("sync.max_speed", max_speed, "lockstep: at most this many simulated seconds per wall-clock second (0: no cap)");
     v("sync.wait_for", wait_for, "process instances whose STATUS_<NAME> must be seen before the first frame");
     v("sync.startup_timeout_s", startup_timeout_s, "longest wait for sync.wait_for, s (then exit 1 naming them)");
+    v("sync.scripted_lockstep", scripted_lockstep,
+      "lockstep: wait for each frame's SETPOINT even when the camera vehicle is scripted (deterministic replays)");
   }
   std::vector<std::string> validate() const;
 };
