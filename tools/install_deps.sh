@@ -19,6 +19,8 @@ packages=(
   libtorch-dev
   # configuration, CLI, logging
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
+  # JSON reading and writing (the tools' and the metrics' JSON documents)
+  nlohmann-json3-dev
   # SHA-256 of a model's weights (detections_t.model_id, the box relation's model check)
   libssl-dev
   # tests and benchmarks

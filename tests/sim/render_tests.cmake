@@ -20,7 +20,8 @@ add_dependencies(test_sim_render wingman-render-dump)
 # `wingman dataset synth` (tools library), read back with the trainer's dataset reader.
 wingman_add_test(test_sim_dataset_synth
   SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_render_dataset_synth.cpp
-  LIBS wingman::tools wingman::sim_render wingman::training_data wingman::test_support yaml-cpp opencv_imgcodecs
+  LIBS wingman::tools wingman::sim_render wingman::training_data wingman::test_support nlohmann_json::nlohmann_json
+       opencv_imgcodecs
   LABEL sim
   TIMEOUT 120)
 target_include_directories(test_sim_dataset_synth PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})

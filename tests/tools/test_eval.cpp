@@ -11,6 +11,7 @@
 #include <wingman/targets_t.hpp>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -157,7 +158,7 @@ TEST(Eval, FormationErrorIsFollowerMinusLeaderPlusOffsetAfterSettling) {
   std::ifstream js(o.json_path);
   std::stringstream j;
   j << js.rdbuf();
-  EXPECT_NE(j.str().find("\"formation_horizontal\": {\"n\": 5"), std::string::npos) << j.str();
+  EXPECT_EQ(nlohmann::json::parse(j.str()).at("formation_horizontal").at("n"), 5) << j.str();
 }
 
 TEST(Eval, MissingLogOrTruthIsAClearError) {
@@ -240,9 +241,13 @@ TEST(Eval, LocalizationErrorIsBinnedByTrueRange) {
   EXPECT_EQ(r2.localization_by_range[1].error.n, 3);
   EXPECT_NEAR(r2.localization_by_range[1].error.mean, 0.4, 1e-9);
   EXPECT_NE(r2.report().find("range 10+ m"), std::string::npos) << r2.report();
-  EXPECT_NE(r2.json().find("\"localization_by_range\": [{\"lo_m\": 0, \"hi_m\": 10, \"error\": {\"n\": 2"),
-            std::string::npos)
-      << r2.json();
+  const nlohmann::json bins = nlohmann::json::parse(r2.json()).at("localization_by_range");
+  ASSERT_EQ(bins.size(), 2u) << r2.json();
+  EXPECT_EQ(bins[0].at("lo_m"), 0.0);
+  EXPECT_EQ(bins[0].at("hi_m"), 10.0);
+  EXPECT_EQ(bins[0].at("error").at("n"), 2);
+  EXPECT_NEAR(bins[0]["error"].at("rms_m").get<double>(), std::sqrt((0.01 + 0.04) / 2), 1e-12);
+  EXPECT_TRUE(bins[1].at("hi_m").is_null()) << r2.json();  // the last bin is open
 }
 
 TEST(Eval, RangeBinsMustIncrease) {
@@ -303,9 +308,9 @@ TEST(Eval, CountsTrackIdsAndSwitchesOfEveryVehicleNotOnlyTheLeaders) {
       r.report().find("track ids per vehicle: vehicle 1: 1 id(s), 0 switch(es); vehicle 2: 2 id(s), 1 switch(es)"),
       std::string::npos)
       << r.report();
-  EXPECT_NE(r.json().find("\"ids_by_vehicle\": {\"1\": {\"track_ids\": 1, \"id_switches\": 0}, \"2\": "
-                          "{\"track_ids\": 2, \"id_switches\": 1}}"),
-            std::string::npos)
+  EXPECT_EQ(
+      nlohmann::json::parse(r.json()).at("ids_by_vehicle"),
+      nlohmann::json::parse(R"({"1": {"track_ids": 1, "id_switches": 0}, "2": {"track_ids": 2, "id_switches": 1}})"))
       << r.json();
 }
 
@@ -318,7 +323,7 @@ TEST(EvalCli, JsonDashPrintsTheJsonAsJsonStdoutDoesAndReportTakesOut) {
   const auto flag = testing::run({wingman, "eval", log, "--json-stdout", "--quiet"});
   ASSERT_EQ(dash.exit_code, 0) << dash.err;
   ASSERT_EQ(flag.exit_code, 0) << flag.err;
-  EXPECT_EQ(dash.out.rfind("{\"detection_source\": ", 0), 0u) << dash.out;
+  EXPECT_EQ(nlohmann::ordered_json::parse(dash.out).begin().key(), "detection_source") << dash.out;  // keys in order
   EXPECT_EQ(dash.out, flag.out);
   EXPECT_FALSE(std::ifstream("-").good()) << "no file named -";
   const auto file = testing::run({wingman, "eval", log, "--json", dir.file("e.json"), "--quiet"});
@@ -419,7 +424,9 @@ TEST(Eval, LatencyPercentilesFromLogEventTimestamps) {
   EXPECT_NEAR(r.inference_latency_ms.p90, 18.0, 1e-9);
   EXPECT_NEAR(r.inference_latency_ms.p99, 20.0, 1e-9);
   EXPECT_EQ(r.image_utimes, std::vector<int64_t>{kT0});
-  EXPECT_NE(r.json().find("\"latency\": {\"n\": 10, \"p50_ms\": 5.000"), std::string::npos) << r.json();
+  const nlohmann::json latency = nlohmann::json::parse(r.json()).at("latency");
+  EXPECT_EQ(latency.at("n"), 10) << r.json();
+  EXPECT_NEAR(latency.at("p50_ms").get<double>(), 5.0, 1e-9) << r.json();
 }
 
 detection_t box(float cx, float cy, float w, bool zoom) {
@@ -512,12 +519,12 @@ TEST(Eval, BoxWidthErrorSingleAndZoomAgainstTruthBox) {
   // False boxes: (300, 100) in frame 0 (5-10 m) and (111, 100) in frame 2 (20-30 m).
   EXPECT_EQ(r.detection_by_range[1].false_boxes, 1);
   EXPECT_EQ(r.detection_by_range[4].frames_with_false_box, 1);
-  EXPECT_NE(
-      r.json().find("\"detection_by_range\": [{\"lo_m\": 0, \"hi_m\": 5, \"visible\": 0, \"detected\": 0, "
-                    "\"false_boxes\": 0, \"frames_with_false_box\": 0}, {\"lo_m\": 5, \"hi_m\": 10, \"visible\": 2, "
-                    "\"detected\": 2, \"false_boxes\": 1, \"frames_with_false_box\": 1}"),
-      std::string::npos)
-      << r.json();
+  const nlohmann::json bins = nlohmann::json::parse(r.json()).at("detection_by_range");
+  ASSERT_GE(bins.size(), 2u) << r.json();
+  EXPECT_EQ(bins[0], nlohmann::json::parse(R"({"lo_m": 0.0, "hi_m": 5.0, "visible": 0, "detected": 0, "false_boxes": 0,
+                                               "frames_with_false_box": 0})"));
+  EXPECT_EQ(bins[1], nlohmann::json::parse(R"({"lo_m": 5.0, "hi_m": 10.0, "visible": 2, "detected": 2, "false_boxes": 1,
+                                               "frames_with_false_box": 1})"));
 }
 
 truth_box_t truth_box(int vehicle_id, float cx, float cy, float size, bool visible, double range) {
@@ -628,13 +635,19 @@ TEST(Eval, LeaderCountsAsDetectedOnlyWithABoxOnItAndOtherBoxesAreFalse) {
   std::ifstream js(o.json_path);
   std::stringstream j;
   j << js.rdbuf();
-  for (const char* field :
-       {"\"frames_leader_visible\": 9, \"frames_leader_detected\": 4, \"false_boxes_leader_visible\": 7, "
-        "\"frames_leader_visible_with_false_box\": 5,",
-        "\"detection_frames\": 10, \"false_boxes\": 9, \"frames_with_false_box\": 7, \"non_drone_boxes\": 0}",
-        "{\"lo_m\": 15, \"hi_m\": 20, \"visible\": 4, \"detected\": 2, \"false_boxes\": 3, \"frames_with_false_box\": "
-        "2}"})
-    EXPECT_NE(j.str().find(field), std::string::npos) << field << " not in " << j.str();
+  const nlohmann::json doc = nlohmann::json::parse(j.str());
+  for (const auto& [key, value] : std::vector<std::pair<std::string, int>>{{"frames_leader_visible", 9},
+                                                                           {"frames_leader_detected", 4},
+                                                                           {"false_boxes_leader_visible", 7},
+                                                                           {"frames_leader_visible_with_false_box", 5},
+                                                                           {"detection_frames", 10},
+                                                                           {"false_boxes", 9},
+                                                                           {"frames_with_false_box", 7},
+                                                                           {"non_drone_boxes", 0}})
+    EXPECT_EQ(doc.at(key), value) << key << " in " << j.str();
+  EXPECT_EQ(doc.at("detection_by_range").at(3),
+            nlohmann::json::parse(R"({"lo_m": 15.0, "hi_m": 20.0, "visible": 4, "detected": 2, "false_boxes": 3,
+                                      "frames_with_false_box": 2})"));
 }
 
 TEST(Eval, BoxesOfOtherClassesAreNeitherDetectionsNorFalseBoxes) {
@@ -663,7 +676,7 @@ TEST(Eval, BoxesOfOtherClassesAreNeitherDetectionsNorFalseBoxes) {
   EXPECT_EQ(r.detections_total, 1);
   EXPECT_EQ(r.false_boxes, 1);
   EXPECT_EQ(r.non_drone_boxes, 2);
-  EXPECT_NE(r.json().find("\"non_drone_boxes\": 2}"), std::string::npos) << r.json();
+  EXPECT_EQ(nlohmann::json::parse(r.json()).at("non_drone_boxes"), 2) << r.json();
   EXPECT_NE(r.report().find("; 2 box(es) of other classes (not drones: not counted)"), std::string::npos) << r.report();
 }
 

@@ -11,6 +11,7 @@
 #include <wingman/tools/scenario_random.hpp>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -214,7 +215,11 @@ TEST(ScenarioSweep, TheSweepLoadsWithTheSimulatorsReaderAndStepsFromFromToTo) {
     const auto loc = common::load_options<localizer::LocalizerOptions>(r.localizer_path);
     EXPECT_NEAR(loc.sphere.radius_m, r.bounding_radius_m, 1e-9);
     EXPECT_NEAR(loc.sphere.radius_m, sim::DroneModel::from_spec(target.drone).bounding_radius(), 1e-9);
-    EXPECT_NE(slurp(r.json_path).find("\"kind\": \"sweep\""), std::string::npos);
+    const nlohmann::json drawn = nlohmann::json::parse(slurp(r.json_path));
+    EXPECT_EQ(drawn.at("kind"), "sweep");
+    EXPECT_EQ(drawn.at("steps"), 7);
+    EXPECT_EQ(drawn.at("view"), view);
+    EXPECT_NEAR(drawn.at("bounding_radius_m").get<double>(), r.bounding_radius_m, 1e-12);
   }
   // Bad options name the option.
   ScenarioSweepOptions bad;

@@ -3,6 +3,7 @@
 #include <wingman/training/detection_metrics.hpp>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <utility>
@@ -126,11 +127,12 @@ TEST(DetectionMetrics, ConfidenceThresholdMovesTheOperatingPointNotTheAp) {
 
 TEST(DetectionMetrics, JsonAndReportCarryTheNumbers) {
   const DetectionMetrics m = evaluate_detections(hand_case(), MetricsOptions{});
-  const std::string j = m.json();
-  EXPECT_NE(j.find("\"criterion\": \"iou\""), std::string::npos) << j;
-  EXPECT_NE(j.find("\"criterion\": \"centre\""), std::string::npos) << j;
-  EXPECT_NE(j.find("\"ap\": 0.666667"), std::string::npos) << j;
-  EXPECT_NE(j.find("\"max_px\": null"), std::string::npos) << j;
+  const nlohmann::json j = nlohmann::json::parse(m.json());
+  EXPECT_EQ(j["iou"]["criterion"], "iou") << j;
+  EXPECT_EQ(j["centre"]["criterion"], "centre") << j;
+  EXPECT_NEAR(j["iou"]["all"]["ap"].get<double>(), 2.0 / 3.0, 1e-12) << j;
+  EXPECT_TRUE(j["iou"]["by_size"].back()["max_px"].is_null()) << j;  // the last size bin is open
+  EXPECT_EQ(j["iou"]["pr_curve_columns"], nlohmann::json({"recall", "precision", "confidence"}));
   EXPECT_NE(m.report().find("16-32px"), std::string::npos);
   EXPECT_NE(m.one_line().find("AP 0.667"), std::string::npos) << m.one_line();
 }
@@ -192,17 +194,33 @@ TEST(DetectionMetrics, UnmatchedTruthsSayWhatTheDetectorDidThere) {
             std::string::npos)
       << r;
   EXPECT_EQ(m.report(1).find("image 0 truth"), std::string::npos) << m.report(1);
-  const std::string j = m.json();
-  EXPECT_NE(j.find("\"edge_truths\": 1, \"edge_found\": 0"), std::string::npos) << j;
-  EXPECT_NE(j.find("{\"image\": 0, \"name\": \"\", \"truth\": [150.00, 50.00, 10.00, 10.00], \"size_px\": 10.00, "
-                   "\"at_edge\": false, \"reason\": \"loose\", \"best_iou\": 0.111111, \"best\": [150.00, 52.00, "
-                   "30.00, 30.00, 0.600000]}"),
-            std::string::npos)
-      << j;
-  EXPECT_NE(j.find("\"name\": \"d\", \"truth\": [11.00, 50.00, 20.00, 20.00], \"size_px\": 20.00, \"at_edge\": true, "
-                   "\"reason\": \"missed\", \"best_iou\": 0.000000, \"best\": null}"),
-            std::string::npos)
-      << j;
+  const nlohmann::json j = nlohmann::json::parse(m.json());
+  EXPECT_EQ(j["iou"]["edge_truths"], 1) << j;
+  EXPECT_EQ(j["iou"]["edge_found"], 0) << j;
+  const nlohmann::json& unmatched = j["iou"]["unmatched"];
+  const auto find = [&](const std::string& name, const std::string& reason, bool at_edge) {
+    for (const nlohmann::json& u : unmatched)
+      if (u.at("name") == name && u.at("reason") == reason && u.at("at_edge") == at_edge) return u;
+    return nlohmann::json();
+  };
+  const nlohmann::json loose = find("", "loose", false);
+  ASSERT_FALSE(loose.is_null()) << j;
+  EXPECT_EQ(loose["image"], 0);
+  EXPECT_EQ(loose["name"], "");
+  EXPECT_EQ(loose["truth"], nlohmann::json({150.0, 50.0, 10.0, 10.0}));
+  EXPECT_DOUBLE_EQ(loose["size_px"].get<double>(), 10.0);
+  EXPECT_EQ(loose["at_edge"], false);
+  EXPECT_NEAR(loose["best_iou"].get<double>(), 100.0 / 900.0, 1e-6);  // the 10x10 truth inside the 30x30 box
+  ASSERT_EQ(loose["best"].size(), 5u);
+  EXPECT_FLOAT_EQ(loose["best"][1].get<float>(), 52.0f);
+  EXPECT_FLOAT_EQ(loose["best"][2].get<float>(), 30.0f);
+  EXPECT_NEAR(loose["best"][4].get<double>(), 0.6, 1e-6);  // a float confidence
+  const nlohmann::json edge = find("d", "missed", true);
+  ASSERT_FALSE(edge.is_null()) << j;
+  EXPECT_EQ(edge["truth"], nlohmann::json({11.0, 50.0, 20.0, 20.0}));
+  EXPECT_DOUBLE_EQ(edge["size_px"].get<double>(), 20.0);
+  EXPECT_EQ(edge["best_iou"], 0.0);
+  EXPECT_TRUE(edge["best"].is_null());
 }
 
 TEST(DetectionMetrics, ImageNamesAreEscapedInTheJson) {
@@ -211,6 +229,7 @@ TEST(DetectionMetrics, ImageNamesAreEscapedInTheJson) {
   images[0].name = "a \"b\".png";
   const std::string j = evaluate_detections(images, MetricsOptions{}).json();
   EXPECT_NE(j.find("\"name\": \"a \\\"b\\\".png\""), std::string::npos) << j;
+  EXPECT_EQ(nlohmann::json::parse(j)["iou"]["unmatched"][0]["name"], "a \"b\".png");
 }
 
 TEST(DetectionMetrics, InvalidOptionsAreNamed) {

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 #include <wingman/common/json.hpp>
+#include <wingman/common/progress.hpp>
 #include <wingman/detector/cpu_backend.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
@@ -147,11 +148,8 @@ class TimedBackend : public InferenceBackend {
   ForwardStats* stats_;
 };
 
-using common::json_string;
-
-std::string json_timing(const TimingMs& t) {
-  return fmt::format("{{\"median\": {:.4f}, \"min\": {:.4f}, \"max\": {:.4f}, \"runs\": {}}}", t.median, t.min, t.max,
-                     t.runs);
+common::Json json_timing(const TimingMs& t) {
+  return {{"median", t.median}, {"min", t.min}, {"max", t.max}, {"runs", t.runs}};
 }
 
 ForwardResult forward_row(const std::string& backend, const std::string& size, int threads, const std::string& note) {
@@ -224,6 +222,10 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
 
   std::vector<cv::Mat> stream;
   for (int i = 0; i < 8; ++i) stream.push_back(synthetic_frame(o.stream_width, o.stream_height, i));
+  // Steps: per size, the forward rows and the layer profile, then the 12 pipeline rows.
+  const int64_t steps_per_size = 1 + (o.layers ? 1 : 0) + (o.pipeline ? 12 : 0);
+  common::Progress steps("wingman bench detector", steps_per_size * static_cast<int64_t>(o.sizes.size()),
+                         "measurements", progress);
 
   for (const std::string& size_option : o.sizes) {
     const DarknetModel model = bench_model(size_option, o);
@@ -329,6 +331,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
       if (row.result.error.empty()) row.result.ms = summarize(row.ms);
       finish(std::move(row.result));
     }
+    steps.step();
 
     // Per-layer device times of the OpenCL backend (OpenCL profiling events), after the timed rounds.
     if (o.layers && ocl) {
@@ -358,6 +361,7 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
         say(fmt::format("opencl {} px: per-layer profile failed: {}", size, e.what()));
       }
     }
+    if (o.layers) steps.step();
   }
   // Speed-up vs bare OpenCV DNN at the same size and thread count (OpenCL: the DNN row with its thread
   // count, else the one with the most threads).
@@ -447,9 +451,11 @@ BenchDetectorReport run_bench_detector(const BenchDetectorOptions& o, std::ostre
           say(fmt::format("{}: {}", label, r.error));
         }
         report.pipeline.push_back(std::move(r));
+        steps.step();
       }
     }
   }
+  steps.finish();
   cv::setNumThreads(saved_threads);
   return report;
 }
@@ -527,49 +533,55 @@ std::string BenchDetectorReport::table() const {
 }
 
 std::string BenchDetectorReport::json() const {
-  std::ostringstream s;
-  s << "{\"benchmark\": \"detector\", \"cfg\": " << json_string(cfg) << ", \"weights\": " << json_string(weights)
-    << ", \"repetitions\": " << repetitions << ", \"warmup\": " << warmup << ", \"stream\": [" << stream_width << ", "
-    << stream_height << "],\n \"machine\": {\"cpu_model\": " << json_string(machine.cpu_model)
-    << ", \"cores\": " << machine.cores << ", \"opencl_devices\": [";
-  for (size_t i = 0; i < machine.opencl_devices.size(); ++i)
-    s << (i ? ", " : "") << json_string(machine.opencl_devices[i]);
-  s << "], \"pocl_affinity\": " << json_string(machine.pocl_affinity)
-    << ", \"pocl_max_pthread_count\": " << json_string(machine.pocl_max_pthread_count)
-    << ", \"opencv_version\": " << json_string(machine.opencv_version) << "},\n \"forward\": [";
-  for (size_t i = 0; i < forward.size(); ++i) {
-    const ForwardResult& r = forward[i];
-    s << (i ? ",\n  " : "\n  ")
-      << fmt::format(
-             "{{\"backend\": {}, \"device\": {}, \"size\": {}, \"threads\": {}, \"threads_note\": {}, "
-             "\"ms\": {}, \"gflop_per_s\": {:.4f}, \"speedup_vs_dnn\": {:.4f}, \"error\": {}}}",
-             json_string(r.backend), json_string(r.device), json_string(r.size), r.threads, json_string(r.threads_note),
-             json_timing(r.ms), r.gflop_per_s, r.speedup_vs_dnn, json_string(r.error));
-  }
-  s << "],\n \"layers\": [";
-  for (size_t i = 0; i < layers.size(); ++i) {
-    const LayerResult& l = layers[i];
-    s << (i ? ",\n  " : "\n  ")
-      << fmt::format(
-             "{{\"size\": {}, \"layer\": {}, \"what\": {}, \"ms\": {}, \"gflop_per_s\": {:.4f}, \"share\": {:.4f}}}",
-             json_string(l.size), l.layer, json_string(l.what), json_timing(l.ms), l.gflop_per_s, l.share);
-  }
-  s << "],\n \"pipeline\": [";
-  for (size_t i = 0; i < pipeline.size(); ++i) {
-    const PipelineResult& r = pipeline[i];
-    s << (i ? ",\n  " : "\n  ")
-      << fmt::format(
-             "{{\"backend\": {}, \"size\": {}, \"threads\": {}, \"zoom_in\": {}, \"flip_fusion\": {}, \"coarse_pass\": "
-             "{}, \"ms\": {}, "
-             "\"frames_per_s\": {:.4f}, \"forwards_per_frame\": {:.4f}, \"images_per_frame\": {:.4f}, "
-             "\"detections_per_frame\": {:.4f}, \"non_forward_share\": {:.4f}, \"error\": {}}}",
-             json_string(r.backend), json_string(r.size), r.threads, r.zoom_in ? "true" : "false",
-             r.flip_fusion ? "true" : "false", r.coarse_pass ? "true" : "false", json_timing(r.ms), r.frames_per_s,
-             r.forwards_per_frame, r.images_per_frame, r.detections_per_frame, r.non_forward_share,
-             json_string(r.error));
-  }
-  s << "]}\n";
-  return s.str();
+  using common::Json;
+  Json j;
+  j["benchmark"] = "detector";
+  j["cfg"] = cfg;
+  j["weights"] = weights;
+  j["repetitions"] = repetitions;
+  j["warmup"] = warmup;
+  j["stream"] = {stream_width, stream_height};
+  j["machine"] = {{"cpu_model", machine.cpu_model},
+                  {"cores", machine.cores},
+                  {"opencl_devices", machine.opencl_devices},
+                  {"pocl_affinity", machine.pocl_affinity},
+                  {"pocl_max_pthread_count", machine.pocl_max_pthread_count},
+                  {"opencv_version", machine.opencv_version}};
+  Json& fwd = j["forward"] = Json::array();
+  for (const ForwardResult& r : forward)
+    fwd.push_back({{"backend", r.backend},
+                   {"device", r.device},
+                   {"size", r.size},
+                   {"threads", r.threads},
+                   {"threads_note", r.threads_note},
+                   {"ms", json_timing(r.ms)},
+                   {"gflop_per_s", r.gflop_per_s},
+                   {"speedup_vs_dnn", r.speedup_vs_dnn},
+                   {"error", r.error}});
+  Json& lay = j["layers"] = Json::array();
+  for (const LayerResult& l : layers)
+    lay.push_back({{"size", l.size},
+                   {"layer", l.layer},
+                   {"what", l.what},
+                   {"ms", json_timing(l.ms)},
+                   {"gflop_per_s", l.gflop_per_s},
+                   {"share", l.share}});
+  Json& pipe = j["pipeline"] = Json::array();
+  for (const PipelineResult& r : pipeline)
+    pipe.push_back({{"backend", r.backend},
+                    {"size", r.size},
+                    {"threads", r.threads},
+                    {"zoom_in", r.zoom_in},
+                    {"flip_fusion", r.flip_fusion},
+                    {"coarse_pass", r.coarse_pass},
+                    {"ms", json_timing(r.ms)},
+                    {"frames_per_s", r.frames_per_s},
+                    {"forwards_per_frame", r.forwards_per_frame},
+                    {"images_per_frame", r.images_per_frame},
+                    {"detections_per_frame", r.detections_per_frame},
+                    {"non_forward_share", r.non_forward_share},
+                    {"error", r.error}});
+  return common::json_text(j) + "\n";
 }
 
 int run_bench_detector_verb(const BenchDetectorOptions& options, std::ostream& out, std::ostream& err) {

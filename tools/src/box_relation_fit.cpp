@@ -3,6 +3,7 @@
 #include "wingman/tools/box_relation_fit.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/common/progress.hpp>
 #include <wingman/detector/box.hpp>
 #include <wingman/detector/detector_options.hpp>
 #include <wingman/detector/input_size.hpp>
@@ -12,7 +13,7 @@
 #include <wingman/localizer/sphere_localizer.hpp>
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
@@ -70,8 +71,8 @@ RangeErrorStats stats_of(const std::vector<double>& e) {
   return s;
 }
 
-localizer::PixelBox read_box(const YAML::Node& n) {
-  return {n["cx"].as<double>(), n["cy"].as<double>(), n["w"].as<double>(), n["h"].as<double>()};
+localizer::PixelBox read_box(const nlohmann::json& n) {
+  return {n.at("cx").get<double>(), n.at("cy").get<double>(), n.at("w").get<double>(), n.at("h").get<double>()};
 }
 
 /// Relative range error of a sample under `relation`: the exact localizer with the true camera and radius.
@@ -197,37 +198,40 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
 
   BoxRelationSummary summary;
   std::vector<Sample> samples;
-  auto last = std::chrono::steady_clock::now();
+  common::Progress images("wingman model box-relation", static_cast<int64_t>(metas.size()), "images", &progress);
   for (size_t k = 0; k < metas.size(); ++k) {
+    images.update(static_cast<int64_t>(k), fmt::format("{} targets found", summary.matched));  // `continue`s below
     const std::string file = metas[k].string();
-    YAML::Node meta;
+    nlohmann::json meta;
     try {
-      meta = YAML::LoadFile(file);
-    } catch (const YAML::Exception& e) {
+      std::ifstream in(file);
+      if (!in) throw std::runtime_error("cannot open the file");
+      meta = nlohmann::json::parse(in);
+    } catch (const std::exception& e) {
       throw std::runtime_error(fmt::format("{}: not readable JSON: {}", file, e.what()));
     }
     ++summary.images;
     try {
-      if (!meta["sphere_box"] || meta["sphere_box"].IsNull())
+      if (!meta.contains("sphere_box") || meta["sphere_box"].is_null())
         throw std::runtime_error("sphere_box: missing (render the set with this version of `wingman dataset synth`)");
-      if (meta["box"]["truncated"].as<bool>()) {
+      if (meta.at("box").at("truncated").get<bool>()) {
         ++summary.skipped_truncated;
         continue;
       }
-      const int W = meta["width"].as<int>(), H = meta["height"].as<int>();
+      const int W = meta.at("width").get<int>(), H = meta.at("height").get<int>();
       const localizer::PixelBox sphere = read_box(meta["sphere_box"]), outline = read_box(meta["box"]);
       if (sphere.cx - sphere.w / 2 < 1 || sphere.cx + sphere.w / 2 > W - 1 || sphere.cy - sphere.h / 2 < 1 ||
           sphere.cy + sphere.h / 2 > H - 1) {
         ++summary.skipped_truncated;  // the sphere's box leaves the image: no whole ratio
         continue;
       }
-      const YAML::Node cam = meta["camera"];
+      const nlohmann::json& cam = meta.at("camera");
+      const std::string distortion = cam.at("distortion_model").get<std::string>();
       auto camera = std::make_shared<const localizer::CameraModel>(
-          W, H, cam["fx"].as<double>(), cam["fy"].as<double>(), cam["cx"].as<double>(), cam["cy"].as<double>(),
-          distortion_of(cam["distortion_model"].as<std::string>(), file),
-          cam["distortion_model"].as<std::string>() == "none" ? std::vector<double>{}
-                                                              : cam["coefficients"].as<std::vector<double>>());
-      const std::string image = (fs::path(rq.data) / meta["image"].as<std::string>()).string();
+          W, H, cam.at("fx").get<double>(), cam.at("fy").get<double>(), cam.at("cx").get<double>(),
+          cam.at("cy").get<double>(), distortion_of(distortion, file),
+          distortion == "none" ? std::vector<double>{} : cam.at("coefficients").get<std::vector<double>>());
+      const std::string image = (fs::path(rq.data) / meta.at("image").get<std::string>()).string();
       const cv::Mat bgr = cv::imread(image, cv::IMREAD_COLOR);
       if (bgr.empty()) throw std::runtime_error(image + ": cannot read the image");
       double best = 0;
@@ -245,15 +249,18 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       }
       ++summary.matched;
       Sample s;
-      const std::string airframe = meta["target"]["airframe"].as<std::string>();
+      const nlohmann::json& target = meta.at("target");
+      const std::string airframe = target.at("airframe").get<std::string>();
       s.airframe = airframe.find('.') != std::string::npos ? airframe : "procedural " + airframe;
-      s.range_m = meta["target"]["range_m"].as<double>();
-      s.radius_m = meta["target"]["bounding_radius_m"].as<double>();
-      if (const YAML::Node fr = meta["target"]["frame_radius_m"]; fr) s.frame_radius_m = fr.as<double>();
+      s.range_m = target.at("range_m").get<double>();
+      s.radius_m = target.at("bounding_radius_m").get<double>();
+      if (target.contains("frame_radius_m")) s.frame_radius_m = target["frame_radius_m"].get<double>();
       {
-        const YAML::Node pc = meta["T_cam_to_world"]["p"], pt = meta["target"]["T_body_to_world"]["p"];
-        const double dx = pc[0].as<double>() - pt[0].as<double>(), dy = pc[1].as<double>() - pt[1].as<double>(),
-                     dz = pc[2].as<double>() - pt[2].as<double>();
+        const auto pc = meta.at("T_cam_to_world").at("p").get<std::vector<double>>();
+        const auto pt = target.at("T_body_to_world").at("p").get<std::vector<double>>();
+        if (pc.size() != 3 || pt.size() != 3)
+          throw std::invalid_argument("T_cam_to_world.p, T_body_to_world.p: 3 numbers");
+        const double dx = pc[0] - pt[0], dy = pc[1] - pt[1], dz = pc[2] - pt[2];
         s.elevation_deg = std::atan2(dz, std::hypot(dx, dy)) * 180.0 / M_PI;
       }
       s.det = det, s.det_w = det.w, s.det_h = det.h, s.image_w = W;
@@ -261,19 +268,14 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       s.width_ratio = det.w / sphere.w, s.height_ratio = det.h / sphere.h;
       s.camera = camera;
       samples.push_back(std::move(s));
-    } catch (const YAML::Exception& e) {
+    } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error(fmt::format("{}: {}", file, e.what()));
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(fmt::format("{}: {}", file, e.what()));
     }
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last > std::chrono::seconds(10) || k + 1 == metas.size()) {
-      progress << fmt::format("wingman model box-relation: {}/{} images, {} targets found\n", k + 1, metas.size(),
-                              summary.matched)
-               << std::flush;
-      last = now;
-    }
   }
+  images.update(static_cast<int64_t>(metas.size()), fmt::format("{} targets found", summary.matched));
+  images.finish();
   if (samples.empty()) throw std::runtime_error("the detector found none of the targets: nothing to measure");
   if (!rq.samples_csv.empty()) {
     std::ofstream csv(rq.samples_csv);

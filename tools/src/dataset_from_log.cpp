@@ -2,6 +2,8 @@
 // `wingman dataset from-log`: a flight log's camera frames and ground-truth boxes as a YOLO dataset.
 #include "wingman/tools/dataset_from_log.hpp"
 
+#include "log_progress.hpp"
+
 #include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detector/preprocess.hpp>
@@ -144,7 +146,9 @@ DatasetFromLogSummary run_dataset_from_log(const DatasetFromLogRequest& request,
         it = pending.truth.erase(it);
     };
 
+    common::Progress read = log_progress(&progress, "wingman dataset from-log: reading " + log_path, log_path);
     while (const common::LcmLogEvent* ev = log.read_next()) {
+      read.update(ev->offset, fmt::format("{} images written", written_here));
       if (ev->channel == request.image_channel) {
         wingman::image_t image;
         if (image.decode(ev->data, 0, ev->datalen) < 0 || !common::validate_message(image).empty()) {
@@ -173,6 +177,8 @@ DatasetFromLogSummary run_dataset_from_log(const DatasetFromLogRequest& request,
         expire(seq);
       }
     }
+    read.update(read.total(), fmt::format("{} images written", written_here));
+    read.finish();
     summary.unmatched += static_cast<int>(pending.images.size());
     if (images_seen > 0 && truth_seen == 0) {
       throw std::runtime_error(fmt::format(

@@ -8,6 +8,8 @@
 #include "synth_random.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/common/json.hpp>
+#include <wingman/common/progress.hpp>
 #include <wingman/localizer/camera_model.hpp>
 #include <wingman/localizer/sphere_projection.hpp>
 #include <wingman/sim/drone_model.hpp>
@@ -169,20 +171,11 @@ Eigen::Isometry3d random_camera_pose(const DatasetSynthConfig& c, Random& rng) {
   return T;
 }
 
-std::string vec_json(const Eigen::Vector3d& v) { return fmt::format("[{:.9g}, {:.9g}, {:.9g}]", v.x(), v.y(), v.z()); }
+common::Json vec_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-std::string quat_json(const Eigen::Matrix3d& R) {
+common::Json quat_json(const Eigen::Matrix3d& R) {
   const Eigen::Quaterniond q(R);
-  return fmt::format("[{:.9g}, {:.9g}, {:.9g}, {:.9g}]", q.w(), q.x(), q.y(), q.z());
-}
-
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    out += ch;
-  }
-  return out + "\"";
+  return {q.w(), q.x(), q.y(), q.z()};
 }
 
 // A DroneSpec as one JSON object (the keys of DroneSpec::visit without a prefix).
@@ -190,23 +183,18 @@ class JsonSpecWriter {
  public:
   template <class T>
   void operator()(const std::string& key, const T& value, const char* /*doc*/) {
-    fields_.push_back(quoted(key) + ": " + format(value));
+    json_[key] = value;
   }
-  std::string str() const { return "{" + fmt::format("{}", fmt::join(fields_, ", ")) + "}"; }
+  common::Json json() const { return json_; }
 
  private:
-  static std::string format(bool v) { return v ? "true" : "false"; }
-  static std::string format(int v) { return std::to_string(v); }
-  static std::string format(double v) { return fmt::format("{:.9g}", v); }
-  static std::string format(const std::string& v) { return quoted(v); }
-  static std::string format(const std::vector<double>& v) { return fmt::format("[{:.9g}]", fmt::join(v, ", ")); }
-  std::vector<std::string> fields_;
+  common::Json json_ = common::Json::object();
 };
 
-std::string spec_json(const sim::DroneSpec& spec) {
+common::Json spec_json(const sim::DroneSpec& spec) {
   JsonSpecWriter writer;
   const_cast<sim::DroneSpec&>(spec).visit(writer, "");  // visit() only reads through a writer
-  return writer.str();
+  return writer.json();
 }
 
 std::vector<std::string> mesh_files(const std::vector<std::string>& args) {
@@ -233,11 +221,6 @@ std::vector<std::string> mesh_files(const std::vector<std::string>& args) {
     }
   }
   return files;
-}
-
-std::string duration_text(double seconds) {
-  const int s = static_cast<int>(std::lround(seconds));
-  return s >= 3600 ? fmt::format("{}h{:02d}m", s / 3600, s / 60 % 60) : fmt::format("{}m{:02d}s", s / 60, s % 60);
 }
 
 // One camera of the pool.
@@ -313,16 +296,15 @@ std::string DatasetSynthSummary::one_line() const {
 }
 
 namespace {
-/// The "sphere_box" line of an image's metadata: the exact box of the target's bounding sphere (the box a sphere
+/// The "sphere_box" of an image's metadata: the exact box of the target's bounding sphere (the box a sphere
 /// detector would draw, not clipped to the image; `wingman model box-relation` relates a model's boxes to it), or
 /// null when the sphere reaches behind the camera.
-std::string sphere_box_json(const localizer::CameraModel& camera, const Eigen::Vector3d& p_target_in_cam,
-                            double radius_m) {
+common::Json sphere_box_json(const localizer::CameraModel& camera, const Eigen::Vector3d& p_target_in_cam,
+                             double radius_m) {
   const localizer::SphereImageBox s = localizer::project_sphere(camera, p_target_in_cam, radius_m);
-  if (!s.valid) return "  \"sphere_box\": null,\n";
+  if (!s.valid) return nullptr;
   const localizer::PixelBox b = s.pixel_box();
-  return fmt::format("  \"sphere_box\": {{\"cx\": {:.9g}, \"cy\": {:.9g}, \"w\": {:.9g}, \"h\": {:.9g}}},\n", b.cx,
-                     b.cy, b.w, b.h);
+  return {{"cx", b.cx}, {"cy", b.cy}, {"w", b.w}, {"h", b.h}};
 }
 }  // namespace
 
@@ -362,7 +344,7 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
 
   DatasetSynthSummary summary;
   summary.out_dir = request.out_dir;
-  auto last_report = start;
+  common::Progress images("wingman dataset synth", request.count, "images", &progress);
   for (int i = 0; i < request.count; ++i) {
     Random rng(request.seed, kImageStream, static_cast<uint64_t>(i));
     const std::string split = rng.chance(config.val_fraction) ? "val" : "train";
@@ -440,37 +422,44 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
       const localizer::CameraModel& cam = camera.model;
       const Eigen::Vector3d p_target_in_cam = T_cam_to_world.inverse() * target.T_body_to_world.translation();
       const std::string meta_path = (out / "meta" / split / (name + ".json")).string();
+      common::Json j;
+      j["image"] = "images/" + split + "/" + name + "." + config.image_format;
+      j["width"] = config.width;
+      j["height"] = config.height;
+      j["camera"] = {{"name", cam.name()},
+                     {"distortion_model", cam.model_name()},
+                     {"fx", cam.fx()},
+                     {"fy", cam.fy()},
+                     {"cx", cam.cx()},
+                     {"cy", cam.cy()},
+                     {"coefficients", cam.coefficients()}};
+      j["T_cam_to_world"] = {{"p", vec_json(T_cam_to_world.translation())},
+                             {"q_wxyz", quat_json(T_cam_to_world.linear())}};
+      j["target"] = {{"airframe", model->name()},
+                     {"spec", spec_json(spec)},
+                     {"bounding_radius_m", model->bounding_radius()},
+                     {"frame_radius_m", model->frame_radius()},
+                     {"T_body_to_world",
+                      {{"p", vec_json(target.T_body_to_world.translation())},
+                       {"q_wxyz", quat_json(target.T_body_to_world.linear())}}},
+                     {"prop_angle_rad", target.prop_angle_rad},
+                     {"p_target_in_cam", vec_json(p_target_in_cam)},
+                     {"range_m", box.range_m}};
+      j["box"] = {{"cx", box.cx},
+                  {"cy", box.cy},
+                  {"w", box.w},
+                  {"h", box.h},
+                  {"truncated", box.truncated},
+                  {"visible_pixels", box.visible_pixels}};
+      j["sphere_box"] = sphere_box_json(cam, p_target_in_cam, model->bounding_radius());
+      j["render"] = {{"scene_seed", scene.seed},
+                     {"exposure_gain", result.exposure_gain},
+                     {"noise_std", scene.noise_std},
+                     {"shot_noise", scene.shot_noise},
+                     {"motion_blur_exposure_s", scene.motion_blur_exposure_s},
+                     {"frame_seed", frame_seed}};
       std::ofstream meta(meta_path);
-      meta << "{\n"
-           << fmt::format("  \"image\": {},\n", quoted("images/" + split + "/" + name + "." + config.image_format))
-           << fmt::format("  \"width\": {}, \"height\": {},\n", config.width, config.height)
-           << fmt::format(
-                  "  \"camera\": {{\"name\": {}, \"distortion_model\": {}, \"fx\": {:.9g}, \"fy\": {:.9g}, "
-                  "\"cx\": {:.9g}, \"cy\": {:.9g}, \"coefficients\": [{:.9g}]}},\n",
-                  quoted(cam.name()), quoted(cam.model_name()), cam.fx(), cam.fy(), cam.cx(), cam.cy(),
-                  fmt::join(cam.coefficients(), ", "))
-           << fmt::format("  \"T_cam_to_world\": {{\"p\": {}, \"q_wxyz\": {}}},\n",
-                          vec_json(T_cam_to_world.translation()), quat_json(T_cam_to_world.linear()))
-           << fmt::format(
-                  "  \"target\": {{\"airframe\": {}, \"spec\": {}, \"bounding_radius_m\": {:.9g}, "
-                  "\"frame_radius_m\": {:.9g},\n",
-                  quoted(model->name()), spec_json(spec), model->bounding_radius(), model->frame_radius())
-           << fmt::format("    \"T_body_to_world\": {{\"p\": {}, \"q_wxyz\": {}}}, \"prop_angle_rad\": {:.9g},\n",
-                          vec_json(target.T_body_to_world.translation()), quat_json(target.T_body_to_world.linear()),
-                          target.prop_angle_rad)
-           << fmt::format("    \"p_target_in_cam\": {}, \"range_m\": {:.9g}}},\n", vec_json(p_target_in_cam),
-                          box.range_m)
-           << fmt::format(
-                  "  \"box\": {{\"cx\": {:.9g}, \"cy\": {:.9g}, \"w\": {:.9g}, \"h\": {:.9g}, \"truncated\": {}, "
-                  "\"visible_pixels\": {}}},\n",
-                  box.cx, box.cy, box.w, box.h, box.truncated ? "true" : "false", box.visible_pixels)
-           << sphere_box_json(cam, p_target_in_cam, model->bounding_radius())
-           << fmt::format(
-                  "  \"render\": {{\"scene_seed\": {}, \"exposure_gain\": {:.9g}, \"noise_std\": {:.9g}, "
-                  "\"shot_noise\": {:.9g}, \"motion_blur_exposure_s\": {:.9g}, \"frame_seed\": {}}}\n",
-                  scene.seed, result.exposure_gain, scene.noise_std, scene.shot_noise, scene.motion_blur_exposure_s,
-                  frame_seed)
-           << "}\n";
+      meta << common::json_text(j) << "\n";
       meta.close();
       if (!meta) throw std::runtime_error(meta_path + ": cannot write the metadata");
       ++summary.images;
@@ -483,17 +472,9 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
                       "lower synth.min_visible_pixels",
                       i, kMaxPlacements));
     }
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_report >= std::chrono::seconds(1) || i + 1 == request.count) {
-      const double elapsed = std::chrono::duration<double>(now - start).count();
-      const double rate = (i + 1) / std::max(elapsed, 1e-9);
-      progress << fmt::format("wingman dataset synth: {}/{} images ({:.0f}%), {:.2f} images/s, {} left", i + 1,
-                              request.count, 100.0 * (i + 1) / request.count, rate,
-                              duration_text((request.count - i - 1) / rate))
-               << std::endl;
-      last_report = now;
-    }
+    images.update(i + 1);
   }
+  images.finish();
   training::write_data_yaml(
       (out / "data.yaml").string(), {"drone"},
       {"written by wingman dataset synth", fmt::format("seed {}, {} images", request.seed, request.count)});

@@ -6,6 +6,7 @@
 #include "log_progress.hpp"
 #include "wingman/tools/report.hpp"
 
+#include <wingman/common/json.hpp>
 #include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detections_t.hpp>
@@ -139,44 +140,44 @@ std::string stats_line(const std::string& name, const ErrorStats& s, const char*
                      s.mean * scale, s.max * scale, s.n, fmt::arg("u", unit));
 }
 
-std::string stats_json(const ErrorStats& s) {
-  return fmt::format("{{\"n\": {}, \"rms_m\": {:.6f}, \"mean_m\": {:.6f}, \"max_m\": {:.6f}}}", s.n, s.rms, s.mean,
-                     s.max);
+common::Json stats_json(const ErrorStats& s) {
+  return {{"n", s.n}, {"rms_m", s.rms}, {"mean_m", s.mean}, {"max_m", s.max}};
 }
 
-std::string fraction_json(const ErrorStats& s) {
-  return fmt::format("{{\"n\": {}, \"rms\": {:.6f}, \"mean\": {:.6f}, \"max\": {:.6f}}}", s.n, s.rms, s.mean, s.max);
+common::Json fraction_json(const ErrorStats& s) {
+  return {{"n", s.n}, {"rms", s.rms}, {"mean", s.mean}, {"max", s.max}};
 }
 
-std::string percentiles_json(const Percentiles& p) {
-  return fmt::format("{{\"n\": {}, \"p50_ms\": {:.3f}, \"p90_ms\": {:.3f}, \"p99_ms\": {:.3f}, \"max_ms\": {:.3f}}}",
-                     p.n, p.p50, p.p90, p.p99, p.max);
+common::Json percentiles_json(const Percentiles& p) {
+  return {{"n", p.n}, {"p50_ms", p.p50}, {"p90_ms", p.p90}, {"p99_ms", p.p99}, {"max_ms", p.max}};
 }
+
+/// A bin's upper edge; null for the last, open bin.
+common::Json hi_json(double hi_m) { return std::isinf(hi_m) ? common::Json(nullptr) : common::Json(hi_m); }
 
 std::string bin_name(const RangeBin& b) {
   return std::isinf(b.hi_m) ? fmt::format("{:g}+ m", b.lo_m) : fmt::format("{:g}-{:g} m", b.lo_m, b.hi_m);
 }
 
-std::string bins_json(const std::vector<RangeBin>& bins, bool fraction) {
-  std::string s = "[";
-  for (const auto& b : bins) {
-    s += fmt::format("{}{{\"lo_m\": {:g}, \"hi_m\": {}, \"error\": {}}}", s.size() > 1 ? ", " : "", b.lo_m,
-                     std::isinf(b.hi_m) ? std::string("null") : fmt::format("{:g}", b.hi_m),
-                     fraction ? fraction_json(b.error) : stats_json(b.error));
-  }
-  return s + "]";
+common::Json bins_json(const std::vector<RangeBin>& bins, bool fraction) {
+  common::Json j = common::Json::array();
+  for (const auto& b : bins)
+    j.push_back({{"lo_m", b.lo_m},
+                 {"hi_m", hi_json(b.hi_m)},
+                 {"error", fraction ? fraction_json(b.error) : stats_json(b.error)}});
+  return j;
 }
 
-std::string detection_bins_json(const std::vector<DetectionBin>& bins) {
-  std::string s = "[";
-  for (const auto& b : bins) {
-    s += fmt::format(
-        "{}{{\"lo_m\": {:g}, \"hi_m\": {}, \"visible\": {}, \"detected\": {}, \"false_boxes\": {}, "
-        "\"frames_with_false_box\": {}}}",
-        s.size() > 1 ? ", " : "", b.lo_m, std::isinf(b.hi_m) ? std::string("null") : fmt::format("{:g}", b.hi_m),
-        b.visible, b.detected, b.false_boxes, b.frames_with_false_box);
-  }
-  return s + "]";
+common::Json detection_bins_json(const std::vector<DetectionBin>& bins) {
+  common::Json j = common::Json::array();
+  for (const auto& b : bins)
+    j.push_back({{"lo_m", b.lo_m},
+                 {"hi_m", hi_json(b.hi_m)},
+                 {"visible", b.visible},
+                 {"detected", b.detected},
+                 {"false_boxes", b.false_boxes},
+                 {"frames_with_false_box", b.frames_with_false_box}});
+  return j;
 }
 
 /// True when the centre of `b` lies inside `tb` (edges included); cameras and visibility are the caller's to check.
@@ -249,9 +250,9 @@ EvalResult evaluate_log(const EvalOptions& o) {
   size_t targets_messages = 0;
   EvalResult r;
 
-  LogProgress progress(o.progress, o.log, file.file_ptr());
+  common::Progress progress = log_progress(o.progress, "wingman: reading " + o.log, o.log);
   while (const common::LcmLogEvent* ev = file.read_next()) {
-    progress.tick();
+    progress.update(ev->offset);
     if (ev->channel == o.truth_channel) {
       wingman::ground_truth_t g;
       if (!decode(*ev, &g)) continue;
@@ -298,7 +299,8 @@ EvalResult evaluate_log(const EvalOptions& o) {
       }
     }
   }
-  progress.done();
+  progress.update(progress.total());
+  progress.finish();
   if (truth.empty()) {
     throw std::runtime_error("wingman eval: '" + o.log + "' holds no ground_truth_t on channel " + o.truth_channel);
   }
@@ -621,39 +623,53 @@ std::string EvalResult::report() const {
 
 namespace {
 /// {"<vehicle id>": {"track_ids": n, "id_switches": n}, ...}
-std::string ids_json(const std::map<int, EvalResult::VehicleIds>& ids) {
-  std::string j = "{";
+common::Json ids_json(const std::map<int, EvalResult::VehicleIds>& ids) {
+  common::Json j = common::Json::object();
   for (const auto& [vehicle, v] : ids)
-    j += fmt::format("{}\"{}\": {{\"track_ids\": {}, \"id_switches\": {}}}", j.size() > 1 ? ", " : "", vehicle,
-                     v.track_ids, v.id_switches);
-  return j + "}";
+    j[std::to_string(vehicle)] = {{"track_ids", v.track_ids}, {"id_switches", v.id_switches}};
+  return j;
 }
 }  // namespace
 
 std::string EvalResult::json() const {
-  return fmt::format(
-      "{{\"detection_source\": \"{}\", \"duration_s\": {:.3f}, \"truth_frames\": {}, \"frames_leader_visible\": {}, "
-      "\"frames_leader_detected\": {}, \"false_boxes_leader_visible\": {}, \"frames_leader_visible_with_false_box\": "
-      "{}, \"target_estimates\": {}, \"false_targets\": {}, \"false_targets_per_s\": "
-      "{:.6f}, \"false_track_ids\": {}, \"track_ids_on_leader\": {}, \"leader_id_switches\": {}, "
-      "\"ids_by_vehicle\": {}, "
-      "\"localization\": {}, \"localization_x\": {}, \"localization_y\": {}, \"localization_z\": {}, "
-      "\"along_line_of_sight\": {}, \"across_line_of_sight\": {}, \"localization_by_range\": {}, "
-      "\"formation_horizontal\": {}, \"formation_vertical\": {}, \"latency\": {}, \"inference_latency\": {}, "
-      "\"box_width_single\": {}, \"box_width_zoom\": {}, \"box_width_single_by_range\": {}, "
-      "\"box_width_zoom_by_range\": {}, \"detection_by_range\": {}, \"detections_total\": {}, "
-      "\"detections_outside_truth\": {}, \"detection_frames\": {}, \"false_boxes\": {}, \"frames_with_false_box\": "
-      "{}, \"non_drone_boxes\": {}}}",
-      detection_source, duration_s, truth_frames, frames_leader_visible, frames_leader_detected,
-      false_boxes_leader_visible, frames_leader_visible_with_false_box, target_estimates, false_targets,
-      false_targets_per_s, false_track_ids, track_ids_on_leader, leader_id_switches, ids_json(ids_by_vehicle),
-      stats_json(localization), stats_json(localization_axis[0]), stats_json(localization_axis[1]),
-      stats_json(localization_axis[2]), stats_json(along_line_of_sight), stats_json(across_line_of_sight),
-      bins_json(localization_by_range, false), stats_json(formation_horizontal), stats_json(formation_vertical),
-      percentiles_json(latency_ms), percentiles_json(inference_latency_ms), fraction_json(box_width_single),
-      fraction_json(box_width_zoom), bins_json(box_width_single_by_range, true),
-      bins_json(box_width_zoom_by_range, true), detection_bins_json(detection_by_range), detections_total,
-      detections_outside_truth, detection_frames, false_boxes, frames_with_false_box, non_drone_boxes);
+  common::Json j;
+  j["detection_source"] = detection_source;
+  j["duration_s"] = duration_s;
+  j["truth_frames"] = truth_frames;
+  j["frames_leader_visible"] = frames_leader_visible;
+  j["frames_leader_detected"] = frames_leader_detected;
+  j["false_boxes_leader_visible"] = false_boxes_leader_visible;
+  j["frames_leader_visible_with_false_box"] = frames_leader_visible_with_false_box;
+  j["target_estimates"] = target_estimates;
+  j["false_targets"] = false_targets;
+  j["false_targets_per_s"] = false_targets_per_s;
+  j["false_track_ids"] = false_track_ids;
+  j["track_ids_on_leader"] = track_ids_on_leader;
+  j["leader_id_switches"] = leader_id_switches;
+  j["ids_by_vehicle"] = ids_json(ids_by_vehicle);
+  j["localization"] = stats_json(localization);
+  j["localization_x"] = stats_json(localization_axis[0]);
+  j["localization_y"] = stats_json(localization_axis[1]);
+  j["localization_z"] = stats_json(localization_axis[2]);
+  j["along_line_of_sight"] = stats_json(along_line_of_sight);
+  j["across_line_of_sight"] = stats_json(across_line_of_sight);
+  j["localization_by_range"] = bins_json(localization_by_range, false);
+  j["formation_horizontal"] = stats_json(formation_horizontal);
+  j["formation_vertical"] = stats_json(formation_vertical);
+  j["latency"] = percentiles_json(latency_ms);
+  j["inference_latency"] = percentiles_json(inference_latency_ms);
+  j["box_width_single"] = fraction_json(box_width_single);
+  j["box_width_zoom"] = fraction_json(box_width_zoom);
+  j["box_width_single_by_range"] = bins_json(box_width_single_by_range, true);
+  j["box_width_zoom_by_range"] = bins_json(box_width_zoom_by_range, true);
+  j["detection_by_range"] = detection_bins_json(detection_by_range);
+  j["detections_total"] = detections_total;
+  j["detections_outside_truth"] = detections_outside_truth;
+  j["detection_frames"] = detection_frames;
+  j["false_boxes"] = false_boxes;
+  j["frames_with_false_box"] = frames_with_false_box;
+  j["non_drone_boxes"] = non_drone_boxes;
+  return common::json_text(j);
 }
 
 std::string EvalResult::csv() const {

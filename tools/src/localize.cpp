@@ -3,6 +3,7 @@
 #include "wingman/tools/localize.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/json.hpp>
 #include <wingman/localizer/calibration.hpp>
 
 #include <cmath>
@@ -18,20 +19,7 @@ std::string vec(const Eigen::Vector3d& v, int precision) {
   return fmt::format("[{:.{}f}, {:.{}f}, {:.{}f}]", v.x(), precision, v.y(), precision, v.z(), precision);
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
-}
-
-std::string json_vec(const Eigen::Vector3d& v) { return fmt::format("[{:.9g}, {:.9g}, {:.9g}]", v.x(), v.y(), v.z()); }
+common::Json json_vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
@@ -80,22 +68,26 @@ int run_localize(const LocalizeToolOptions& o, std::ostream& out, std::ostream& 
   const double sigma_range = m.range_valid ? std::sqrt(m.bearing_in_cam.dot(m.cov_p_in_cam * m.bearing_in_cam)) : 0;
 
   if (o.json) {
-    out << "{\"ok\": true, \"calibration\": " << json_string(o.calibration) << ", \"camera\": \"" << camera.model_name()
-        << "\", \"image_size\": [" << camera.width() << ", " << camera.height()
-        << "], \"radius_m\": " << fmt::format("{:.9g}", o.localizer.radius_m)
-        << ", \"method\": " << json_string(o.localizer.range_method)
-        << ", \"box\": " << fmt::format("[{:.9g}, {:.9g}, {:.9g}, {:.9g}]", box.cx, box.cy, box.w, box.h)
-        << ", \"direction_in_cam\": " << json_vec(m.bearing_in_cam)
-        << ", \"range_valid\": " << (m.range_valid ? "true" : "false");
+    common::Json j;
+    j["ok"] = true;
+    j["calibration"] = o.calibration;
+    j["camera"] = camera.model_name();
+    j["image_size"] = {camera.width(), camera.height()};
+    j["radius_m"] = o.localizer.radius_m;
+    j["method"] = o.localizer.range_method;
+    j["box"] = {box.cx, box.cy, box.w, box.h};
+    j["direction_in_cam"] = json_vec(m.bearing_in_cam);
+    j["range_valid"] = m.range_valid;
     if (m.range_valid) {
       const Eigen::Matrix3d& c = m.cov_p_in_cam;
-      out << ", \"range_m\": " << fmt::format("{:.9g}", m.range)
-          << ", \"range_sigma_m\": " << fmt::format("{:.9g}", sigma_range)
-          << ", \"p_target_in_cam\": " << json_vec(m.p_target_in_cam) << ", \"cov_p_in_cam\": ["
-          << json_vec(c.row(0).transpose()) << ", " << json_vec(c.row(1).transpose()) << ", "
-          << json_vec(c.row(2).transpose()) << "]";
+      j["range_m"] = m.range;
+      j["range_sigma_m"] = sigma_range;
+      j["p_target_in_cam"] = json_vec(m.p_target_in_cam);
+      j["cov_p_in_cam"] = {json_vec(c.row(0).transpose()), json_vec(c.row(1).transpose()),
+                           json_vec(c.row(2).transpose())};
     }
-    out << ", \"edges_used\": " << r.edges_used << "}" << std::endl;
+    j["edges_used"] = r.edges_used;
+    out << common::json_text(j) << std::endl;
     return 0;
   }
   out << "camera:    " << camera.describe() << "  (" << o.calibration << ")\n";

@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
   r->add_option("--step-timeout", replay.step_timeout_s,
                 "Seconds to wait for the pipeline to settle after each message");
   r->add_option("--max-events", replay.max_events, "Play at most this many events (0 = all)");
+  bool replay_quiet = false;
+  r->add_flag("--quiet", replay_quiet, "No progress on stderr");
   r->add_flag("--skip-corrupt", replay.skip_corrupt,
               "Skip and count corrupt log events (default: stop at the first with an error naming its byte offset)");
 
@@ -238,6 +240,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*r) {
+      if (!replay_quiet) replay.progress = &std::cerr;
       const ReplaySummary summary = run_replay(replay);
       std::cerr << summary.one_line() << std::endl;
       return summary.ok ? 0 : 1;

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 #include <wingman/common/detection_class.hpp>
+#include <wingman/common/progress.hpp>
 #include <wingman/detector/box.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
@@ -102,7 +103,10 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
   }
 
   int failures = 0;
-  for (const fs::path& path : images) {
+  common::Progress progress("wingman predict", static_cast<int64_t>(images.size()), "images", &err);
+  for (size_t i = 0; i < images.size(); ++i) {
+    progress.update(static_cast<int64_t>(i), fmt::format("{} failed", failures));  // before the `continue`s below
+    const fs::path& path = images[i];
     const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
     if (bgr.empty()) {
       err << prefix << fmt::format("{}: cannot read the image", path.string()) << "\n";
@@ -147,6 +151,8 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
     }
     out << fmt::format("{}: {} detection(s) -> {}", path.string(), boxes.size(), txt.string()) << "\n";
   }
+  progress.update(static_cast<int64_t>(images.size()), fmt::format("{} failed", failures));
+  progress.finish();
   return failures == 0 ? 0 : 1;
 }
 

@@ -2,6 +2,8 @@
 // `wingman replay`: plays an LCM log, optionally in lockstep with the pipeline's processes.
 #include "wingman/tools/replay.hpp"
 
+#include "log_progress.hpp"
+
 #include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/status_t.hpp>
@@ -170,10 +172,12 @@ ReplaySummary run_replay(const ReplayOptions& options) {
 
   int64_t first_timestamp = -1;
   const auto play_start = Clock::now();
+  common::Progress progress = log_progress(options.progress, "wingman replay: " + options.input_log, options.input_log);
   while (options.max_events == 0 || summary.events_played < options.max_events) {
     const common::LcmLogEvent* ev = in.read_next();
     summary.corrupt_events = in.corrupt_events();
     if (ev == nullptr) break;
+    progress.update(ev->offset);
     const bool play = !is_status_channel(ev->channel) && !is_lcm_internal(ev->channel) &&
                       !stage_outputs.count(ev->channel) &&
                       (options.channels.empty() || std::regex_match(ev->channel, include_re)) &&
@@ -216,6 +220,7 @@ ReplaySummary run_replay(const ReplayOptions& options) {
       lcm.handleTimeout(20);
     }
   }
+  progress.finish();
   if (!lockstep) {
     // Let the last messages arrive for the record (bounded).
     const auto until = Clock::now() + std::chrono::milliseconds(300);

@@ -514,10 +514,10 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
   const size_t k = std::min(n, static_cast<size_t>(o.report_frames));
   for (size_t i = 0; i < k; ++i) wanted.insert(k == 1 ? n / 2 : (i * (n - 1) + (k - 1) / 2) / (k - 1));
   common::LcmLogReader file(o.log);  // a corrupt event throws, naming its byte offset
-  LogProgress progress(o.progress, o.log, file.file_ptr(), "drawing frames:");
+  common::Progress progress = log_progress(o.progress, "wingman: drawing frames from " + o.log, o.log);
   size_t index = 0;
   while (const common::LcmLogEvent* ev = file.read_next()) {
-    progress.tick();
+    progress.update(ev->offset);
     if (ev->channel != channel ||
         lcm_fingerprint(ev->data, ev->datalen) != static_cast<uint64_t>(wingman::image_t::getHash()))
       continue;
@@ -568,6 +568,7 @@ std::vector<ReportFrame> draw_report_frames(const EvalResult& r, const EvalOptio
         {static_cast<double>(img.utime - r.first_truth_utime) * 1e-6, img.utime, base64(jpeg), bgr.cols, bgr.rows});
     if (i >= *wanted.rbegin()) break;
   }
+  progress.finish();
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include "synth_random.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/common/json.hpp>
 #include <wingman/sim/drone_model.hpp>
 #include <wingman/sim/scenario.hpp>
 
@@ -291,12 +292,17 @@ ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
   write_file(r.follower_path, common::print_options(formation, header + " (the follower's defaults otherwise)"));
 
   // What was drawn, for the suite's table (tools/experiment_summary.py suite).
-  write_file(r.json_path,
-             fmt::format("{{\"seed\": {}, \"airframe\": \"{}\", \"view\": \"{}\", \"lighting\": \"{}\", "
-                         "\"duration_s\": {:.1f}, \"legs\": {}, \"offset_m\": [{:.4f}, {:.4f}, {:.4f}], "
-                         "\"offset_distance_m\": {:.4f}, \"bounding_radius_m\": {:.6f}}}\n",
-                         o.seed, r.airframe, o.view, o.lighting, r.duration_s, r.legs, r.offset_in_world.x(),
-                         r.offset_in_world.y(), r.offset_in_world.z(), r.offset_in_world.norm(), r.bounding_radius_m));
+  common::Json drawn;
+  drawn["seed"] = o.seed;
+  drawn["airframe"] = r.airframe;
+  drawn["view"] = o.view;
+  drawn["lighting"] = o.lighting;
+  drawn["duration_s"] = r.duration_s;
+  drawn["legs"] = r.legs;
+  drawn["offset_m"] = {r.offset_in_world.x(), r.offset_in_world.y(), r.offset_in_world.z()};
+  drawn["offset_distance_m"] = r.offset_in_world.norm();
+  drawn["bounding_radius_m"] = r.bounding_radius_m;
+  write_file(r.json_path, common::json_text(drawn) + "\n");
 
   // What was written loads with the readers that will use it.
   sim::load_scenario(r.scenario_path);
@@ -384,12 +390,19 @@ ScenarioRandomResult write_sweep_scenario(const ScenarioSweepOptions& o) {
   write_file(r.scenario_path, yaml);
   const std::string header = "written by `" + command + "` for " + out.filename().string();
   write_localizer_and_render(r, header, o.seed, o.lighting, synth);
-  write_file(r.json_path,
-             fmt::format("{{\"kind\": \"sweep\", \"seed\": {}, \"airframe\": \"{}\", \"view\": \"{}\", "
-                         "\"lighting\": \"{}\", \"from_m\": {}, \"to_m\": {}, \"step_m\": {}, \"steps\": {}, "
-                         "\"frames_per_step\": {}, \"bounding_radius_m\": {:.6f}}}\n",
-                         o.seed, r.airframe, o.view, o.lighting, o.from_m, o.to_m, o.step_m, r.legs, o.frames_per_step,
-                         r.bounding_radius_m));
+  common::Json drawn;
+  drawn["kind"] = "sweep";
+  drawn["seed"] = o.seed;
+  drawn["airframe"] = r.airframe;
+  drawn["view"] = o.view;
+  drawn["lighting"] = o.lighting;
+  drawn["from_m"] = o.from_m;
+  drawn["to_m"] = o.to_m;
+  drawn["step_m"] = o.step_m;
+  drawn["steps"] = r.legs;
+  drawn["frames_per_step"] = o.frames_per_step;
+  drawn["bounding_radius_m"] = r.bounding_radius_m;
+  write_file(r.json_path, common::json_text(drawn) + "\n");
   sim::load_scenario(r.scenario_path);
   common::load_options<LocalizerTarget>(r.localizer_path);
   common::load_options<RenderSection>(r.render_path);

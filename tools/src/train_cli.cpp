@@ -4,6 +4,7 @@
 
 #include "run_verb.hpp"
 
+#include <wingman/common/progress.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/training/halmstad_import.hpp>
 #include <wingman/training/sequence_eval.hpp>
@@ -24,6 +25,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -298,9 +300,14 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       so.detection = vo.detection;  // Algorithm 2's flags as given, and the detector's p_thresh unless given
       if (s.val_p_thresh->count() == 0) so.detection.p_thresh = detector::DetectorPipelineOptions{}.p_thresh;
       const auto t0 = std::chrono::steady_clock::now();
-      const training::SequenceEvalResult r = training::run_sequence_eval(so, {}, [&](const std::string& line) {
-        err << "wingman val: " << line << "\n" << std::flush;
-      });
+      std::optional<common::Progress> clips;  // the number of clips is known once the split is read
+      const training::SequenceEvalResult r = training::run_sequence_eval(
+          so, {}, [&](const std::string& line) { err << "wingman val: " << line << "\n"
+                                                     << std::flush; },
+          [&](size_t done, size_t total) {
+            if (!clips) clips.emplace("wingman val", static_cast<int64_t>(total), "clips", &err);
+            clips->update(static_cast<int64_t>(done));
+          });
       err << fmt::format("wingman val: {} clips in {:.0f} s\n", r.clips.size(),
                          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       const bool json_stdout = s.val_json->count() > 0 && (s.val_json_path.empty() || s.val_json_path == "-");
@@ -316,12 +323,15 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   }
   if (*s.val) {
     return run_verb("wingman val", err, [&] {
+      std::optional<common::Progress> images;  // the number of images is known once the set is read
       const training::DetectionMetrics m = training::run_val(
           s.val_options,
           [&](size_t done, size_t total) {
-            if (done % 100 == 0 || done == total) err << fmt::format("wingman val: {}/{} images\n", done, total);
+            if (!images) images.emplace("wingman val", static_cast<int64_t>(total), "images", &err);
+            images->update(static_cast<int64_t>(done));
           },
           [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
+      if (images) images->finish();
       const bool json_stdout = s.val_json->count() > 0 && (s.val_json_path.empty() || s.val_json_path == "-");
       if (!json_stdout && !s.val_json_path.empty()) {
         std::ofstream f(s.val_json_path);

@@ -219,44 +219,52 @@ CriterionMetrics evaluate(const std::vector<ImageDetections>& images, MatchCrite
   return c;
 }
 
-std::string stats_json(const MatchStats& s) {
-  return fmt::format(
-      "{{\"truths\": {}, \"detections\": {}, \"true_positives\": {}, \"false_positives\": {}, \"precision\": {:.6f}, "
-      "\"recall\": {:.6f}, \"f1\": {:.6f}, \"mean_iou\": {:.6f}, \"ap\": {:.6f}}}",
-      s.truths, s.detections, s.true_positives, s.false_positives, s.precision, s.recall, s.f1, s.mean_iou, s.ap);
+common::Json stats_json(const MatchStats& s) {
+  return {{"truths", s.truths},
+          {"detections", s.detections},
+          {"true_positives", s.true_positives},
+          {"false_positives", s.false_positives},
+          {"precision", s.precision},
+          {"recall", s.recall},
+          {"f1", s.f1},
+          {"mean_iou", s.mean_iou},
+          {"ap", s.ap}};
 }
 
-std::string criterion_json(const CriterionMetrics& c) {
-  std::string bins;
-  for (size_t i = 0; i < c.by_size.size(); ++i) {
-    const SizeBinStats& b = c.by_size[i];
-    bins += fmt::format("{}{{\"name\": \"{}\", \"min_px\": {}, \"max_px\": {}, \"stats\": {}}}", i ? ", " : "", b.name,
-                        b.min_px, std::isinf(b.max_px) ? std::string("null") : fmt::format("{}", b.max_px),
-                        stats_json(b.stats));
+common::Json criterion_json(const CriterionMetrics& c) {
+  using common::Json;
+  Json bins = Json::array();
+  for (const SizeBinStats& b : c.by_size)
+    bins.push_back({{"name", b.name},
+                    {"min_px", b.min_px},
+                    {"max_px", std::isinf(b.max_px) ? Json(nullptr) : Json(b.max_px)},
+                    {"stats", stats_json(b.stats)}});
+  Json curve = Json::array();
+  for (const PrPoint& p : c.pr_curve) curve.push_back({p.recall, p.precision, p.confidence});
+  Json unmatched = Json::array();
+  for (const UnmatchedTruth& u : c.unmatched) {
+    const Json best =
+        u.reason == "missed" ? Json(nullptr) : Json{u.best.cx, u.best.cy, u.best.w, u.best.h, u.best.confidence};
+    unmatched.push_back({{"image", u.image},
+                         {"name", u.image_name},
+                         {"truth", {u.truth.cx, u.truth.cy, u.truth.w, u.truth.h}},
+                         {"size_px", std::sqrt(std::max(0.0, static_cast<double>(u.truth.w) * u.truth.h))},
+                         {"at_edge", u.at_edge},
+                         {"reason", u.reason},
+                         {"best_iou", u.best_iou},
+                         {"best", best}});
   }
-  std::string curve;
-  for (size_t i = 0; i < c.pr_curve.size(); ++i)
-    curve += fmt::format("{}[{:.4f}, {:.6f}, {:.6f}]", i ? ", " : "", c.pr_curve[i].recall, c.pr_curve[i].precision,
-                         c.pr_curve[i].confidence);
-  std::string unmatched;
-  for (size_t i = 0; i < c.unmatched.size(); ++i) {
-    const UnmatchedTruth& u = c.unmatched[i];
-    const std::string best = u.reason == "missed" ? std::string("null")
-                                                  : fmt::format("[{:.2f}, {:.2f}, {:.2f}, {:.2f}, {:.6f}]", u.best.cx,
-                                                                u.best.cy, u.best.w, u.best.h, u.best.confidence);
-    unmatched += fmt::format(
-        "{}{{\"image\": {}, \"name\": {}, \"truth\": [{:.2f}, {:.2f}, {:.2f}, {:.2f}], \"size_px\": {:.2f}, "
-        "\"at_edge\": {}, \"reason\": \"{}\", \"best_iou\": {:.6f}, \"best\": {}}}",
-        i ? ", " : "", u.image, common::json_string(u.image_name), u.truth.cx, u.truth.cy, u.truth.w, u.truth.h,
-        std::sqrt(std::max(0.0, static_cast<double>(u.truth.w) * u.truth.h)), u.at_edge ? "true" : "false", u.reason,
-        u.best_iou, best);
-  }
-  return fmt::format(
-      "{{\"criterion\": \"{}\", \"all\": {}, \"by_size\": [{}], \"pr_curve_columns\": [\"recall\", \"precision\", "
-      "\"confidence\"], \"pr_curve\": [{}], \"edge_truths\": {}, \"edge_found\": {}, \"unmatched_columns\": "
-      "{{\"truth\": [\"cx\", \"cy\", \"w\", \"h\"], \"best\": [\"cx\", \"cy\", \"w\", \"h\", \"confidence\"]}}, "
-      "\"unmatched\": [{}]}}",
-      criterion_name(c.criterion), stats_json(c.all), bins, curve, c.edge_truths, c.edge_found, unmatched);
+  Json j;
+  j["criterion"] = criterion_name(c.criterion);
+  j["all"] = stats_json(c.all);
+  j["by_size"] = bins;
+  j["pr_curve_columns"] = {"recall", "precision", "confidence"};
+  j["pr_curve"] = curve;
+  j["edge_truths"] = c.edge_truths;
+  j["edge_found"] = c.edge_found;
+  j["unmatched_columns"] = {{"truth", {"cx", "cy", "w", "h"}}, {"best", {"cx", "cy", "w", "h", "confidence"}}};
+  j["unmatched"] = unmatched;
+  return j;
 }
 
 std::string report_rows(const CriterionMetrics& c) {
@@ -345,14 +353,18 @@ std::string DetectionMetrics::report(size_t listed) const {
 }
 
 std::string DetectionMetrics::json() const {
-  std::string edges;
-  for (size_t i = 0; i < options.size_edges_px.size(); ++i)
-    edges += fmt::format("{}{}", i ? ", " : "", options.size_edges_px[i]);
-  return fmt::format(
-      "{{\"images\": {}, \"negative_images\": {}, \"truths\": {}, \"predictions\": {}, \"iou_thresh\": {}, "
-      "\"conf_thresh\": {}, \"size_edges_px\": [{}], \"edge_margin_px\": {}, \"iou\": {}, \"centre\": {}}}",
-      images, negative_images, truths, predictions, options.iou_thresh, options.conf_thresh, edges,
-      options.edge_margin_px, criterion_json(iou), criterion_json(centre));
+  common::Json j;
+  j["images"] = images;
+  j["negative_images"] = negative_images;
+  j["truths"] = truths;
+  j["predictions"] = predictions;
+  j["iou_thresh"] = options.iou_thresh;
+  j["conf_thresh"] = options.conf_thresh;
+  j["size_edges_px"] = options.size_edges_px;
+  j["edge_margin_px"] = options.edge_margin_px;
+  j["iou"] = criterion_json(iou);
+  j["centre"] = criterion_json(centre);
+  return common::json_text(j);
 }
 
 }  // namespace wingman::training

@@ -117,9 +117,8 @@ std::vector<SplitClip> read_splits(const std::string& path, const std::string& s
   return clips;
 }
 
-std::string fixed_or_null(double v, int decimals) {
-  return v < 0 || !std::isfinite(v) ? "null" : fmt::format("{:.{}f}", v, decimals);
-}
+/// A time that may be missing (negative: never happened) as JSON: null when missing or not finite.
+common::Json seconds_or_null(double v) { return v < 0 || !std::isfinite(v) ? common::Json(nullptr) : common::Json(v); }
 
 }  // namespace
 
@@ -402,51 +401,69 @@ std::string SequenceEvalResult::report() const {
 }
 
 std::string SequenceEvalResult::json() const {
-  std::string groups_json;
+  using common::Json;
+  Json groups_json = Json::array();
   for (const TrackGroupSummary& g : groups()) {
-    if (!groups_json.empty()) groups_json += ", ";
-    groups_json += fmt::format(
-        "{{\"name\": {}, \"drone\": {}, \"clips\": {}, \"hours\": {:.6f}, \"false_tracks\": {}, "
-        "\"false_tracks_per_hour\": {:.4f}, \"false_tracks_per_hour_upper95\": {:.4f}",
-        common::json_string(g.name), g.drone ? "true" : "false", g.clips, g.hours, g.false_tracks, g.false_per_hour,
-        g.false_per_hour_upper95);
-    if (g.drone)
-      groups_json += fmt::format(
-          ", \"drone_tracks\": {}, \"confirmed\": {}, \"confirmed_share\": {:.4f}, \"confirmed_within\": {}, "
-          "\"confirmed_within_share\": "
-          "{:.4f}, \"median_time_to_confirm_s\": {}",
-          g.drone_tracks, g.confirmed, static_cast<double>(g.confirmed) / g.clips, g.confirmed_within,
-          static_cast<double>(g.confirmed_within) / g.clips, fixed_or_null(g.median_time_to_confirm_s, 4));
-    groups_json += "}";
-  }
-  std::string clips_json;
-  for (const ClipTrackResult& c : clips) {
-    if (!clips_json.empty()) clips_json += ",\n  ";
-    std::string tracks_json;
-    for (const TrackRecord& t : c.tracks) {
-      if (!tracks_json.empty()) tracks_json += ", ";
-      tracks_json += fmt::format(
-          "{{\"id\": {}, \"confirmed_frame\": {}, \"confirmed_s\": {:.4f}, \"last_frame\": {}, \"hits\": {}, "
-          "\"hits_on_target\": {}, \"on_target\": {}}}",
-          t.track_id, t.confirmed_frame, c.fps > 0 ? t.confirmed_frame / c.fps : 0.0, t.last_frame, t.hits,
-          t.hits_on_target, t.on_target ? "true" : "false");
+    Json gj;
+    gj["name"] = g.name;
+    gj["drone"] = g.drone;
+    gj["clips"] = g.clips;
+    gj["hours"] = g.hours;
+    gj["false_tracks"] = g.false_tracks;
+    gj["false_tracks_per_hour"] = g.false_per_hour;
+    gj["false_tracks_per_hour_upper95"] = g.false_per_hour_upper95;
+    if (g.drone) {
+      gj["drone_tracks"] = g.drone_tracks;
+      gj["confirmed"] = g.confirmed;
+      gj["confirmed_share"] = static_cast<double>(g.confirmed) / g.clips;
+      gj["confirmed_within"] = g.confirmed_within;
+      gj["confirmed_within_share"] = static_cast<double>(g.confirmed_within) / g.clips;
+      gj["median_time_to_confirm_s"] = seconds_or_null(g.median_time_to_confirm_s);
     }
-    clips_json += fmt::format(
-        "{{\"clip\": {}, \"class\": {}, \"distance_bin\": {}, \"skipped\": {}, \"fps\": {:.4f}, \"frames\": {}, "
-        "\"frames_tracked\": {}, \"duration_s\": {:.4f}, \"first_label_frame\": {}, \"drone_boxes\": {}, "
-        "\"other_class_boxes\": {}, \"rejected_boxes\": {}, \"false_tracks\": {}, \"drone_tracks\": {}, "
-        "\"drone_confirmed\": {}, "
-        "\"time_to_confirm_s\": {}, \"tracks\": [{}]}}",
-        common::json_string(c.clip), common::json_string(c.cls), common::json_string(c.distance_bin),
-        c.skipped.empty() ? "null" : common::json_string(c.skipped), c.fps, c.frames, c.frames_tracked, c.duration_s,
-        c.first_label_frame, c.drone_boxes, c.other_class_boxes, c.rejected_boxes, c.false_tracks, c.drone_tracks,
-        c.drone_confirmed ? "true" : "false", fixed_or_null(c.time_to_confirm_s, 4), tracks_json);
+    groups_json.push_back(std::move(gj));
   }
-  return fmt::format(
-      "{{\"split\": {}, \"hfov_deg\": {:.4f}, \"focal_px\": {:.4f}, \"frame_step\": {}, \"on_target_fraction\": {}, "
-      "\"confirm_within_s\": {}, \"skipped\": {},\n \"groups\": [{}],\n \"clips\": [\n  {}]}}",
-      common::json_string(split), hfov_deg, focal_px, frame_step, scoring.on_target_fraction, scoring.confirm_within_s,
-      skipped(), groups_json, clips_json);
+  Json clips_json = Json::array();
+  for (const ClipTrackResult& c : clips) {
+    Json tracks = Json::array();
+    for (const TrackRecord& t : c.tracks)
+      tracks.push_back({{"id", t.track_id},
+                        {"confirmed_frame", t.confirmed_frame},
+                        {"confirmed_s", c.fps > 0 ? t.confirmed_frame / c.fps : 0.0},
+                        {"last_frame", t.last_frame},
+                        {"hits", t.hits},
+                        {"hits_on_target", t.hits_on_target},
+                        {"on_target", t.on_target}});
+    Json cj;
+    cj["clip"] = c.clip;
+    cj["class"] = c.cls;
+    cj["distance_bin"] = c.distance_bin;
+    cj["skipped"] = c.skipped.empty() ? Json(nullptr) : Json(c.skipped);
+    cj["fps"] = c.fps;
+    cj["frames"] = c.frames;
+    cj["frames_tracked"] = c.frames_tracked;
+    cj["duration_s"] = c.duration_s;
+    cj["first_label_frame"] = c.first_label_frame;
+    cj["drone_boxes"] = c.drone_boxes;
+    cj["other_class_boxes"] = c.other_class_boxes;
+    cj["rejected_boxes"] = c.rejected_boxes;
+    cj["false_tracks"] = c.false_tracks;
+    cj["drone_tracks"] = c.drone_tracks;
+    cj["drone_confirmed"] = c.drone_confirmed;
+    cj["time_to_confirm_s"] = seconds_or_null(c.time_to_confirm_s);
+    cj["tracks"] = std::move(tracks);
+    clips_json.push_back(std::move(cj));
+  }
+  Json j;
+  j["split"] = split;
+  j["hfov_deg"] = hfov_deg;
+  j["focal_px"] = focal_px;
+  j["frame_step"] = frame_step;
+  j["on_target_fraction"] = scoring.on_target_fraction;
+  j["confirm_within_s"] = scoring.confirm_within_s;
+  j["skipped"] = skipped();
+  j["groups"] = std::move(groups_json);
+  j["clips"] = std::move(clips_json);
+  return common::json_text(j);
 }
 
 // ---------------------------------------------------------------------------------------------------------------------
@@ -538,7 +555,8 @@ std::string detection_settings(const SequenceEvalOptions& o) {
 }
 
 SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDetector& detect_in,
-                                     const std::function<void(const std::string&)>& log) {
+                                     const std::function<void(const std::string&)>& log,
+                                     const std::function<void(size_t, size_t)>& progress) {
   const std::vector<std::string> problems = o.validate();
   if (!problems.empty()) {
     std::string msg = "run_sequence_eval: invalid options:";
@@ -726,6 +744,7 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
       }
     }
     result.clips.push_back(std::move(c));
+    if (progress) progress(result.clips.size(), clips.size());
   }
   return result;
 }

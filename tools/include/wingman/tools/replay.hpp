@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@ struct ReplayOptions {
   double start_timeout_s = 10.0;    ///< lockstep: seconds to wait for every stage's first status
   double step_timeout_s = 5.0;      ///< lockstep: seconds to wait for the pipeline to settle after one message
   int64_t max_events = 0;           ///< play at most this many events; 0 = all
+  /// Progress through the log (common::Progress, every 5 s) goes here; nullptr = quiet.
+  std::ostream* progress = nullptr;
 
   /// "" or one line naming the bad option.
   std::string validate() const;

@@ -231,13 +231,15 @@ std::string detection_settings(const SequenceEvalOptions& o);
 std::map<int, std::vector<cv::Rect2d>> read_halmstad_drone_boxes(const std::string& path);
 
 /// Runs every clip of the split through `detect` (empty: the detector built from the options, as `wingman val`
-/// builds it) and ClipTracker, and scores them. Clips in name order; one line per clip to `log` (may be empty).
+/// builds it) and ClipTracker, and scores them. Clips in name order; one line per clip to `log` (may be empty) and
+/// `progress(clips done, clips in all)` (may be empty) after each clip.
 /// Deterministic for a deterministic detector. Throws std::invalid_argument listing invalid options; DatasetError
 /// naming the file for a missing or malformed splits.csv, a split without clips, a clip named in `clips` that is
 /// not in the split, a missing Halmstad folder, or a missing or malformed label file; std::runtime_error from loading
 /// the model or the localizer config (common::ConfigError). A video that cannot be opened or gives no frame is
 /// skipped and reported (ClipTrackResult::skipped).
 SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& options, const FrameDetector& detect = {},
-                                     const std::function<void(const std::string&)>& log = {});
+                                     const std::function<void(const std::string&)>& log = {},
+                                     const std::function<void(size_t, size_t)>& progress = {});
 
 }  // namespace wingman::training
