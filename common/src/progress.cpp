@@ -71,6 +71,13 @@ std::string Progress::line(int64_t done, std::chrono::steady_clock::time_point n
   return note_.empty() ? s : s + "; " + note_;
 }
 
+void Progress::emit(const std::string& text) const {
+  if (o_.sink)
+    o_.sink(text);
+  else if (o_.out)
+    *o_.out << text << std::endl;
+}
+
 void Progress::update(int64_t done, const std::string& note) {
   done_ = done;
   note_ = note;
@@ -79,7 +86,7 @@ void Progress::update(int64_t done, const std::string& note) {
   if (seconds_between(last_, now) < o_.every_s) return;
   last_ = now;
   printed_ = true;
-  if (o_.out) *o_.out << line(done, now) << std::endl;
+  emit(line(done, now));
 }
 
 void Progress::finish() {
@@ -87,7 +94,7 @@ void Progress::finish() {
   const auto now = o_.clock();
   const bool print = printed_ || seconds_between(start_, now) >= o_.every_s;
   finished_ = true;
-  if (print && o_.out) *o_.out << line(done_, now) << std::endl;
+  if (print) emit(line(done_, now));
 }
 
 }  // namespace wingman::common

@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace wingman::common {
 namespace {
@@ -123,6 +125,26 @@ TEST(Progress, ANoteEndsTheLineAndTheClosingLine) {
             "wingman model box-relation: 20/200 images (10.0 %), 4.00 images/s, ETA 45s; 18 targets found\n"
             "wingman model box-relation: 200/200 images (100.0 %), 10.0 images/s, ETA 0s; 190 targets found\n"
             "wingman model box-relation: 200/200 images (100.0 %), 10.0 images/s, took 20s; 190 targets found\n");
+}
+
+TEST(Progress, ASinkGetsTheLinesInsteadOfTheStream) {
+  // A process logs its progress (e.g. the simulator's frames, through spdlog): the lines go to the sink.
+  FakeClock clock;
+  std::ostringstream out;
+  Progress::Options o = options(clock, out, "frames");
+  o.every_s = 10.0;
+  std::vector<std::string> lines;
+  o.sink = [&](const std::string& l) { lines.push_back(l); };
+  Progress p("wingman-sim", 600, o);
+  clock.now += seconds(10);
+  p.update(195);
+  clock.now += seconds(10);
+  p.update(390);
+  p.finish();
+  EXPECT_EQ(out.str(), "");
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], "wingman-sim: 195/600 frames (32.5 %), 19.5 frames/s, ETA 21s");
+  EXPECT_EQ(lines[2], "wingman-sim: 390/600 frames (65.0 %), 19.5 frames/s, took 20s");
 }
 
 TEST(Progress, RejectsANonPositivePeriodOrScale) {

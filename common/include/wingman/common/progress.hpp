@@ -29,6 +29,9 @@ class Progress {
     double scale = 1.0;              ///< shown = counted * scale (e.g. 1e-6 with unit "MB" for bytes); > 0
     double every_s = 5.0;            ///< seconds between lines, > 0
     std::ostream* out = &std::cerr;  ///< where lines go; nullptr = nowhere (a quiet job)
+    /// When set, each line (no newline) goes here instead of `out`: a process's logger, e.g.
+    /// `[](const std::string& l) { spdlog::info("{}", l); }`.
+    std::function<void(const std::string&)> sink;
     Clock clock = std::chrono::steady_clock::now;  ///< the time source (a fake one in tests)
   };
 
@@ -62,6 +65,8 @@ class Progress {
   std::string note_;
   bool printed_ = false;
   bool finished_ = false;
+
+  void emit(const std::string& line) const;
 };
 
 /// `seconds` as people read a duration: "42s", "4m05s", "2h03m" (rounded to whole seconds; negative as 0s).
