@@ -97,6 +97,7 @@ std::vector<Box> merge_window_boxes(std::vector<Box> first_pass, const std::vect
   if (crop_of_window.size() != windows.size() || crop_boxes.size() < crops.size())
     throw std::invalid_argument("merge_window_boxes: one crop index per window and one box list per crop expected");
   std::vector<Box> found;
+  std::vector<const Window*> found_for;  // the window each found box answers
   int searched = 0, hits = 0;
   for (size_t i = 0; i < windows.size(); ++i) {
     const int c = crop_of_window[i];
@@ -121,12 +122,17 @@ std::vector<Box> merge_window_boxes(std::vector<Box> first_pass, const std::vect
     ++hits;
     best_in_image.zoom_refined = true;
     found.push_back(best_in_image);
+    found_for.push_back(&w);
   }
   // A window's box replaces the single pass's boxes of the same drone.
-  for (const Box& f : found) {
+  for (size_t i = 0; i < found.size(); ++i) {
+    const Box& f = found[i];
+    const Window& w = *found_for[i];
+    const double g = gate_half(w, o);
     first_pass.erase(std::remove_if(first_pass.begin(), first_pass.end(),
                                     [&](const Box& b) {
-                                      return iou(b, f) > pipeline.o_thresh || centre_in(f, b) || centre_in(b, f);
+                                      return iou(b, f) > pipeline.o_thresh || centre_in(f, b) || centre_in(b, f) ||
+                                             (std::abs(b.cx - w.cx) <= g && std::abs(b.cy - w.cy) <= g);
                                     }),
                      first_pass.end());
   }

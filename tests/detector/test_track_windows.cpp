@@ -120,6 +120,14 @@ TEST(MergeWindowBoxes, TheWindowsBoxInItsGateReplacesTheSinglePassBoxOfTheSameDr
   EXPECT_EQ(stats.windows, 2);
   EXPECT_EQ(stats.crops, 2);
   EXPECT_EQ(stats.found, 1);
+  // A far drone's single-pass box: twice the size and offset downwards, touching the window's box (IoU 0), its centre
+  // in the window's gate (12 px): the same drone, replaced.
+  const std::vector<Box> coarse = {box(643, 368, 24, 9, 0.31f)};
+  const std::vector<std::vector<Box>> found_at = {{box(128, 129, 14, 6, 0.5f)}, {}};  // image (640, 361)
+  const auto replaced = merge_window_boxes(coarse, w, crops, crop_of, found_at, p, o);
+  ASSERT_EQ(replaced.size(), 1u);
+  EXPECT_TRUE(replaced[0].zoom_refined);
+  EXPECT_FLOAT_EQ(replaced[0].w, 14.0f);
   // With policy most_confident, one box.
   p.policy = "most_confident";
   EXPECT_EQ(merge_window_boxes(first, w, crops, crop_of, crop_boxes, p, o).size(), 1u);

@@ -98,9 +98,11 @@ struct WindowStats {
 
 /// The single pass's boxes and the windows' boxes together: for each searched window (in order), the most confident
 /// drone box (class 0) of its crop whose centre lies in its gate, in full-image pixels, flagged zoom_refined (a
-/// full-resolution re-detection); it replaces every first-pass box it overlaps (IoU > o_thresh, or either centre in
-/// the other box: the single pass's coarse box of the same drone). Then non-max suppression (o_thresh), most confident
-/// first, at most `max_detections` (with policy most_confident: 1). `crop_boxes[c]` are crop c's boxes in crop pixels.
+/// full-resolution re-detection); it replaces every first-pass box of the same drone: one it overlaps at IoU >
+/// o_thresh, whose centre lies in it or holds its centre, or whose centre lies in the window's gate (the single pass's
+/// box of a far drone is often twice its size and offset, touching the drone's box at IoU near 0: measured in
+/// tools/experiment.sh fly_away at 20-25 m). Then non-max suppression (o_thresh), most confident first, at most
+/// `max_detections` (with policy most_confident: 1). `crop_boxes[c]` are crop c's boxes in crop pixels.
 std::vector<Box> merge_window_boxes(std::vector<Box> first_pass, const std::vector<Window>& windows,
                                     const std::vector<cv::Rect>& crops, const std::vector<int>& crop_of_window,
                                     const std::vector<std::vector<Box>>& crop_boxes,

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: MIT
+// Tracker-driven windows: the detector's time per 1280x720 frame with the shipped model (builtin:wingman-small, its
+// network 640x352 for this size) on the OpenCL backend, the single pass alone and with 1 and 2 windows (256x256
+// full-resolution crops, each through its own 256x256 network), side by side in one run. Run with POCL_AFFINITY=1.
+// The image is random texture (the time does not depend on what it shows). Report the median aggregates; the ratio
+// windows / single pass is the figure (docs/benchmarks.md, "Tracker-driven windows").
+#include <benchmark/benchmark.h>
+
+#include "wingman/detector/detector_options.hpp"
+#include "wingman/detector/model_loader.hpp"
+#include "wingman/detector/sized_detector.hpp"
+#include "wingman/detector/track_windows.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace {
+
+using namespace wingman::detector;
+
+void BM_DetectFrame1280x720(benchmark::State& state) {
+  const int n_windows = static_cast<int>(state.range(0));
+  DetectorOptions o;
+  o.windows.enabled = true;
+  auto make = [&](const DarknetModel& sized) { return make_backend("opencl", sized, o.opencl, 1, nullptr); };
+  const DarknetModel model = load_model(o.cfg, o.weights);
+  SizedDetector pipeline(o.detection, model, *InputSize::parse(o.input_size), make);
+  WindowDetector windows(o.windows, o.detection, model, make);
+  cv::Mat image(720, 1280, CV_8UC3);
+  cv::theRNG().state = 7;
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  // Windows far apart (each its own crop), as two far tracks would be.
+  std::vector<Window> w;
+  for (int i = 0; i < n_windows; ++i) w.push_back(Window{300.0 + 600.0 * i, 360, 12, 8, 3, true, i + 1});
+  std::vector<Box> boxes = pipeline.detect(image);  // warm-up: networks built, buffers allocated
+  if (n_windows > 0) boxes = windows.detect(image, std::move(boxes), w);
+  WindowStats stats;
+  for (auto _ : state) {
+    boxes = pipeline.detect(image);
+    if (n_windows > 0) boxes = windows.detect(image, std::move(boxes), w, &stats);
+    benchmark::DoNotOptimize(boxes.data());
+  }
+  state.counters["crops/frame"] = benchmark::Counter(static_cast<double>(stats.crops) /
+                                                     static_cast<double>(std::max<int64_t>(1, state.iterations())));
+}
+
+BENCHMARK(BM_DetectFrame1280x720)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(7)
+    ->ReportAggregatesOnly(true)
+    ->MinTime(0.5);
+
+}  // namespace
+
+BENCHMARK_MAIN();
