@@ -15,6 +15,9 @@
 #                  follow_1d     the 1-D PID follow (thesis section 5.3)
 #                  formation_2d  the 2-D formation, three runs with different seeds (Table 4)
 #                  max_range     the farthest range at which the detector still finds an F450-sized drone at 1280x720
+#                  fly_away      a leader flying away from 5 to 40 m (seen from behind), the single pass against the
+#                                tracker-driven windows (tools/fly.sh --windows): detection and RMS by range, the
+#                                farthest range the leader is tracked to, ids, false targets
 #                  suite         out of sample: 8 formation flights nothing was tuned on (seeds 1001-1008, used nowhere
 #                                else), drawn by `wingman scenario random`: the four shared airframes (../shared/meshes
 #                                or WINGMAN_SHARED_MESHES; skipped with a message when absent) and procedural quad, hex
@@ -155,6 +158,16 @@ formation_2d() {
   py formation_2d "$out" "${runs[@]}"
 }
 
+fly_away() {
+  local out="$out_root/fly_away" dur=""; $quick && dur="--duration 8"
+  rm -rf "$out"; mkdir -p "$out"
+  # shellcheck disable=SC2086  # $dur is empty or two words
+  fly "$out/single" --scenario fly_away $dur
+  # shellcheck disable=SC2086
+  fly "$out/windows" --scenario fly_away --windows $dur
+  py fly_away "$out" "$out/single" "$out/windows"
+}
+
 max_range() {
   local out="$out_root/max_range" fps=2; $quick && fps=1
   rm -rf "$out"; mkdir -p "$out"
@@ -235,8 +248,8 @@ sweeps() {  # suite-out meshes
 }
 
 case "$name" in
-  static_sweep|calibration|distance|follow_1d|formation_2d|max_range|suite) "$name" ;;
-  all) static_sweep; calibration; distance; follow_1d; formation_2d; max_range ;;
+  static_sweep|calibration|distance|follow_1d|formation_2d|max_range|fly_away|suite) "$name" ;;
+  all) static_sweep; calibration; distance; follow_1d; formation_2d; max_range; fly_away ;;
   *) echo "experiment: unknown experiment '$name' (see --help)" >&2; exit 2 ;;
 esac
 echo "experiment: results in $out_root" >&2

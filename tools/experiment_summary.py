@@ -419,11 +419,40 @@ def sweeps(out, *args):
         sys.exit(1)
 
 
+def fly_away(out, single, windows):
+    """Issue 31's tracker-driven windows: the same leader flying away, single pass against windows."""
+    import csv
+    bins_out, data = [], {}
+    for name, d in (("single pass", single), ("windows", windows)):
+        r = load(os.path.join(d, "eval.json"))
+        with open(os.path.join(d, "targets.csv")) as f:
+            rows = [row for row in csv.DictReader(f) if row["vehicle_id"] == "1"]
+        farthest = max((float(row["range_m"]) for row in rows), default=0.0)
+        loc = {b["lo_m"]: b for b in r["localization_by_range"]}
+        det = {b["lo_m"]: b for b in r["detection_by_range"]}
+        data[name] = {"farthest_tracked_m": farthest, "track_ids_on_leader": r["track_ids_on_leader"],
+                      "false_targets": r["false_targets"], "detection_by_range": r["detection_by_range"],
+                      "localization_by_range": r["localization_by_range"],
+                      "inference_p50_ms": r["inference_latency"]["p50_ms"]}
+        cells = []
+        for lo in (10.0, 15.0, 20.0, 30.0):
+            b, l = det.get(lo), (loc.get(lo) or {}).get("error")
+            d_txt = f"{100 * b['detected'] / b['visible']:.0f} %" if b and b["visible"] else "—"
+            hi = (loc.get(lo) or {}).get("hi_m") or 40.0
+            l_txt = f"{l['rms_m']:.2f} m ({100 * l['rms_m'] / ((lo + hi) / 2):.0f} %)" if l and l["n"] else "—"
+            cells.append(f"{d_txt} / {l_txt}")
+        bins_out.append(f"| {name} | " + " | ".join(cells) + f" | {farthest:.1f} m | {r['track_ids_on_leader']} | "
+                        f"{r['false_targets']} | {r['inference_latency']['p50_ms']:.1f} ms |")
+    lines = ["| detector | 10-15 m: detected / RMS | 15-20 m | 20-30 m | 30+ m | leader tracked to | ids on the leader | "
+             "false targets | inference p50 |", "|---|---|---|---|---|---|---|---|---|"] + bins_out
+    write(out, "fly_away", data, lines)
+
+
 # Each kind: its function and how many arguments after OUT_DIR it takes (static_sweep: the third flight, from behind,
 # optional; calibration: the radius flown, then its flight).
 KINDS = {"static_sweep": (static_sweep, (2, 3)), "calibration": (calibration, (2, 2)), "distance": (distance, (4, 4)),
          "follow_1d": (follow_1d, (1, 1)), "formation_2d": (formation_2d, (3, 3)), "max_range": (max_range, (1, 1)),
-         "suite": (suite, (1, 100)), "sweeps": (sweeps, (1, 100))}
+         "suite": (suite, (1, 100)), "sweeps": (sweeps, (1, 100)), "fly_away": (fly_away, (2, 2))}
 
 if __name__ == "__main__":
     if (len(sys.argv) < 3 or sys.argv[1] not in KINDS or
