@@ -347,8 +347,14 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     s.import.tighten = !s.no_tighten;
     s.import.negatives = !s.no_negatives;
     return run_verb("wingman import-halmstad", err, [&] {
+      std::optional<common::Progress> clips;  // the number of clips is known once clips.csv is read
       const training::HalmstadImportSummary summary = training::import_halmstad(
-          s.import, [&](const std::string& line) { err << "wingman import-halmstad: " << line << "\n"; });
+          s.import, [&](const std::string& line) { err << "wingman import-halmstad: " << line << "\n"; },
+          [&](size_t done, size_t total) {
+            if (!clips) clips.emplace("wingman import-halmstad", static_cast<int64_t>(total), "clips", &err);
+            clips->update(static_cast<int64_t>(done));
+          });
+      if (clips) clips->finish();
       out << summary.report() << "wrote " << s.import.out_dir << "/data.yaml\n" << std::flush;
       return 0;
     });

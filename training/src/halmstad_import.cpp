@@ -100,7 +100,8 @@ std::vector<Clip> read_clips(const std::string& path) {
 }  // namespace
 
 HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
-                                      const std::function<void(const std::string&)>& log) {
+                                      const std::function<void(const std::string&)>& log,
+                                      const std::function<void(size_t, size_t)>& progress) {
   const std::vector<std::string> problems = o.validate();
   if (!problems.empty()) {
     std::string msg = "import_halmstad: invalid options:";
@@ -210,6 +211,7 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
     if (log)
       log(fmt::format("{} ({} {}): {} -> {} images, {} boxes, {} tightened", clip.name, clip.cls, clip.distance, split,
                       written, clip_boxes + clip_distractors, clip_tight));
+    if (progress) progress(ci + 1, clips.size());
   }
   summary.mean_area_ratio = summary.tightened > 0 ? ratio_sum / static_cast<double>(summary.tightened) : 0.0;
   splits.close();

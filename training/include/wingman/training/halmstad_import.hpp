@@ -55,11 +55,13 @@ struct HalmstadImportSummary {
 /// splits.csv (clip, class, distance bin, split). The split does not depend on distractor_classes.
 /// Box CSV values are MATLAB's (pixel centres at integers), so 0.5 px is subtracted from x and y.
 /// The split is by clip, never by frame: within each (class, distance bin) group the clips are shuffled
-/// with `seed` and round(val_fraction * n) of them go to val. `log` (may be empty) gets one line per clip.
+/// with `seed` and round(val_fraction * n) of them go to val. `log` (may be empty) gets one line per clip,
+/// `progress(clips done, clips in all)` (may be empty) a call after each.
 /// Throws std::invalid_argument for invalid options; DatasetError naming the file and line for a missing or
 /// malformed clips.csv or label CSV (also a box whose class is not one of DRONE, AIRPLANE, BIRD, HELICOPTER), a clip
 /// named in `clips` that is not listed, or a video that cannot be read.
 HalmstadImportSummary import_halmstad(const HalmstadImportOptions& options,
-                                      const std::function<void(const std::string&)>& log = {});
+                                      const std::function<void(const std::string&)>& log = {},
+                                      const std::function<void(size_t, size_t)>& progress = {});
 
 }  // namespace wingman::training
