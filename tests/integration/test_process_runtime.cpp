@@ -8,6 +8,7 @@
 #include <wingman/detections_t.hpp>
 #include <wingman/image_t.hpp>
 #include <wingman/status_t.hpp>
+#include <wingman/track_windows_t.hpp>
 
 #include <poll.h>
 #include <sys/socket.h>
@@ -347,6 +348,62 @@ TEST(ProcessFileIo, DetectorDropsAnImageDatedAheadOrOutOfOrderBeforeDetectingIt)
     seqs.push_back(d.seq);
   }
   EXPECT_EQ(seqs, (std::vector<int64_t>{0, 1, 2, 3, 4, 5, 8, 9}));
+}
+
+/// A track_windows_t of camera `camera` for 8x4 images, predicted for frame `seq`: one tiny window (far: below
+/// windows.max_net_px in the single pass's network pixels) at the image centre.
+wingman::track_windows_t far_window(int64_t seq, int32_t camera) {
+  wingman::track_windows_t m{};
+  m.utime = gray_image(seq - 1).utime;
+  m.utime_predicted = gray_image(seq).utime;
+  m.camera_id = camera;
+  m.image_width = 8;
+  m.image_height = 4;
+  wingman::track_window_t w{};
+  w.track_id = 1;
+  w.confirmed = true;
+  w.cx = 4;
+  w.cy = 2;
+  w.w = 0.1f;
+  w.h = 0.1f;
+  w.sigma_px = 1;
+  w.range_m = 30;
+  w.confidence = 0.5f;
+  m.windows = {w};
+  m.num_windows = 1;
+  return m;
+}
+
+TEST(ProcessFileIo, DetectorSearchesTheWindowsOfItsCameraAndCountsAnotherCamerasAsADrop) {
+  // Issue 31: with windows.enabled the detector reads the localizer's track_windows_t: frames 1 and 2 are searched in
+  // the window predicted for frame 1 (frame 2 is 33 ms later, inside windows.max_age_s), frame 0 has none yet; a
+  // windows message of camera 3 is dropped and counted naming the field, and the process goes on.
+  TempDir dir;
+  std::vector<wingman::testing::LogEvent> events;
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(0), 1000));
+  events.push_back(wingman::testing::make_event("WINDOWS_CAM0", far_window(1, 0), 1001));
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(1), 1002));
+  events.push_back(wingman::testing::make_event("WINDOWS_CAM0", far_window(2, 3), 1003));
+  events.push_back(wingman::testing::make_event("IMAGE_CAM0", gray_image(2), 1004));
+  wingman::testing::write_log(dir.file("in.lcmlog"), events);
+  const auto r =
+      run({bin_path("wingman-detector"), "--lcm-in", "file://" + dir.file("in.lcmlog") + "?speed=0", "--lcm-out",
+           "file://" + dir.file("out.lcmlog") + "?mode=w", "--set", "windows.enabled=true", "--log-level", "info"},
+          kDetectorRunLimit);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("windows: 2 searched in 2 crops"), std::string::npos) << r.err;
+  const auto out = wingman::testing::read_log(dir.file("out.lcmlog"));
+  ASSERT_FALSE(out.empty());
+  wingman::status_t last;
+  ASSERT_EQ(out.back().channel, "STATUS_DETECTOR");
+  ASSERT_GE(last.decode(out.back().data.data(), 0, static_cast<int>(out.back().data.size())), 0);
+  EXPECT_EQ(last.messages_handled, 5);
+  EXPECT_EQ(last.drops_total, 1);
+  EXPECT_NE(last.last_error.find("track_windows_t.camera_id = 3: the frames are camera 0"), std::string::npos)
+      << last.last_error;
+  int detections = 0;
+  for (const auto& e : out) detections += e.channel == "DETECTIONS_CAM0";
+  EXPECT_EQ(detections, 3);
 }
 
 TEST(ProcessFileIo, FileInputIsProcessedToItsEndWithExitZeroAndBadMessagesAreCountedNotFatal) {
