@@ -3,6 +3,7 @@
 #include "wingman/tools/log_info.hpp"
 
 #include "lcm_fingerprint.hpp"
+#include "log_progress.hpp"
 
 #include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
@@ -40,7 +41,8 @@ std::pair<uint64_t, std::pair<std::string, Decoder>> entry() {
 
 }  // namespace
 
-LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png, bool skip_corrupt) {
+LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png, bool skip_corrupt,
+                         std::ostream* progress) {
   common::LcmLogReadOptions read_options;
   read_options.skip_corrupt = skip_corrupt;
   common::LcmLogReader log(log_path, read_options);  // a corrupt event throws, naming its byte offset
@@ -51,7 +53,9 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
   LogSummary summary;
   std::map<std::string, size_t> index;
   std::vector<uint8_t> last_image;
+  common::Progress read = log_progress(progress, "wingman loginfo: reading " + log_path, log_path);
   while (const common::LcmLogEvent* ev = log.read_next()) {
+    read.update(ev->offset);
     auto [it, fresh] = index.emplace(ev->channel, summary.channels.size());
     if (fresh)
       summary.channels.push_back(ChannelSummary{ev->channel, ev->channel == "LCM_SELF_TEST" ? "(LCM internal)" : "?"});
@@ -80,6 +84,8 @@ LogSummary summarize_log(const std::string& log_path, const std::string& snapsho
       last_image.assign(p, p + ev->datalen);
     }
   }
+  read.update(read.total());
+  read.finish();
   if (!last_image.empty()) {
     wingman::image_t img;
     img.decode(last_image.data(), 0, static_cast<int>(last_image.size()));

@@ -291,7 +291,7 @@ int main(int argc, char** argv) {
       std::cerr << "wrote " << video.frames << " frames to " << video.output << std::endl;
     }
     if (*li) {
-      const LogSummary summary = summarize_log(info_log, info_snapshot, info_skip_corrupt);
+      const LogSummary summary = summarize_log(info_log, info_snapshot, info_skip_corrupt, &std::cerr);
       std::cout << summary.report() << std::flush;
       if (!info_snapshot.empty() && summary.images_with_pixels > 0)
         std::cout << "last image saved to " << info_snapshot << std::endl;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,8 @@ struct LogSummary {
 /// Reads `log_path` (throws std::runtime_error naming it when unreadable). When `snapshot_png` is
 /// not empty, the last image_t is saved there as PNG (MJPEG and YUYV are decoded). A corrupt event throws
 /// common::LcmLogError naming its byte offset, or with `skip_corrupt` is skipped and counted in the summary.
-LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png = "", bool skip_corrupt = false);
+/// Progress through the log (common::Progress, every 5 s) goes to `progress` (nullptr: quiet).
+LogSummary summarize_log(const std::string& log_path, const std::string& snapshot_png = "", bool skip_corrupt = false,
+                         std::ostream* progress = nullptr);
 
 }  // namespace wingman::tools
