@@ -44,20 +44,29 @@ r = json.load(open(sys.argv[1]))
 problems = []
 def check(ok, what):
     if not ok: problems.append(what)
-# Bounds (docs/results.md, "Tracker-driven windows"): fly_away_far, seed 6, lockstep, the shipped CNN.
+# Bounds (docs/results.md, "Tracker-driven windows"): fly_away_far, seed 6, lockstep, the shipped CNN. Measured
+# (2026-12-05): the leader detected in 210 of 210 frames at 20-30 m and 59 of 59 beyond 30 m (the single pass: 44 %
+# and 0 % on fly_away), one track id in the whole flight, targets within 3 m of the leader to 22.9 m (beyond, the
+# range from 10-pixel boxes is too short: docs/results.md).
 bins = {b["lo_m"]: b for b in r["detection_by_range"]}
-far = bins[20.0]
-rate = far["detected"] / max(far["visible"], 1)
-check(far["visible"] >= 150, f"{far['visible']} frames with the leader at 20-30 m, expected >= 150")
-check(rate >= WINDOWS_MIN_RATE_20_30, f"leader detected in {rate:.2f} of its frames at 20-30 m")
-check(r["track_ids_on_leader"] <= WINDOWS_MAX_IDS, f"{r['track_ids_on_leader']} track ids on the leader")
-# The farthest true range at which a target matched to the leader was published.
-rows = [row for row in csv.DictReader(open(sys.argv[2])) if row["vehicle_id"] == "1"]
-farthest = max((float(row["range_m"]) for row in rows), default=0.0)
-check(farthest >= WINDOWS_MIN_TRACKED_M, f"the leader tracked to {farthest:.1f} m only")
+def detected(lo):
+    b = bins[lo]
+    return b["detected"] / max(b["visible"], 1), b["visible"]
+rate, visible = detected(20.0)
+check(visible >= 150, f"{visible} frames with the leader at 20-30 m, expected >= 150")
+check(rate >= 0.9, f"leader detected in {rate:.2f} of its frames at 20-30 m, expected >= 0.9")
+rate30, visible30 = detected(30.0)
+check(visible30 >= 40, f"{visible30} frames with the leader beyond 30 m, expected >= 40")
+check(rate30 >= 0.8, f"leader detected in {rate30:.2f} of its frames beyond 30 m, expected >= 0.8")
+check(r["track_ids_on_leader"] == 1, f"{r['track_ids_on_leader']} track ids on the leader, expected 1")
+rows = list(csv.DictReader(open(sys.argv[2])))
+ids = sorted({row["track_id"] for row in rows})
+check(len(ids) == 1, f"track ids {ids} published: the leader is the only drone in view, expected one")
+farthest = max((float(row["range_m"]) for row in rows if row["vehicle_id"] == "1"), default=0.0)
+check(farthest >= 20.0, f"targets within 3 m of the leader only to {farthest:.1f} m, expected >= 20 m")
 print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
-print(f"sim_flight_test: measured detection at 20-30 m {rate:.3f}, leader tracked to {farthest:.1f} m, "
-      f"{r['track_ids_on_leader']} id(s), {r['false_targets']} false targets")
+print(f"sim_flight_test: measured detection at 20-30 m {rate:.3f}, beyond 30 m {rate30:.3f}, within 3 m to "
+      f"{farthest:.1f} m, track ids {ids}, {r['false_targets']} targets off the leader by > 3 m")
 sys.exit(1 if problems else 0)
 PY
   exit
