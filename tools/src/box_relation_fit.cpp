@@ -8,7 +8,9 @@
 #include <wingman/detector/detector_options.hpp>
 #include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
+#include <wingman/detector/preprocess.hpp>
 #include <wingman/detector/sized_detector.hpp>
+#include <wingman/detector/track_windows.hpp>
 #include <wingman/localizer/camera_model.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
 
@@ -21,6 +23,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 
 namespace wingman::tools {
@@ -195,6 +198,32 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   };
   detector::SizedDetector pipeline(dopt.detection, detector::load_model(dopt.cfg, dopt.weights),
                                    *detector::InputSize::parse(dopt.input_size), make_backend);
+  // With windows.enabled: each target is also searched as the tracker-driven windows search a tracked drone (a window
+  // on its outline box, 2 px of doubt), so that the relation covers the full-resolution boxes they give.
+  std::unique_ptr<detector::WindowDetector> windows;
+  if (dopt.windows.enabled)
+    windows = std::make_unique<detector::WindowDetector>(dopt.windows, dopt.detection,
+                                                         detector::load_model(dopt.cfg, dopt.weights), make_backend);
+  auto detect = [&](const cv::Mat& bgr, const localizer::PixelBox& outline) {
+    std::vector<detector::Box> boxes = pipeline.detect(bgr);
+    if (!windows) return boxes;
+    wingman::track_windows_t m{};
+    m.camera_id = 0;
+    m.image_width = bgr.cols;
+    m.image_height = bgr.rows;
+    wingman::track_window_t w{};
+    w.cx = static_cast<float>(outline.cx), w.cy = static_cast<float>(outline.cy);
+    w.w = static_cast<float>(outline.w), w.h = static_cast<float>(outline.h);
+    w.sigma_px = 2.0f;
+    w.confirmed = true;
+    m.windows = {w};
+    m.num_windows = 1;
+    const cv::Size size(bgr.cols, bgr.rows);
+    const double net_px_per_image_px = static_cast<double>(pipeline.net_size_for(size).width) /
+                                       detector::detection_region(size, dopt.detection.subsquare).width;
+    const auto search = detector::windows_to_search(m, 0, size, 0, net_px_per_image_px, dopt.windows);
+    return search.empty() ? boxes : windows->detect(bgr, std::move(boxes), search);
+  };
 
   BoxRelationSummary summary;
   std::vector<Sample> samples;
@@ -239,7 +268,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       detector::Box truth;
       truth.cx = static_cast<float>(outline.cx), truth.cy = static_cast<float>(outline.cy);
       truth.w = static_cast<float>(outline.w), truth.h = static_cast<float>(outline.h);
-      for (const detector::Box& b : pipeline.detect(bgr)) {
+      for (const detector::Box& b : detect(bgr, outline)) {
         if (b.class_id != 0) continue;
         if (const double o = detector::iou(b, truth); o > best) best = o, det = {b.cx, b.cy, b.w, b.h};
       }
