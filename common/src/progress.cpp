@@ -57,8 +57,8 @@ std::string Progress::line(int64_t done, std::chrono::steady_clock::time_point n
   const double rate = elapsed > 0 ? static_cast<double>(done) * o_.scale / elapsed : 0.0;
   std::string s = label_ + ": " + count_text(done, o_.scale);
   if (total_ > 0)
-    s += fmt::format("/{}{} ({:.1f} %)", count_text(total_, o_.scale), unit,
-                     100.0 * static_cast<double>(done) / static_cast<double>(total_));
+    s += fmt::format("/{}{} ({:.1f} %)", count_text(total_, o_.scale), unit,  // rounded down: 100.0 % is done
+                     std::floor(1000.0 * static_cast<double>(done) / static_cast<double>(total_)) / 10.0);
   else
     s += unit;
   s += fmt::format(", {}{}/s", rate_text(rate), o_.unit.empty() ? "" : unit);
@@ -81,7 +81,7 @@ void Progress::emit(const std::string& text) const {
 void Progress::update(int64_t done, const std::string& note) {
   done_ = done;
   note_ = note;
-  if (finished_) return;
+  if (finished_ || (total_ > 0 && done >= total_)) return;  // all done: finish() has the closing line
   const auto now = o_.clock();
   if (seconds_between(last_, now) < o_.every_s) return;
   last_ = now;

@@ -65,11 +65,13 @@ TEST(Progress, FinishPrintsTheClosingLineOnlyAfterALongJob) {
 
   std::ostringstream out;
   Progress long_job("wingman val", 4000, options(clock, out));
-  clock.now += seconds(3723);  // 1 h 2 min 3 s, no update() in between: the closing line alone
-  long_job.update(4000);
-  EXPECT_EQ(out.str(), "wingman val: 4000/4000 images (100.0 %), 1.07 images/s, ETA 0s\n");
+  clock.now += seconds(3723);  // 1 h 2 min 3 s, no update() in between
+  long_job.update(3999);       // the percentage rounds down: 100.0 % means done
+  EXPECT_EQ(out.str(), "wingman val: 3999/4000 images (99.9 %), 1.07 images/s, ETA 1s\n");
   out.str("");
   clock.now += seconds(77);  // 3800 s in all
+  long_job.update(4000);     // all done: no line, finish() closes
+  EXPECT_EQ(out.str(), "");
   long_job.finish();
   EXPECT_EQ(out.str(), "wingman val: 4000/4000 images (100.0 %), 1.05 images/s, took 1h03m\n");
   long_job.finish();  // once only
@@ -123,7 +125,6 @@ TEST(Progress, ANoteEndsTheLineAndTheClosingLine) {
   p.finish();
   EXPECT_EQ(out.str(),
             "wingman model box-relation: 20/200 images (10.0 %), 4.00 images/s, ETA 45s; 18 targets found\n"
-            "wingman model box-relation: 200/200 images (100.0 %), 10.0 images/s, ETA 0s; 190 targets found\n"
             "wingman model box-relation: 200/200 images (100.0 %), 10.0 images/s, took 20s; 190 targets found\n");
 }
 

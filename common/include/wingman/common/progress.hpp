@@ -42,7 +42,8 @@ class Progress {
   Progress(std::string label, int64_t total, std::string unit, std::ostream* out);
 
   /// `done` steps are finished (counted from 0 at construction; non-decreasing). Prints a line when every_s has
-  /// passed since construction or since the last line. `note` (e.g. "12 targets found"), when not empty, ends the
+  /// passed since construction or since the last line, and `done` is short of the total (the closing line is
+  /// finish()'s). `note` (e.g. "12 targets found"), when not empty, ends the
   /// line after a semicolon and is kept for finish().
   void update(int64_t done, const std::string& note = "");
   /// One more step finished: update(done() + 1) with the last note.
