@@ -9,6 +9,7 @@
 #include "wingman/sim/simulator.hpp"
 #include "wingman/sim/truth_detections.hpp"
 
+#include <wingman/common/progress.hpp>
 #include <wingman/common/runtime.hpp>
 #include <wingman/localizer/calibration.hpp>
 #include <wingman/mavlink/parser.hpp>
@@ -296,9 +297,12 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   int64_t own_pose_timeouts = 0;
   int64_t barrier_timeouts = 0;
   const auto wall_start = Clock::now();
-  // Progress: one line every kProgressPeriod of wall clock (logging only: what is published never depends on it).
-  constexpr auto kProgressPeriod = std::chrono::seconds(10);
-  auto last_progress = wall_start;
+  // Progress: one log line every 10 s of wall clock (logging only: what is published never depends on it).
+  common::Progress::Options progress_options;
+  progress_options.unit = "frames";
+  progress_options.every_s = 10.0;
+  progress_options.sink = [](const std::string& line) { spdlog::info("{}", line); };
+  common::Progress progress("flight", static_cast<int64_t>(simulator.frame_count()), progress_options);
   std::string stop_reason = "end of scenario";
   while (!simulator.done()) {
     if (rt.stop_requested()) {
@@ -352,14 +356,7 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     }
     status.set_last_processed_seq(frame.index);
     status.record_latency_ms(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-    if (Clock::now() - last_progress >= kProgressPeriod) {  // a flight takes minutes: say how far it is
-      last_progress = Clock::now();
-      const double elapsed_s = std::chrono::duration<double>(last_progress - wall_start).count();
-      const double done = static_cast<double>(frame.index + 1), total = static_cast<double>(simulator.frame_count());
-      const double rate = done / std::max(elapsed_s, 1e-9);
-      spdlog::info("frame {} of {} ({:.0f} %), {:.1f} frames/s, about {:.0f} s left", frame.index + 1,
-                   simulator.frame_count(), 100.0 * done / total, rate, (total - done) / std::max(rate, 1e-9));
-    }
+    progress.update(frame.index + 1);  // a flight takes minutes: say how far it is
 
     if (lockstep && !input_ended) {  // wait for this frame's setpoint (utime >= t_k)
       const auto deadline =
