@@ -73,6 +73,20 @@ std::unique_ptr<wingman::testing::Child> start_detector(lcm::LCM& lcm, Bus& bus,
   return detector;
 }
 
+/// Frame `i` of a 30 Hz stream of 64x48 BGR8 images of one grey level each.
+wingman::image_t frame(int i) {
+  wingman::image_t img{};
+  img.utime = 1700000000000000 + i * 33333;
+  img.seq = i;
+  img.width = 64;
+  img.height = 48;
+  img.stride = 64 * 3;
+  img.pixel_format = wingman::image_t::BGR8;
+  img.data.assign(static_cast<size_t>(img.stride) * img.height, static_cast<uint8_t>(10 * i));
+  img.size = static_cast<int32_t>(img.data.size());
+  return img;
+}
+
 TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
   wingman::testing::TempDir dir;
   const std::string cfg = write_realtime_config(dir, "");
@@ -87,15 +101,7 @@ TEST(DetectorRealtime, KeepsTheNewestFrameWhenBusyAndCountsTheSupersededOnes) {
   // 20 frames at once: far faster than ~100 ms per frame on the CPU backend.
   constexpr int kFrames = 20;
   for (int i = 0; i < kFrames; ++i) {
-    wingman::image_t img{};
-    img.utime = 1700000000000000 + i * 33333;
-    img.seq = i;
-    img.width = 64;
-    img.height = 48;
-    img.stride = 64 * 3;
-    img.pixel_format = wingman::image_t::BGR8;
-    img.data.assign(static_cast<size_t>(img.stride) * img.height, static_cast<uint8_t>(10 * i));
-    img.size = static_cast<int32_t>(img.data.size());
+    const wingman::image_t img = frame(i);
     lcm.publish("IMAGE_CAM0", &img);
   }
   // Every frame is accounted for: detected or superseded.
@@ -192,15 +198,7 @@ TEST(DetectorRealtime, SearchesTheNewestWindowsWhileFramesArrive) {
   ASSERT_TRUE(detector);
   constexpr int kFrames = 10;
   for (int i = 0; i < kFrames; ++i) {
-    wingman::image_t img{};
-    img.utime = 1700000000000000 + i * 33333;
-    img.seq = i;
-    img.width = 64;
-    img.height = 48;
-    img.stride = 64 * 3;
-    img.pixel_format = wingman::image_t::BGR8;
-    img.data.assign(static_cast<size_t>(img.stride) * img.height, static_cast<uint8_t>(10 * i));
-    img.size = static_cast<int32_t>(img.data.size());
+    const wingman::image_t img = frame(i);
     wingman::track_windows_t w{};
     w.utime = img.utime - 33333;
     w.utime_predicted = img.utime;
