@@ -119,6 +119,53 @@ void DetectionPipeline::run_and_decode(int count) {
   }
 }
 
+std::vector<std::vector<Box>> DetectionPipeline::detect_regions(const cv::Mat& bgr_image,
+                                                                const std::vector<cv::Rect>& regions) {
+  if (bgr_image.empty() || bgr_image.type() != CV_8UC3)
+    throw std::invalid_argument(
+        fmt::format("DetectionPipeline::detect_regions: image {}x{} type {}: must be non-empty CV_8UC3", bgr_image.cols,
+                    bgr_image.rows, bgr_image.type()));
+  const cv::Rect whole(0, 0, bgr_image.cols, bgr_image.rows);
+  for (const cv::Rect& r : regions)
+    if (r.empty() || (r & whole) != r)
+      throw std::invalid_argument(
+          fmt::format("DetectionPipeline::detect_regions: region {}x{} at ({}, {}) is empty or "
+                      "leaves the {}x{} image",
+                      r.width, r.height, r.x, r.y, bgr_image.cols, bgr_image.rows));
+  const int batch = std::max(1, std::min(backend_->max_batch(), static_cast<int>(regions.size())));
+  if (batch > batch_capacity_) {  // grow once to the batch this caller uses
+    const Shape in = backend_->input_shape();
+    batch_capacity_ = batch;
+    input_.resize(static_cast<size_t>(batch_capacity_) * in.size());
+    output_.resize(static_cast<size_t>(batch_capacity_) * output_size(backend_->output_shapes()));
+    const size_t per_image = candidates_.empty() ? 0 : candidates_[0].capacity();
+    candidates_.resize(static_cast<size_t>(batch_capacity_));
+    for (auto& c : candidates_) c.reserve(per_image);
+  }
+  const size_t input_size = static_cast<size_t>(backend_->input_shape().size());
+  const size_t keep = options_.policy == "most_confident" ? 1 : static_cast<size_t>(options_.max_detections);
+  std::vector<std::vector<Box>> out(regions.size());
+  for (size_t first = 0; first < regions.size(); first += static_cast<size_t>(batch)) {
+    const int count = static_cast<int>(std::min(regions.size() - first, static_cast<size_t>(batch)));
+    for (int i = 0; i < count; ++i)
+      to_network_input(bgr_image, regions[first + i], net_size_, resized_, input_.data() + i * input_size);
+    run_and_decode(count);
+    for (int i = 0; i < count; ++i) {
+      std::vector<Box>& found = candidates_[static_cast<size_t>(i)];
+      // Boxes of at least p_thresh (run_and_decode() keeps down to the pass floor, the same for a single pass).
+      found.erase(std::remove_if(found.begin(), found.end(),
+                                 [&](const Box& b) { return b.confidence < static_cast<float>(options_.p_thresh); }),
+                  found.end());
+      non_max_suppression(found, static_cast<float>(options_.o_thresh));
+      if (found.size() > keep) found.resize(keep);
+      const cv::Rect& r = regions[first + static_cast<size_t>(i)];
+      const cv::Rect own(0, 0, r.width, r.height);
+      for (const Box& b : found) out[first + static_cast<size_t>(i)].push_back(network_to_image(b, own, net_size_));
+    }
+  }
+  return out;
+}
+
 std::vector<Box> DetectionPipeline::detect(const cv::Mat& bgr_image) {
   if (bgr_image.empty() || bgr_image.type() != CV_8UC3)
     throw std::invalid_argument(fmt::format("DetectionPipeline::detect: image {}x{} type {}: must be non-empty CV_8UC3",

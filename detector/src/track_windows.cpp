@@ -173,9 +173,9 @@ WindowDetector::WindowDetector(WindowOptions options, const DetectorPipelineOpti
 std::vector<Box> WindowDetector::detect(const cv::Mat& bgr_image, std::vector<Box> first_pass,
                                         const std::vector<Window>& windows, WindowStats* stats) {
   const std::vector<cv::Rect> crops = place_window_crops(windows, bgr_image.size(), options_, crop_of_window_);
-  if (crop_boxes_.size() < crops.size()) crop_boxes_.resize(crops.size());
-  for (size_t c = 0; c < crops.size(); ++c) crop_boxes_[c] = pipeline_->detect(bgr_image(crops[c]));
-  return merge_window_boxes(std::move(first_pass), windows, crops, crop_of_window_, crop_boxes_, pipeline_options_,
+  // Every crop of the frame in one forward (up to the backend's max_batch).
+  const std::vector<std::vector<Box>> crop_boxes = pipeline_->detect_regions(bgr_image, crops);
+  return merge_window_boxes(std::move(first_pass), windows, crops, crop_of_window_, crop_boxes, pipeline_options_,
                             options_, stats);
 }
 

@@ -24,7 +24,10 @@ void BM_DetectFrame1280x720(benchmark::State& state) {
   const int n_windows = static_cast<int>(state.range(0));
   DetectorOptions o;
   o.windows.enabled = true;
-  auto make = [&](const DarknetModel& sized) { return make_backend("opencl", sized, o.opencl, 1, nullptr); };
+  // As the process builds them: batches of up to opencl.max_batch (the windows' crops go in one forward).
+  auto make = [&](const DarknetModel& sized) {
+    return make_backend("opencl", sized, o.opencl, o.opencl.max_batch, nullptr);
+  };
   const DarknetModel model = load_model(o.cfg, o.weights);
   SizedDetector pipeline(o.detection, model, *InputSize::parse(o.input_size), make);
   WindowDetector windows(o.windows, o.detection, model, make);

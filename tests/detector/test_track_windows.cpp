@@ -3,6 +3,11 @@
 // single pass's.
 #include "wingman/detector/track_windows.hpp"
 
+#include "wingman/detector/cpu_backend.hpp"
+#include "wingman/detector/darknet_cfg.hpp"
+#include "wingman/detector/darknet_weights.hpp"
+#include "wingman/detector/model_loader.hpp"
+
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -137,6 +142,41 @@ TEST(MergeWindowBoxes, TheWindowsBoxInItsGateReplacesTheSinglePassBoxOfTheSameDr
   EXPECT_FALSE(none[0].zoom_refined || none[1].zoom_refined);
   EXPECT_THROW(merge_window_boxes(first, w, crops, {0}, crop_boxes, DetectorPipelineOptions{}, o),
                std::invalid_argument);
+}
+
+// The batched path against the plain one: detect_regions() on three crops in batches of two (a real CPU backend, the
+// thesis network at 128x128 with random weights, a low threshold so that there are boxes) gives each crop's
+// detect(), in the crop's pixels.
+TEST(DetectRegions, BatchedCropsGiveEachCropsOwnDetection) {
+  DarknetModel model = parse_darknet_cfg_string(builtin_thesis_cfg(), "thesis");
+  model.net.width = model.net.height = 128;
+  compute_shapes(model);
+  randomize_weights(model, 11);
+  DetectorPipelineOptions o;
+  o.p_thresh = 0.05;
+  DetectionPipeline batched(o, std::make_unique<CpuBackend>(model, 2), model);
+  DetectionPipeline plain(o, std::make_unique<CpuBackend>(model, 1), model);
+  cv::Mat image(300, 400, CV_8UC3);
+  cv::theRNG().state = 5;
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  const std::vector<cv::Rect> crops = {cv::Rect(0, 0, 128, 128), cv::Rect(250, 100, 128, 128),
+                                       cv::Rect(100, 150, 150, 150)};
+  const auto out = batched.detect_regions(image, crops);
+  ASSERT_EQ(out.size(), crops.size());
+  size_t boxes = 0;
+  for (size_t c = 0; c < crops.size(); ++c) {
+    const std::vector<Box> expected = plain.detect(image(crops[c]).clone());
+    ASSERT_EQ(out[c].size(), expected.size()) << "crop " << c;
+    for (size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_NEAR(out[c][k].cx, expected[k].cx, 1e-3) << c << "/" << k;
+      EXPECT_NEAR(out[c][k].cy, expected[k].cy, 1e-3) << c << "/" << k;
+      EXPECT_NEAR(out[c][k].w, expected[k].w, 1e-3) << c << "/" << k;
+      EXPECT_NEAR(out[c][k].confidence, expected[k].confidence, 1e-5) << c << "/" << k;
+    }
+    boxes += expected.size();
+  }
+  EXPECT_GT(boxes, 0u) << "no box in any crop: the comparison proves nothing";
+  EXPECT_THROW(batched.detect_regions(image, {cv::Rect(350, 0, 128, 128)}), std::invalid_argument);  // leaves it
 }
 
 TEST(WindowOptions, EveryBadKeyIsNamed) {

@@ -121,6 +121,13 @@ class DetectionPipeline {
   /// Returns boxes in full-image pixels, most confident first.
   std::vector<Box> detect(const cv::Mat& bgr_image);
 
+  /// Steps 2-3 on each of `regions` of `bgr_image` (each stretched to the network input; no subsquare, zoom-in, mirror
+  /// or coarse pass), run in batches of up to backend().max_batch() images: per region, its boxes >= p_thresh after
+  /// NMS and `policy`/`max_detections`, in that region's own pixels (origin at its top-left corner), most confident
+  /// first. For tracker-driven windows (WindowDetector). Every region must lie inside the image and be non-empty
+  /// (std::invalid_argument otherwise). The batch buffers grow to the largest batch used, once.
+  std::vector<std::vector<Box>> detect_regions(const cv::Mat& bgr_image, const std::vector<cv::Rect>& regions);
+
   const DetectorPipelineOptions& options() const { return options_; }
   InferenceBackend& backend() { return *backend_; }
   /// coarse_pass: the nested coarse pipeline; null otherwise.

@@ -109,8 +109,9 @@ std::vector<Box> merge_window_boxes(std::vector<Box> first_pass, const std::vect
                                     const DetectorPipelineOptions& pipeline, const WindowOptions& options,
                                     WindowStats* stats = nullptr);
 
-/// The window network: Algorithm 2's steps 1-3 on crop_px x crop_px crops at full resolution (windows.p_thresh;
-/// no zoom-in, mirror or coarse pass), built once through `make_backend` with the model at that input size.
+/// The window network: Algorithm 2's steps 2-3 on crop_px x crop_px crops at full resolution (windows.p_thresh;
+/// no zoom-in, mirror or coarse pass), a frame's crops in one batch (DetectionPipeline::detect_regions(), up to the
+/// backend's max_batch), built once through `make_backend` with the model at that input size.
 class WindowDetector {
  public:
   using BackendFactory = std::function<std::unique_ptr<InferenceBackend>(const DarknetModel& model)>;
@@ -129,7 +130,6 @@ class WindowDetector {
   DetectorPipelineOptions pipeline_options_;  ///< the single pass's (NMS, policy, max_detections of the merge)
   std::unique_ptr<DetectionPipeline> pipeline_;
   std::vector<int> crop_of_window_;
-  std::vector<std::vector<Box>> crop_boxes_;
 };
 
 }  // namespace wingman::detector
