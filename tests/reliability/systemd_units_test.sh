@@ -4,7 +4,10 @@
 # folder substituted for /usr/local/bin, as for an install there) and any warning or error fails the test. Also
 # checks that each unit runs its process with its configuration, restarts it always, stops it with SIGTERM and
 # that wingman.target wants all six, and that `systemd-analyze security --offline=true` rates each unit's sandbox at
-# an overall exposure of at most 3.0 (printed per unit). Exits 77 (skipped) when systemd-analyze is not installed.
+# an overall exposure of at most 3.0 (printed per unit). Then the same two checks on the units as `cmake --install`
+# renders them for --prefix /usr and --prefix /opt/wingman (cmake/install_layout.cmake run into a scratch root, the
+# build's executables linked where the units name them, systemd's own units copied in; `--root=` makes systemd-analyze
+# resolve every path there). Exits 77 (skipped) when systemd-analyze is not installed.
 # Usage: tests/reliability/systemd_units_test.sh SRC_DIR BIN_DIR
 set -euo pipefail
 src=$(cd "$1" && pwd) bin=$(cd "$2" && pwd)
@@ -49,5 +52,36 @@ for exe in $(printf '%s\n' "${!cfg[@]}" | sort); do
     echo "$exe.service: exposure $score (at most $max_exposure)"
   fi
 done
+# The installed units, per prefix: rendered by the install script into a scratch root.
+for prefix in /usr /opt/wingman; do
+  root="$tmp/root${prefix//\//-}"
+  if ! DESTDIR="$root" cmake -DWINGMAN_SOURCE_DIR="$src" -DCMAKE_INSTALL_PREFIX="$prefix" \
+       -P "$src/cmake/install_layout.cmake" > "$tmp/install.txt" 2>&1; then
+    fail "--prefix $prefix: cmake/install_layout.cmake failed:"; cat "$tmp/install.txt"; continue
+  fi
+  mkdir -p "$root$prefix/bin" "$root/etc/systemd/system" "$root/usr/lib/systemd"
+  # Hard links where the file system allows (the executables are tens of MB), copies otherwise; a symbolic link would
+  # point outside the root.
+  for exe in "${!cfg[@]}"; do ln -f "$bin/$exe" "$root$prefix/bin/$exe" 2> /dev/null || cp "$bin/$exe" "$root$prefix/bin/"; done
+  cp -a /usr/lib/systemd/system "$root/usr/lib/systemd/"  # sysinit.target and the rest that units depend on
+  cp "$root$prefix/share/wingman/systemd/"* "$root/etc/systemd/system/"
+  if [ "$prefix" = /usr ]; then confdir=/etc/wingman; else confdir="/etc$prefix/wingman"; fi
+  for exe in "${!cfg[@]}"; do
+    grep -qx "ExecStart=$prefix/bin/$exe --config $confdir/${cfg[$exe]}.yaml" "$root/etc/systemd/system/$exe.service" ||
+      fail "--prefix $prefix: $exe.service: $(grep ExecStart= "$root/etc/systemd/system/$exe.service")"
+  done
+  if ! (cd / && systemd-analyze verify --man=no --root="$root" "$root"/etc/systemd/system/wingman.target \
+        "$root"/etc/systemd/system/wingman-*.service) > "$tmp/verify.txt" 2>&1 || [ -s "$tmp/verify.txt" ]; then
+    fail "--prefix $prefix: systemd-analyze verify:"; cat "$tmp/verify.txt"
+  fi
+  for exe in $(printf '%s\n' "${!cfg[@]}" | sort); do
+    out=$(systemd-analyze security --offline=true --no-pager --root="$root" "$exe.service" 2>&1) || true
+    score=$(sed -nE "s/.*Overall exposure level for $exe\.service: ([0-9]+\.[0-9]+).*/\1/p" <<<"$out")
+    if [ -z "$score" ] || awk -v s="$score" -v m="$max_exposure" 'BEGIN { exit !(s > m) }'; then
+      fail "--prefix $prefix: $exe.service: exposure '${score:-none}' (at most $max_exposure):"; tail -n 5 <<<"$out"
+    fi
+  done
+  echo "--prefix $prefix: the rendered units pass verify and security (each at most $max_exposure)"
+done
 [ "$failures" -eq 0 ] || exit 1
-echo "systemd_units_test: ${#cfg[@]} units and wingman.target verified ($(systemd-analyze --version | head -n 1))"
+echo "systemd_units_test: ${#cfg[@]} units and wingman.target verified, as in the source tree and as installed to /usr and /opt/wingman ($(systemd-analyze --version | head -n 1))"
