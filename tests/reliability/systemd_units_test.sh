@@ -74,14 +74,16 @@ for prefix in /usr /opt/wingman; do
         "$root"/etc/systemd/system/wingman-*.service) > "$tmp/verify.txt" 2>&1 || [ -s "$tmp/verify.txt" ]; then
     fail "--prefix $prefix: systemd-analyze verify:"; cat "$tmp/verify.txt"
   fi
+  scores=""
   for exe in $(printf '%s\n' "${!cfg[@]}" | sort); do
     out=$(systemd-analyze security --offline=true --no-pager --root="$root" "$exe.service" 2>&1) || true
     score=$(sed -nE "s/.*Overall exposure level for $exe\.service: ([0-9]+\.[0-9]+).*/\1/p" <<<"$out")
     if [ -z "$score" ] || awk -v s="$score" -v m="$max_exposure" 'BEGIN { exit !(s > m) }'; then
       fail "--prefix $prefix: $exe.service: exposure '${score:-none}' (at most $max_exposure):"; tail -n 5 <<<"$out"
     fi
+    scores+=" ${exe#wingman-} ${score:-none}"
   done
-  echo "--prefix $prefix: the rendered units pass verify and security (each at most $max_exposure)"
+  echo "--prefix $prefix: the rendered units verified; exposure:$scores (each at most $max_exposure)"
 done
 [ "$failures" -eq 0 ] || exit 1
 echo "systemd_units_test: ${#cfg[@]} units and wingman.target verified, as in the source tree and as installed to /usr and /opt/wingman ($(systemd-analyze --version | head -n 1))"
