@@ -86,6 +86,11 @@ for exe in wingman-camera-driver wingman-detector wingman-localizer wingman-foll
   [ -x "$bin/$exe" ] || die "$bin/$exe is missing: build first (tools/build.sh)"
 done
 command -v lcm-logger >/dev/null || die "lcm-logger is missing (tools/install_deps.sh)"
+# load_summary.py decodes with the generated Python types: the build tree's (build/python beside the binaries) or an
+# installed prefix's; checked now, not after the run.
+pypath="$(dirname "$bin")/python:$(dirname "$bin")/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}"
+summary=(env PYENV_VERSION=system "PYTHONPATH=$pypath" python3 "$src/tools/load_summary.py")
+"${summary[@]}" --help > /dev/null || die "tools/load_summary.py cannot run (above)"
 
 if [ "${WINGMAN_IN_NETNS:-}" != "1" ]; then
   exec tools/netns_run.sh "$0" "${args[@]}"
@@ -95,7 +100,6 @@ export PYENV_VERSION=system POCL_AFFINITY="${POCL_AFFINITY:-1}" OMP_WAIT_POLICY=
 mkdir -p "$out"
 out=$(realpath "$out")
 url="$WINGMAN_LCM_URL"
-summary=(python3 "$src/tools/load_summary.py")
 
 clip="$out/clip_1280x720.avi"
 if [ ! -s "$clip" ]; then
