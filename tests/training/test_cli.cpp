@@ -68,15 +68,29 @@ TEST(WingmanVal, JsonOfSavedPredictionsHasTheHandComputedAp) {
   EXPECT_NE(bad_margin.err.find("edge_margin_px = -3"), std::string::npos) << bad_margin.err;
 }
 
+// Issue 34: one default per flag: without --weights or --predictions `wingman val` runs the shipped model, as `wingman
+// predict` does, on the backend auto chooses (as predict and the detector process).
+TEST(WingmanVal, WithoutWeightsOrPredictionsRunsTheShippedModel) {
+  testing::TempDir dir;
+  write_hand_case(dir);
+  const auto r = wingman({"val", "--data", dir.file("data.yaml"), "--json", "-"}, 180);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"images\": 3"), std::string::npos) << r.out;
+  const auto help = wingman({"val", "--help"});
+  EXPECT_NE(help.out.find("auto (default), opencl or cpu"), std::string::npos) << help.out;
+}
+
 TEST(WingmanVal, BadOptionsAndFilesAreNamed) {
   testing::TempDir dir;
   write_hand_case(dir);
-  const auto none = wingman({"val", "--data", dir.file("data.yaml")});
-  EXPECT_EQ(none.exit_code, 2);
-  EXPECT_NE(none.err.find("give exactly one"), std::string::npos) << none.err;
+  // Both a model and saved predictions: one of them, named.
+  const auto both = wingman({"val", "--data", dir.file("data.yaml"), "--weights", "builtin:wingman-small",
+                             "--predictions", dir.file("pred")});
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.err.find("give exactly one"), std::string::npos) << both.err;
   // One "wingman val:" prefix: the library names itself (run_val), the verb adds its own.
-  EXPECT_EQ(none.err.rfind("wingman val: error: run_val: invalid options:", 0), 0u) << none.err;
-  EXPECT_EQ(none.err.find("wingman val:", 1), std::string::npos) << none.err;
+  EXPECT_EQ(both.err.rfind("wingman val: error: run_val: invalid options:", 0), 0u) << both.err;
+  EXPECT_EQ(both.err.find("wingman val:", 1), std::string::npos) << both.err;
   std::ofstream(dir.file("labels/val/b.txt")) << "0 0.5 0.5 0.1 7\n";
   const auto bad = wingman({"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred")});
   EXPECT_EQ(bad.exit_code, 1);

@@ -181,12 +181,14 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "val", "Detection metrics of a detector (or saved predictions) on a labelled split: AP, PR curve, recall, IoU");
   auto* v = s.val;
   training::ValOptions& vo = s.val_options;
+  vo.backend = "auto";  // as `wingman predict` and the detector process (one default per flag, issue 34)
   v->add_option("--data", vo.data, "data.yaml or YOLO-layout folder")->required();
   v->add_option("--split", vo.split, "Split to evaluate (default val; \"\" = a folder's images/)");
   v->add_option("--weights", vo.weights,
-                "Darknet .weights or builtin:wingman-small (the shipped model): run the detector (Algorithm 2)");
+                "Darknet .weights, or builtin:wingman-small (default without --predictions: the shipped model): run "
+                "the detector (Algorithm 2)");
   v->add_option("--cfg", vo.cfg, "Darknet .cfg, or builtin:wingman-small (default) or builtin:tiny-yolo-thesis");
-  v->add_option("--backend", vo.backend, "Detector backend: cpu (default), opencl or auto");
+  v->add_option("--backend", vo.backend, "Detector backend: auto (default), opencl or cpu");
   v->add_option("--input-size", vo.input_size,
                 "Network input: auto (default: the cfg's longer side, the other fitted to each image's aspect), cfg "
                 "or WxH");
@@ -323,6 +325,9 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   }
   if (*s.val) {
     return run_verb("wingman val", err, [&] {
+      // Neither a model nor saved predictions: the shipped model, as `wingman predict`.
+      if (s.val_options.weights.empty() && s.val_options.predictions.empty())
+        s.val_options.weights = "builtin:wingman-small";
       std::optional<common::Progress> images;  // the number of images is known once the set is read
       const training::DetectionMetrics m = training::run_val(
           s.val_options,
