@@ -7,6 +7,7 @@
 #include "wingman/training/seeded_random.hpp"
 #include "wingman/training/yolo_dataset.hpp"
 
+#include <wingman/common/progress.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
 #include <wingman/detector/darknet_weights.hpp>
 #include <wingman/detector/nms.hpp>
@@ -48,14 +49,6 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-std::string duration_text(double s) {
-  if (!std::isfinite(s) || s < 0) return "?";
-  const int64_t t = static_cast<int64_t>(s + 0.5);
-  if (t >= 3600) return fmt::format("{}h{:02d}m", t / 3600, static_cast<int>((t % 3600) / 60));
-  if (t >= 60) return fmt::format("{}m{:02d}s", t / 60, static_cast<int>(t % 60));
-  return fmt::format("{}s", t);
-}
-
 torch::Tensor bytes_tensor(const std::string& s) {
   torch::Tensor t = torch::empty({static_cast<int64_t>(s.size())}, torch::kUInt8);
   if (!s.empty()) std::memcpy(t.data_ptr<uint8_t>(), s.data(), s.size());
@@ -74,7 +67,7 @@ std::string TrainProgress::one_line() const {
       "iter {}/{}: loss {:.4f} avg {:.4f} (coord {:.4f} obj {:.4f} noobj {:.4f} cls {:.4f}) IoU {:.3f} truths {} "
       "lr {:.3g} {:.2f} img/s (data {:.0f}%) elapsed {} ETA {}",
       iteration, max_batches, loss, loss_avg, coord, object, noobject, cls, mean_iou, truths, learning_rate,
-      images_per_s, 100.0 * data_share, duration_text(elapsed_s), duration_text(eta_s));
+      images_per_s, 100.0 * data_share, common::duration_text(elapsed_s), common::duration_text(eta_s));
 }
 
 std::string TrainSummary::one_line() const {
@@ -85,7 +78,7 @@ std::string TrainSummary::one_line() const {
 
 std::string TrainSummary::report() const {
   std::string s = one_line() + "\n";
-  s += fmt::format("checkpoint: {}\nelapsed: {}\n", checkpoint, duration_text(elapsed_s));
+  s += fmt::format("checkpoint: {}\nelapsed: {}\n", checkpoint, common::duration_text(elapsed_s));
   if (!raw_weights.empty()) s += fmt::format("trained weights (not averaged): {}\n", raw_weights);
   if (validation) s += "validation:\n" + validation->report();
   return s;
