@@ -133,15 +133,19 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
                      net.height, image.width, image.height),
          ""});
   };
-  // Tracker-driven windows: the localizer's predictions, and a second network at the crop size.
-  std::unique_ptr<detector::WindowDetector> window_detector;
-  if (o.windows.enabled)
-    window_detector = std::make_unique<detector::WindowDetector>(o.windows, o.detection, model, make_backend);
+  // Tracker-driven windows: the localizer's predictions, and a second network at the crop size, built after the single
+  // pass's (with model.backend auto, the single pass's network decides the backend and the window's takes the same).
+  std::optional<detector::DarknetModel> window_model;
+  if (o.windows.enabled) window_model = model;
   std::mutex windows_mutex;  // the newest windows: written by the LCM thread, read where frames are detected
   std::optional<track_windows_t> newest_windows;
   int32_t image_camera_id = -1;  // the camera of the frames seen (a windows message for another is a counted drop)
   detector::WindowStats window_stats;
   detector::SizedDetector pipeline(o.detection, std::move(model), input_size, make_backend, on_build);
+  std::unique_ptr<detector::WindowDetector> window_detector;
+  if (window_model)
+    window_detector = std::make_unique<detector::WindowDetector>(o.windows, o.detection, *window_model, make_backend);
+  window_model.reset();
 
   // Publishes the detections of frame `img` (its header is enough) and marks it processed.
   auto publish_detections = [&](const image_t& img, const std::vector<detector::Box>& boxes, int64_t latency_us) {
