@@ -138,7 +138,7 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
   std::optional<detector::DarknetModel> window_model;
   if (o.windows.enabled) window_model = model;
   std::mutex windows_mutex;  // the newest windows: written by the LCM thread, read where frames are detected
-  std::optional<track_windows_t> newest_windows;
+  std::shared_ptr<const track_windows_t> newest_windows;  // swapped whole: a frame takes the pointer, not a copy
   int32_t image_camera_id = -1;  // the camera of the frames seen (a windows message for another is a counted drop)
   detector::WindowStats window_stats;
   detector::SizedDetector pipeline(o.detection, std::move(model), input_size, make_backend, on_build);
@@ -177,17 +177,15 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     Detected d;
     d.boxes = pipeline.detect(bgr);
     if (window_detector) {
-      std::optional<track_windows_t> windows;
+      std::shared_ptr<const track_windows_t> windows;
       {
         std::lock_guard<std::mutex> lock(windows_mutex);
         windows = newest_windows;
       }
       if (windows) {
         const cv::Size size(bgr.cols, bgr.rows);
-        const double net_px_per_image_px = static_cast<double>(pipeline.net_size_for(size).width) /
-                                           detector::detection_region(size, o.detection.subsquare).width;
-        const std::vector<detector::Window> search =
-            detector::windows_to_search(*windows, img.utime, size, img.camera_id, net_px_per_image_px, o.windows);
+        const std::vector<detector::Window> search = detector::windows_to_search(
+            *windows, img.utime, size, img.camera_id, pipeline.net_px_per_image_px(size), o.windows);
         if (!search.empty()) d.boxes = window_detector->detect(bgr, std::move(d.boxes), search, &window_stats);
       }
     }
@@ -221,8 +219,9 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
       if (image_camera_id >= 0 && w.camera_id != image_camera_id)
         throw std::invalid_argument(
             fmt::format("track_windows_t.camera_id = {}: the frames are camera {}", w.camera_id, image_camera_id));
+      auto fresh = std::make_shared<const track_windows_t>(w);
       std::lock_guard<std::mutex> lock(windows_mutex);
-      newest_windows = w;
+      newest_windows = std::move(fresh);
     });
   }
   auto log_windows = [&] {

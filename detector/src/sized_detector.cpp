@@ -40,6 +40,10 @@ cv::Size SizedDetector::net_size_for(cv::Size image) const {
   return fit_input_size(cfg_net_, detection_region(image, options_.subsquare).size());
 }
 
+double SizedDetector::net_px_per_image_px(cv::Size image) const {
+  return static_cast<double>(net_size_for(image).width) / detection_region(image, options_.subsquare).width;
+}
+
 DetectionPipeline& SizedDetector::pipeline_for(cv::Size image) {
   const cv::Size net = net_size_for(image);
   for (size_t i = 0; i < pipelines_.size(); ++i) {

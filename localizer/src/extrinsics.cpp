@@ -59,10 +59,19 @@ Extrinsics Extrinsics::from_options(const ExtrinsicsOptions& options) {
   return e;
 }
 
+CameraPoseInWorld camera_pose_in_world(const Extrinsics& extrinsics, const PoseSample& pose) {
+  const Eigen::Matrix3d R_body_to_world = pose.q_body_to_world.normalized().toRotationMatrix();
+  CameraPoseInWorld c;
+  c.R_cam_to_world = R_body_to_world * extrinsics.R_cam_to_body;
+  c.p_cam_in_world = R_body_to_world * extrinsics.p_cam_in_body + pose.p_body_in_world;
+  return c;
+}
+
 WorldMeasurement to_world(const CameraMeasurement& m, const Extrinsics& extrinsics, const PoseSample& pose_at_exposure,
                           int64_t image_utime, int32_t camera_id) {
   const Eigen::Matrix3d R_body_to_world = pose_at_exposure.q_body_to_world.normalized().toRotationMatrix();
-  const Eigen::Matrix3d R_cam_to_world = R_body_to_world * extrinsics.R_cam_to_body;
+  const CameraPoseInWorld camera = camera_pose_in_world(extrinsics, pose_at_exposure);
+  const Eigen::Matrix3d& R_cam_to_world = camera.R_cam_to_world;
   WorldMeasurement w;
   w.utime = image_utime;
   w.camera_id = camera_id;
@@ -80,7 +89,7 @@ WorldMeasurement to_world(const CameraMeasurement& m, const Extrinsics& extrinsi
   w.cov_p_in_world += pose_at_exposure.cov_p_body_in_world;
   w.cov_p_in_world = 0.5 * (w.cov_p_in_world + w.cov_p_in_world.transpose());  // exact symmetry for the filter
   w.p_target_in_cam = m.p_target_in_cam;
-  w.p_cam_in_world = R_body_to_world * extrinsics.p_cam_in_body + pose_at_exposure.p_body_in_world;
+  w.p_cam_in_world = camera.p_cam_in_world;
   w.range = m.range;
   w.confidence = m.confidence;
   return w;

@@ -187,13 +187,13 @@ wingman::track_windows_t Localizer::track_windows(const wingman::detections_t& d
   out.image_height = d.image_height;
   // The camera then: the pose at this exposure moved on with the body's velocity (its rotation held).
   const double dt = static_cast<double>(interval_us) * 1e-6;
-  const Eigen::Matrix3d R_body_to_world = pose.q_body_to_world.normalized().toRotationMatrix();
+  const CameraPoseInWorld now = camera_pose_in_world(extrinsics_, pose);
   CameraAtExposure cam;
-  cam.R_cam_to_world = R_body_to_world * extrinsics_.R_cam_to_body;
+  cam.R_cam_to_world = now.R_cam_to_world;
   cam.v_cam_in_world = pose.v_body_in_world;
-  cam.p_cam_in_world = R_body_to_world * extrinsics_.p_cam_in_body + pose.p_body_in_world + dt * pose.v_body_in_world;
+  cam.p_cam_in_world = now.p_cam_in_world + dt * pose.v_body_in_world;
   const bool ground_truth = d.source == wingman::detections_t::SOURCE_GROUND_TRUTH;
-  const BoxRelation sphere = BoxRelation::sphere();
+  static const BoxRelation sphere = BoxRelation::sphere();  // built once, not per frame
   for (const TrackOutput& t : tracker_.predicted_tracks(out.utime_predicted)) {
     if (static_cast<int>(out.windows.size()) >= options_.windows.max_windows) break;
     // The box relation holds for full-resolution re-detections too (measured: docs/detector.md, "Tracker-driven

@@ -8,7 +8,6 @@
 #include <wingman/detector/detector_options.hpp>
 #include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
-#include <wingman/detector/preprocess.hpp>
 #include <wingman/detector/sized_detector.hpp>
 #include <wingman/detector/track_windows.hpp>
 #include <wingman/localizer/camera_model.hpp>
@@ -219,9 +218,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     m.windows = {w};
     m.num_windows = 1;
     const cv::Size size(bgr.cols, bgr.rows);
-    const double net_px_per_image_px = static_cast<double>(pipeline.net_size_for(size).width) /
-                                       detector::detection_region(size, dopt.detection.subsquare).width;
-    const auto search = detector::windows_to_search(m, 0, size, 0, net_px_per_image_px, dopt.windows);
+    const auto search = detector::windows_to_search(m, 0, size, 0, pipeline.net_px_per_image_px(size), dopt.windows);
     return search.empty() ? boxes : windows->detect(bgr, std::move(boxes), search);
   };
 

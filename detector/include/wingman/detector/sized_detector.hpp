@@ -40,6 +40,9 @@ class SizedDetector {
   DetectionPipeline& pipeline_for(cv::Size image);
   /// The network input an image of this size is detected at.
   cv::Size net_size_for(cv::Size image) const;
+  /// Network pixels per image pixel of the single pass on an image of this size (net_size_for() over the width of
+  /// its detection region): how large a box of the image looks to the network.
+  double net_px_per_image_px(cv::Size image) const;
   /// Pipelines built so far (a rebuilt size counts again).
   int builds() const { return builds_; }
   const InputSize& input_size() const { return input_size_; }

@@ -68,6 +68,14 @@ inline Eigen::Matrix3d rotate_covariance(const Eigen::Matrix3d& R_a_to_b, const 
   return R_a_to_b * cov_in_a * R_a_to_b.transpose();
 }
 
+/// The camera's pose in the world frame at a body pose: R_cam_to_world = R_body_to_world R_cam_to_body and the optical
+/// centre p_cam_in_world = R_body_to_world p_cam_in_body + p_body_in_world.
+struct CameraPoseInWorld {
+  Eigen::Matrix3d R_cam_to_world = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_cam_in_world = Eigen::Vector3d::Zero();  ///< metres
+};
+CameraPoseInWorld camera_pose_in_world(const Extrinsics& extrinsics, const PoseSample& pose);
+
 /// Maps a camera-frame measurement into the world frame with the body pose at the image's exposure
 /// time (`pose_at_exposure`, from PoseBuffer::at(image_utime)):
 /// p_in_world = R_body_to_world (R_cam_to_body p_in_cam + p_cam_in_body) + p_body_in_world,
