@@ -111,25 +111,35 @@ fi
 # Camera i looks along body x yawed by 90 degrees * i (FLU): camera optical frame -> body, row-major.
 extrinsics=("0, 0, 1, -1, 0, 0, 0, -1, 0" "1, 0, 0, 0, 0, 1, 0, -1, 0" "0, 0, -1, 1, 0, 0, 0, -1, 0"
             "-1, 0, 0, 0, 0, -1, 0, -1, 0")
+# Each process: its defaults with these keys over them (--set, read by its config loader, as in tools/fly.sh).
+detector_sets() {  # detector_sets I: camera I's detector, the shipped model
+  sets=(--set "input={channel: IMAGE_CAM$1, mode: $mode}" --set "output.channel=DETECTIONS_CAM$1"
+        --set 'model={cfg: "builtin:wingman-small", weights: "builtin:wingman-small"}')
+}
+localizer_sets() {  # localizer_sets I: camera I's localizer (one camera id per localizer), with its extrinsics
+  sets=(--set "input.detections_channel=DETECTIONS_CAM$1" --set "output.channel=TARGETS_CAM$1"
+        --set "camera.camera_id=$1" --set "extrinsics.R_cam_to_body=[${extrinsics[$1]}]")
+}
+# The follower follows camera 0's targets (it reads one targets channel).
+follower_sets=(--set "input={targets_channel: TARGETS_CAM0, detections_channel: DETECTIONS_CAM0}")
+camera_sets() {  # camera_sets I realtime|fast: camera I plays the clip in a loop at 30 fps
+  sets=(--set "source.kind=file" --set "output={channel: IMAGE_CAM$1, camera_id: $1}"
+        --set "file={path: \"$clip\", mode: $2, fps: 30.0, loop: true}")
+  # fast: the replay log's frames, stamped from a fixed start time (deterministic); realtime: by the wall clock.
+  [ "$2" = realtime ] || sets+=(--set file.start_utime=1700000000000000 --set "output.max_frames=$replay_frames")
+}
+# Every process's merged configuration, as its loader read it (a record of the run).
+record_config() {  # record_config FILE EXE SETS...
+  local file=$1 exe=$2; shift 2
+  "$bin/$exe" "$@" --print-config > "$file" || { echo "load_test: FAILED: $exe rejects its settings (above)" >&2; exit 1; }
+}
 for ((i = 0; i < cameras; i++)); do
-  cat > "$out/detector_$i.yaml" <<YAML
-# Written by tools/load_test.sh: camera $i's detector, the shipped model.
-input: {channel: IMAGE_CAM$i, mode: $mode}
-output: {channel: DETECTIONS_CAM$i}
-model: {cfg: "builtin:wingman-small", weights: "builtin:wingman-small"}
-YAML
-  cat > "$out/localizer_$i.yaml" <<YAML
-# Written by tools/load_test.sh: camera $i's localizer (one camera id per localizer).
-input: {detections_channel: DETECTIONS_CAM$i}
-output: {channel: TARGETS_CAM$i}
-camera: {camera_id: $i}
-extrinsics: {R_cam_to_body: [${extrinsics[$i]}]}
-YAML
+  detector_sets "$i"; record_config "$out/detector_$i.yaml" wingman-detector "${sets[@]}"
+  localizer_sets "$i"; record_config "$out/localizer_$i.yaml" wingman-localizer "${sets[@]}"
+  camera_sets "$i" "$([ "$mode" = replay ] && echo fast || echo realtime)"
+  record_config "$out/camera_$i.yaml" wingman-camera-driver "${sets[@]}"
 done
-cat > "$out/follower_ctrl.yaml" <<YAML
-# Written by tools/load_test.sh: follows camera 0's targets (the follower reads one targets channel).
-input: {targets_channel: TARGETS_CAM0, detections_channel: DETECTIONS_CAM0}
-YAML
+record_config "$out/follower_ctrl.yaml" wingman-follower-ctrl "${follower_sets[@]}"
 
 # ---------------------------------------------------------------------------------------------------- replay
 if [ "$mode" = replay ]; then
@@ -138,13 +148,8 @@ if [ "$mode" = replay ]; then
   # The same four-camera input as real time, recorded: each camera in turn appends its frames to one log, stamped
   # from a fixed start time (fast mode: deterministic), as the cameras would have captured them together.
   for ((i = 0; i < cameras; i++)); do
-    cat > "$out/camera_$i.yaml" <<YAML
-# Written by tools/load_test.sh: camera $i, $replay_frames frames of the clip into the replay log.
-source: {kind: file}
-file: {path: "$clip", mode: fast, fps: 30.0, loop: true, start_utime: 1700000000000000}
-output: {channel: IMAGE_CAM$i, camera_id: $i, max_frames: $replay_frames}
-YAML
-    "$bin/wingman-camera-driver" --name "camera_$i" --config "$out/camera_$i.yaml" --log-level warn \
+    camera_sets "$i" fast
+    "$bin/wingman-camera-driver" --name "camera_$i" "${sets[@]}" --log-level warn \
       --lcm-out "file://$images?mode=$([ "$i" = 0 ] && echo w || echo a)"
   done
   echo "load_test: replay: $cameras cameras x $replay_frames frames of 1280x720 BGR in $images" \
@@ -152,7 +157,8 @@ YAML
   SECONDS=0
   pids=()
   for ((i = 0; i < cameras; i++)); do
-    "$bin/wingman-detector" --name "detector_$i" --config "$out/detector_$i.yaml" --log-level warn \
+    detector_sets "$i"
+    "$bin/wingman-detector" --name "detector_$i" "${sets[@]}" --log-level warn \
       --lcm-in "file://$images?speed=0" --lcm-out "file://$out/detections_$i.lcmlog?mode=w" & pids+=($!)
   done
   rc=0
@@ -167,14 +173,6 @@ YAML
 fi
 
 # -------------------------------------------------------------------------------------------------- realtime
-for ((i = 0; i < cameras; i++)); do
-  cat > "$out/camera_$i.yaml" <<YAML
-# Written by tools/load_test.sh: camera $i plays the clip in a loop at 30 fps, stamped by the wall clock.
-source: {kind: file}
-file: {path: "$clip", mode: realtime, fps: 30.0, loop: true}
-output: {channel: IMAGE_CAM$i, camera_id: $i}
-YAML
-done
 log="$out/load.lcmlog" proc_csv="$out/processes.csv"
 rm -f "$log" "$proc_csv"
 declare -A pid_of=()
@@ -203,10 +201,10 @@ start() {  # start NAME EXE ARGS...
 echo "load_test: $cameras cameras x 1280x720 x 30 fps for $duration s on $url (private network namespace), output in $out"
 lcm-logger --lcm-url="$url" --force --quiet --channel='IMAGE_.*' --invert-channels "$log" & logger_pid=$!
 for ((i = 0; i < cameras; i++)); do
-  start "detector_$i" wingman-detector --config "$out/detector_$i.yaml"
-  start "localizer_$i" wingman-localizer --config "$out/localizer_$i.yaml"
+  detector_sets "$i"; start "detector_$i" wingman-detector "${sets[@]}"
+  localizer_sets "$i"; start "localizer_$i" wingman-localizer "${sets[@]}"
 done
-start follower_ctrl wingman-follower-ctrl --config "$out/follower_ctrl.yaml"
+start follower_ctrl wingman-follower-ctrl "${follower_sets[@]}"
 # Start-up takes seconds (each detector loads the model and picks its backend): wait, at most 180 s, until every
 # process has published its first heartbeat, which it does once it listens.
 ready=false
@@ -244,7 +242,7 @@ sampler() {
   done
 }
 
-for ((i = 0; i < cameras; i++)); do start "camera_$i" wingman-camera-driver --config "$out/camera_$i.yaml"; done
+for ((i = 0; i < cameras; i++)); do camera_sets "$i" realtime; start "camera_$i" wingman-camera-driver "${sets[@]}"; done
 sampler & sampler_pid=$!
 echo "load_test: pipeline up; cameras playing"
 SECONDS=0
