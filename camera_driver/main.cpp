@@ -15,7 +15,7 @@ namespace common = wingman::common;
 int run(common::Runtime& rt, const cd::CameraDriverOptions& options) {
   cd::CameraDriver driver(options.output, cd::make_source(options, std::make_shared<cd::SystemV4l2Io>(),
                                                           std::make_shared<cd::SystemClock>()));
-  driver.open();  // a missing device or unreadable file throws: one line, exit 1
+  driver.open();  // an unreadable file (a missing device with v4l2.wait_for_device false) throws: one line, exit 1
   return cd::run_driver_loop(rt, driver, options.output.channel, options.preview);
 }
 

@@ -16,19 +16,30 @@ int run_driver_loop(common::Runtime& rt, CameraDriver& driver, const std::string
   PreviewMaker preview(preview_options);
   const std::string preview_channel = preview_options.channel_for(channel);
   if (preview_options.enabled) status.declare_output(preview_channel);
-  status.set_state(status_t::STATE_OK, driver.describe());
-  rt.publish_heartbeat();
-
   std::string stop_reason = "signal";
   bool in_error = false;
+  if (const std::string waiting = driver.source().waiting_reason(); !waiting.empty()) {
+    status.set_state(status_t::STATE_ERROR, waiting);  // the device was not there at start: waiting for it
+    status.set_error(waiting);
+    in_error = true;
+  } else {
+    status.set_state(status_t::STATE_OK, driver.describe());
+  }
+  rt.publish_heartbeat();
+
   while (!rt.stop_requested()) {
     const DriverStep step = driver.step(kDriverReadTimeoutMs);
     if (step.lost > 0) status.source_dropped(channel, step.lost, step.reason);
     if ((in_error || step.reconnected) && step.status != ReadStatus::kDisconnected) {
       const SourceStats& s = driver.source().stats();
-      status.set_state(status_t::STATE_OK, fmt::format("{} (back after {} disconnect(s), {} reconnect(s))",
-                                                       driver.describe(), s.disconnects, s.reconnects));
-      spdlog::info("camera back: {} ({} reconnect(s) so far)", driver.describe(), s.reconnects);
+      if (s.disconnects == 0) {  // the device that was missing at start is there
+        status.set_state(status_t::STATE_OK, driver.describe());
+        spdlog::info("camera found: {}", driver.describe());
+      } else {
+        status.set_state(status_t::STATE_OK, fmt::format("{} (back after {} disconnect(s), {} reconnect(s))",
+                                                         driver.describe(), s.disconnects, s.reconnects));
+        spdlog::info("camera back: {} ({} reconnect(s) so far)", driver.describe(), s.reconnects);
+      }
       in_error = false;
       rt.publish_heartbeat();  // monitors see the recovery now, not at the next period
     }

@@ -257,13 +257,26 @@ void V4l2Source::stop() {
 void V4l2Source::open() {
   if (opened_) throw std::logic_error("V4l2Source::open: already open");
   const std::string err = start();
-  if (!err.empty()) throw std::runtime_error(err);
+  if (!err.empty()) {
+    if (!options_.wait_for_device) throw std::runtime_error(err);
+    // Not there yet: wait for it as for a replug (no disconnect counted: it never streamed).
+    opened_ = true;
+    disconnected_ = true;
+    backoff_us_ = seconds_to_us(options_.reconnect_initial_s);
+    next_attempt_mono_us_ = clock_->monotonic_utime() + backoff_us_;
+    disconnect_reason_ = err;
+    spdlog::warn("{}; waiting for the device (v4l2.wait_for_device), next attempt in {} s", err,
+                 options_.reconnect_initial_s);
+    return;
+  }
   opened_ = true;
+  ever_streamed_ = true;
   spdlog::info("{}", describe());
 }
 
 std::string V4l2Source::describe() const {
   if (!opened_) return fmt::format("v4l2 {} (not open)", options_.device);
+  if (disconnected_ && !ever_streamed_) return fmt::format("v4l2 {} (waiting for the device)", options_.device);
   if (disconnected_) return fmt::format("v4l2 {} (disconnected, reconnecting)", options_.device);
   std::string s = fmt::format("v4l2 {} {} {}x{}", options_.device, pixel_format_name(format_), width_, height_);
   if (stride_ > 0) s += fmt::format(" stride {}", stride_);
@@ -316,8 +329,13 @@ ReadResult V4l2Source::try_reconnect(Frame& out, int timeout_ms) {
     return ReadResult{ReadStatus::kDisconnected, 0, err, false};
   }
   disconnected_ = false;
-  ++stats_.reconnects;
-  spdlog::info("reconnected: {}", describe());
+  if (ever_streamed_) {
+    ++stats_.reconnects;
+    spdlog::info("reconnected: {}", describe());
+  } else {
+    ever_streamed_ = true;
+    spdlog::info("the device is there: {}", describe());
+  }
   ReadResult r = capture(out, 0);
   r.reconnected = true;
   return r;

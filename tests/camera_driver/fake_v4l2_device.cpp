@@ -50,6 +50,7 @@ int FakeV4l2Device::open(const std::string& path) {
   ++open_calls_;
   if (clock_ != nullptr) open_attempts_us_.push_back(clock_->monotonic_utime());
   if (path != config_.path || !config_.present) return -ENOENT;
+  if (open_calls_ <= config_.absent_opens) return -ENOENT;
   if (unplugged_) {
     if (failing_opens_ > 0) {
       --failing_opens_;

@@ -19,6 +19,7 @@ namespace wingman::camera_driver::testing {
 struct FakeDeviceConfig {
   std::string path = "/dev/video0";  ///< the only node that opens
   bool present = true;               ///< false: open() fails with ENOENT (missing device)
+  int absent_opens = 0;              ///< the first this many open() calls fail with ENOENT (a camera enumerating late)
   std::string card = "Fake UVC Camera";
   uint32_t capabilities = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING;
   std::vector<uint32_t> formats = {V4L2_PIX_FMT_YUYV, V4L2_PIX_FMT_MJPEG};  ///< S_FMT falls back to the first

@@ -183,7 +183,7 @@ TEST(CameraDriverProcess, MissingOrUnreadableInputsExitOneWithOneLineNamingThem)
       {"missing video", file_config(missing, "mode: fast"), "file " + missing + ": does not exist"},
       {"unreadable video (OpenCV's backend noise must not reach stderr)", file_config(bad, "mode: fast"),
        "file " + bad + ": cannot open as a video"},
-      {"missing camera", "v4l2: {device: /dev/video-wingman-test-missing}\n",
+      {"missing camera, not waited for", "v4l2: {device: /dev/video-wingman-test-missing, wait_for_device: false}\n",
        "device /dev/video-wingman-test-missing: cannot open: ENOENT"},
   };
   for (const auto& c : cases) {
@@ -194,6 +194,35 @@ TEST(CameraDriverProcess, MissingOrUnreadableInputsExitOneWithOneLineNamingThem)
     ASSERT_EQ(lines.size(), 1u) << r.err;
     EXPECT_THAT(lines[0], HasSubstr(c.expected));
   }
+}
+
+TEST(CameraDriverProcess, AMissingCameraIsWaitedForWithAnErrorHeartbeatAndSigtermExitsZero) {
+  TempDir dir;
+  std::ofstream(dir.file("config.yaml")) << "v4l2: {device: /dev/video-wingman-test-missing, reconnect_initial_s: 0.1, "
+                                            "reconnect_max_s: 0.2}\n";
+  Child child({wingman::testing::bin_path("wingman-camera-driver"), "--config", dir.file("config.yaml"), "--lcm-out",
+               "file://" + dir.file("out.lcmlog") + "?mode=w"});
+  // Up and waiting once it has retried twice (0.1 s, then 0.2 s after the failed open).
+  const auto deadline = SteadyClock::now() + kProcessTimeout;
+  auto retries = [&child] {
+    size_t n = 0;
+    for (size_t at = 0; (at = child.err().find("next attempt in", at)) != std::string::npos; ++at) ++n;
+    return n;
+  };
+  while (retries() < 3 && SteadyClock::now() < deadline) {
+    ASSERT_EQ(child.wait(std::chrono::milliseconds(10)), -1) << "exited instead of waiting: " << child.err();
+  }
+  ASSERT_GE(retries(), 3u) << child.err();
+  child.signal(SIGTERM);
+  EXPECT_EQ(child.wait(std::chrono::seconds(5)), 0) << child.err();
+  EXPECT_THAT(child.err(), HasSubstr("waiting for the device (v4l2.wait_for_device)"));
+
+  const LogContents log = decode_log(dir.file("out.lcmlog"));
+  EXPECT_TRUE(log.images.empty());
+  ASSERT_GE(log.statuses.size(), 2u) << "a heartbeat at start and one at the stop";
+  EXPECT_EQ(log.statuses.front().state, int8_t{wingman::status_t::STATE_ERROR}) << "never OK without the camera";
+  EXPECT_THAT(log.statuses.front().detail, HasSubstr("device /dev/video-wingman-test-missing: cannot open: ENOENT"));
+  EXPECT_EQ(log.statuses.back().state, int8_t{wingman::status_t::STATE_STOPPING});
 }
 
 }  // namespace

@@ -122,6 +122,28 @@ TEST(CameraDriverLoop, UnplugIsAnErrorHeartbeatUntilTheReplugThenFramesResumeInO
   EXPECT_EQ(p.statuses.back().drops_total, 0) << "an unplug loses no counted frame in this script";
 }
 
+TEST(CameraDriverLoop, ACameraMissingAtStartIsAnErrorHeartbeatUntilItAppears) {
+  TempDir dir;
+  auto clock = std::make_shared<FakeClock>();
+  testing::FakeDeviceConfig config;
+  config.absent_opens = 3;  // the open() and two attempts fail (0.1 and 0.2 s later)
+  auto device = std::make_shared<FakeV4l2Device>(config, clock.get());
+  for (uint32_t i = 0; i < 3; ++i) push_timed_frame(*device, i, kMono0 + 300'000 + (i + 1) * kFrameUs);
+  int64_t reconnects = 0;
+  EXPECT_EQ(run_loop(dir.file("out.lcmlog"), clock, device, 3, &reconnects), 3);
+  EXPECT_EQ(reconnects, 0);
+
+  const Published p = read_output(dir.file("out.lcmlog"));
+  const std::vector<std::string> expected = {"error", "ok", "image", "image", "image", "stopping"};
+  EXPECT_EQ(p.kinds, expected) << "the first heartbeat already says the camera is missing; never OK before it is there";
+  ASSERT_EQ(p.statuses.size(), 3u);
+  EXPECT_THAT(p.statuses[0].detail, HasSubstr("device /dev/video0"));
+  EXPECT_THAT(p.statuses[0].detail, HasSubstr("ENOENT"));
+  EXPECT_EQ(p.statuses[0].last_error, p.statuses[0].detail);
+  EXPECT_THAT(p.statuses[1].detail, HasSubstr("v4l2 /dev/video0 YUYV")) << "OK with the negotiated format";
+  EXPECT_THAT(p.statuses[1].detail, ::testing::Not(HasSubstr("disconnect")));
+}
+
 TEST(CameraDriverLoop, FramesLostAroundAnUnplugAreCountedAsDrops) {
   TempDir dir;
   auto clock = std::make_shared<FakeClock>();

@@ -34,7 +34,9 @@ struct Rig {
   }
 };
 
+/// open()'s error with wait_for_device off (with it, open() does not throw: WaitsForADeviceMissingAtStart...).
 std::string open_error(V4l2SourceOptions options, FakeDeviceConfig config) {
+  options.wait_for_device = false;
   Rig rig(std::move(options), std::move(config));
   try {
     rig.source->open();
@@ -105,6 +107,67 @@ TEST(V4l2Source, MissingDeviceFailsToOpenNamingIt) {
   const std::string err = open_error({}, config);
   EXPECT_THAT(err, HasSubstr("device /dev/video0"));
   EXPECT_THAT(err, HasSubstr("ENOENT"));
+}
+
+TEST(V4l2Source, WaitsForADeviceMissingAtStartThenStreamsWithoutCountingAReconnect) {
+  V4l2SourceOptions options;  // wait_for_device: true by default
+  options.reconnect_initial_s = 0.5;
+  options.reconnect_max_s = 1.0;
+  options.stall_timeout_s = 0;
+  FakeDeviceConfig config;
+  config.absent_opens = 4;  // the open() and three attempts fail: the camera appears at the fourth
+  Rig rig(options, config);
+  ASSERT_NO_THROW(rig.source->open());
+  EXPECT_THAT(rig.source->waiting_reason(), HasSubstr("device /dev/video0"));
+  EXPECT_THAT(rig.source->waiting_reason(), HasSubstr("ENOENT"));
+  EXPECT_EQ(rig.source->describe(), "v4l2 /dev/video0 (waiting for the device)");
+  EXPECT_FALSE(rig.source->streaming());
+  rig.device->push_frames(0, 2);
+
+  Frame f;
+  std::vector<int64_t> seqs;
+  int waiting_results = 0;
+  bool first_frame_flagged = false;
+  for (int i = 0; i < kMaxReads && seqs.size() < 2; ++i) {
+    const ReadResult r = rig.source->read(f, 100);
+    if (r.status == ReadStatus::kDisconnected) {
+      ++waiting_results;
+      EXPECT_THAT(r.reason, HasSubstr("/dev/video0"));
+    }
+    if (r.status == ReadStatus::kFrame) {
+      if (seqs.empty()) first_frame_flagged = r.reconnected;
+      seqs.push_back(f.seq);
+    }
+  }
+  EXPECT_EQ(seqs, (std::vector<int64_t>{0, 1}));
+  EXPECT_GT(waiting_results, 0);
+  EXPECT_TRUE(first_frame_flagged) << "the first frame says the source came up (the loop's heartbeat turns OK)";
+  EXPECT_TRUE(rig.source->waiting_reason().empty());
+  EXPECT_TRUE(rig.source->streaming());
+  EXPECT_EQ(rig.source->stats().disconnects, 0) << "it never streamed before: not a disconnect";
+  EXPECT_EQ(rig.source->stats().reconnects, 0);
+  // The attempts back off as after an unplug: 0.5, 1, 1 (capped), 1 s after the failed open().
+  const auto& attempts = rig.device->open_attempts_us();
+  ASSERT_EQ(attempts.size(), 5u);
+  std::vector<int64_t> gaps_us;
+  for (size_t i = 1; i < attempts.size(); ++i) gaps_us.push_back(attempts[i] - attempts[i - 1]);
+  EXPECT_EQ(gaps_us, (std::vector<int64_t>{500'000, 1'000'000, 1'000'000, 1'000'000}));
+}
+
+TEST(V4l2Source, WaitingForTheDeviceAlsoRetriesANegotiationThatFailsAndSaysWhy) {
+  FakeDeviceConfig config;
+  config.formats = {v4l2_fourcc('H', '2', '6', '4')};
+  Rig rig({}, config);
+  ASSERT_NO_THROW(rig.source->open());
+  EXPECT_THAT(rig.source->waiting_reason(), HasSubstr("pixel format 'YUYV' not supported"));
+  EXPECT_FALSE(rig.device->is_open()) << "the failed negotiation closed the device";
+  Frame f;
+  for (int i = 0; i < 50; ++i) {
+    const ReadResult r = rig.source->read(f, 100);
+    ASSERT_EQ(r.status, ReadStatus::kDisconnected);
+    EXPECT_THAT(r.reason, HasSubstr("not supported"));
+  }
+  EXPECT_GE(rig.device->open_calls(), 3);
 }
 
 TEST(V4l2Source, UnsupportedPixelFormatFailsNamingWhatTheDriverOffers) {

@@ -18,8 +18,8 @@
 #     with the INSTALLED Python types (P/lib/python3/dist-packages; for /usr Debian's python3 finds them unaided);
 #   - the flight: wingman-sim stands in for the camera and the autopilot (it renders IMAGE_CAM0 and publishes
 #     OWN_POSE, takes SETPOINT; the MAVLink bridge waits for an autopilot that does not come). There is no
-#     /dev/video0 here, and the installed camera driver exits 1 at start without its device (supervisord would
-#     restart it every 1-4 s), so the installed camera_driver.yaml is edited as a vehicle owner would: a looped clip
+#     /dev/video0 here (the installed camera driver would wait for it, heartbeat ERROR), so the installed
+#     camera_driver.yaml is edited as a vehicle owner would: a looped clip
 #     on a channel of its own (IMAGE_SUPCAM), the rest at the shipped values. Lockstep, the README's formation
 #     (config/scenarios/formation_2d.yaml, the shipped CNN on rendered images) for WINGMAN_SUPD_DURATION s (default
 #     12), recorded with lcm-logger and evaluated with the installed `wingman eval` and the installed follower

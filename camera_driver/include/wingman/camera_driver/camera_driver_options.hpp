@@ -54,6 +54,8 @@ struct CameraDriverOptions {
     v("v4l2.reconnect_max_s", v4l2.reconnect_max_s, "longest wait between reopening attempts, seconds");
     v("v4l2.stall_timeout_s", v4l2.stall_timeout_s,
       "no frame for this long while streaming counts as an unplug (reopen), seconds; 0 = never");
+    v("v4l2.wait_for_device", v4l2.wait_for_device,
+      "a device missing or failing at start is retried like an unplug (heartbeat ERROR says why); false: exit 1");
     v("file.path", file.path, "video file, image folder (played in name order) or single image; required for file");
     v("file.mode", file.mode,
       "realtime (paced at fps, utime = wall clock) or fast (no waiting, utime = start_utime + i / fps)");

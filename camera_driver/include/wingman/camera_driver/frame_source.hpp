@@ -46,8 +46,8 @@ struct SourceStats {
 /// A source of frames. Not thread-safe; use from one thread.
 ///
 /// Usage: construct, open() (throws std::runtime_error naming the device or file when it cannot
-/// start), then read() in a loop. read() never blocks longer than about `timeout_ms`, so the
-/// caller can check for a stop request between calls.
+/// start, unless the source waits for its device: waiting_reason()), then read() in a loop. read() never blocks longer
+/// than about `timeout_ms`, so the caller can check for a stop request between calls.
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
@@ -62,6 +62,9 @@ class FrameSource {
   virtual std::string describe() const = 0;
   /// Counters since open().
   virtual const SourceStats& stats() const = 0;
+  /// Why the source has delivered nothing since open(), when it is waiting for a device that was not there at
+  /// start (V4l2SourceOptions::wait_for_device); empty otherwise.
+  virtual std::string waiting_reason() const { return ""; }
 };
 
 }  // namespace wingman::camera_driver

@@ -36,6 +36,10 @@ struct V4l2SourceOptions {
   double reconnect_max_s = 8.0;
   /// Streaming with no frame for this long counts as a disconnect (reopen), seconds; 0 = never.
   double stall_timeout_s = 2.0;
+  /// A device that cannot be opened or negotiated at start (not plugged in yet, still enumerating at boot, busy) is
+  /// retried like an unplugged one (reconnect_initial_s, doubling up to reconnect_max_s) instead of failing open():
+  /// the process stays up and reports why in its heartbeat. false: open() throws (the process exits 1).
+  bool wait_for_device = true;
 
   /// One line per problem ("v4l2.width = 0: must be in [1, 8192]"); empty when valid.
   std::vector<std::string> validate() const;
@@ -78,12 +82,15 @@ class V4l2Source : public FrameSource {
   V4l2Source(const V4l2Source&) = delete;
   V4l2Source& operator=(const V4l2Source&) = delete;
 
-  /// Opens and starts streaming. Throws std::runtime_error naming the device and the failed step,
-  /// e.g. "device /dev/video0: cannot open: ENOENT (No such file or directory)".
+  /// Opens and starts streaming. On failure, with wait_for_device (default) the source starts out disconnected:
+  /// read() returns kDisconnected naming the device and the failed step until an attempt succeeds (that frame's
+  /// ReadResult::reconnected is true; stats().reconnects does not count it). Without it, throws
+  /// std::runtime_error naming them, e.g. "device /dev/video0: cannot open: ENOENT (No such file or directory)".
   void open() override;
   ReadResult read(Frame& out, int timeout_ms) override;
   std::string describe() const override;
   const SourceStats& stats() const override { return stats_; }
+  std::string waiting_reason() const override { return disconnected_ && !ever_streamed_ ? disconnect_reason_ : ""; }
 
   /// True while streaming (false while disconnected and before open()).
   bool streaming() const { return fd_ >= 0 && streaming_; }
@@ -145,6 +152,7 @@ class V4l2Source : public FrameSource {
   std::string pending_failure_;  // a QBUF failure after a delivered frame: disconnect on the next read
 
   bool disconnected_ = false;
+  bool ever_streamed_ = false;  // false while waiting for the device at start (wait_for_device)
   bool just_reconnected_ = false;
   std::string disconnect_reason_;
   int64_t backoff_us_ = 0;
