@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // wingman-localizer: detections and own pose in, tracked 3D targets out.
-#include "wingman/localizer/calibration.hpp"
+#include <wingman/geometry/calibration.hpp>
 #include "wingman/localizer/localizer.hpp"
 
 #include <wingman/common/runtime.hpp>
@@ -11,13 +11,13 @@ namespace {
 
 using namespace wingman;
 
-localizer::CameraModel make_camera(const localizer::CameraOptions& o) {
+geometry::CameraModel make_camera(const localizer::CameraOptions& o) {
   if (o.calibration.empty()) {
     // Principal point at the image centre, in the calibration convention (pixel centres at integers).
-    return localizer::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
-                                           0.5 * o.height - 0.5);
+    return geometry::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
+                                          0.5 * o.height - 0.5);
   }
-  return localizer::load_calibration(o.calibration, o.kalibr_camera);
+  return geometry::load_calibration(o.calibration, o.kalibr_camera);
 }
 
 int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {

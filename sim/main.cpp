@@ -11,7 +11,7 @@
 
 #include <wingman/common/progress.hpp>
 #include <wingman/common/runtime.hpp>
-#include <wingman/localizer/calibration.hpp>
+#include <wingman/geometry/calibration.hpp>
 #include <wingman/mavlink/parser.hpp>
 #include <wingman/mavlink_bridge/link.hpp>
 #include <wingman/mavlink_bridge/link_reader.hpp>
@@ -36,13 +36,13 @@ using namespace wingman;
 using Clock = std::chrono::steady_clock;
 namespace common = wingman::common;
 
-localizer::CameraModel make_camera(const sim::SimCameraOptions& o) {
+geometry::CameraModel make_camera(const sim::SimCameraOptions& o) {
   if (o.calibration.empty()) {
     // The localizer's built-in camera: principal point at the image centre (pixel centres at integers).
-    return localizer::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
-                                           0.5 * o.height - 0.5);
+    return geometry::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
+                                          0.5 * o.height - 0.5);
   }
-  return localizer::load_calibration(o.calibration, o.kalibr_camera);
+  return geometry::load_calibration(o.calibration, o.kalibr_camera);
 }
 
 int remaining_ms(Clock::time_point deadline, int cap_ms) {
@@ -200,7 +200,7 @@ std::string mavlink_detail(MavlinkSide& mav, int64_t own_pose_timeouts, int64_t 
 
 int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scenario) {
   common::StatusTracker& status = rt.status();
-  sim::SimCamera camera{make_camera(o.camera), localizer::Extrinsics::from_options(o.extrinsics), o.camera.rate_hz,
+  sim::SimCamera camera{make_camera(o.camera), geometry::Extrinsics::from_options(o.extrinsics), o.camera.rate_hz,
                         o.camera.camera_id};
 
   std::unique_ptr<sim::Renderer> renderer;

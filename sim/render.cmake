@@ -24,6 +24,6 @@ target_include_directories(wingman_sim_render
   PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
   PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src/render)
 target_link_libraries(wingman_sim_render
-  PUBLIC wingman::localizer wingman::common Eigen3::Eigen opencv_core
+  PUBLIC wingman::geometry wingman::common Eigen3::Eigen opencv_core
   PRIVATE PkgConfig::GLESV2 PkgConfig::WINGMAN_EGL assimp::assimp fmt::fmt)
 wingman_warnings(wingman_sim_render)

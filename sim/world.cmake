@@ -15,7 +15,7 @@ add_library(wingman_sim_world
 add_library(wingman::sim_world ALIAS wingman_sim_world)
 target_include_directories(wingman_sim_world PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 target_link_libraries(wingman_sim_world
-  PUBLIC wingman::sim_render wingman::localizer wingman::common wingman::mavlink wingman::lcmtypes Eigen3::Eigen opencv_core
+  PUBLIC wingman::sim_render wingman::geometry wingman::common wingman::mavlink wingman::lcmtypes Eigen3::Eigen opencv_core
          wingman::camera_driver  # PreviewOptions (the monitoring preview of the rendered camera)
   PRIVATE yaml-cpp fmt::fmt)
 wingman_warnings(wingman_sim_world)

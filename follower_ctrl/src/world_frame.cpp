@@ -30,7 +30,7 @@ OwnState own_state_from_message(const wingman::own_pose_t& m) {
   if (m.frame == wingman::own_pose_t::FRAME_NED) {
     s.p_body_in_world = swap_ned_enu(p);
     s.v_body_in_world = swap_ned_enu(v);
-    s.R_body_to_world = common::swap_ned_frd_enu_flu(R);
+    s.R_body_to_world = geometry::swap_ned_frd_enu_flu(R);
   } else {
     s.p_body_in_world = p;
     s.v_body_in_world = v;

@@ -2,6 +2,8 @@
 // The localizer's logic: boxes -> camera-frame measurements -> world frame -> tracks -> targets_t.
 #include "wingman/localizer/localizer.hpp"
 
+#include "wingman/localizer/camera_to_world.hpp"
+
 #include <fmt/format.h>
 #include <wingman/common/detection_class.hpp>
 
@@ -33,11 +35,11 @@ std::string NonDroneCounts::summary() const {
                      by_class_text);
 }
 
-Localizer::Localizer(const LocalizerOptions& options, CameraModel camera)
+Localizer::Localizer(const LocalizerOptions& options, geometry::CameraModel camera)
     : options_(options),
       cnn_relation_(BoxRelation::load(options.sphere.box_relation)),
       camera_(std::move(camera)),
-      extrinsics_(Extrinsics::from_options(options.extrinsics)),
+      extrinsics_(geometry::Extrinsics::from_options(options.extrinsics)),
       poses_(options.pose),
       tracker_(options.tracker),
       clock_(options.time),
@@ -107,7 +109,7 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
       ++result.non_drone.by_class[det.class_id];
       if (!track_every_class) continue;  // decided per box: never a target
     }
-    const PixelBox box{det.cx, det.cy, det.w, det.h};
+    const geometry::PixelBox box{det.cx, det.cy, det.w, det.h};
     const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d.image_width);
     LocalizeResult r = localize_box(box, camera_, options_.sphere, scale);
     if (!r.ok) {

@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 #include <wingman/common/config.hpp>
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -40,13 +40,13 @@ std::vector<std::string> PoseBufferOptions::validate() const {
   return p;
 }
 
-PoseSample pose_ned_frd_to_enu_flu(const PoseSample& ned_frd) {  // common/ned_enu.hpp: the one conversion
+PoseSample pose_ned_frd_to_enu_flu(const PoseSample& ned_frd) {  // geometry/ned_enu.hpp: the one conversion
   PoseSample out;
   out.utime = ned_frd.utime;
-  out.p_body_in_world = common::swap_ned_enu(ned_frd.p_body_in_world);
-  out.v_body_in_world = common::swap_ned_enu(ned_frd.v_body_in_world);
-  out.q_body_to_world = common::swap_ned_frd_enu_flu(ned_frd.q_body_to_world);
-  out.cov_p_body_in_world = common::swap_ned_enu_covariance(ned_frd.cov_p_body_in_world);
+  out.p_body_in_world = geometry::swap_ned_enu(ned_frd.p_body_in_world);
+  out.v_body_in_world = geometry::swap_ned_enu(ned_frd.v_body_in_world);
+  out.q_body_to_world = geometry::swap_ned_frd_enu_flu(ned_frd.q_body_to_world);
+  out.cov_p_body_in_world = geometry::swap_ned_enu_covariance(ned_frd.cov_p_body_in_world);
   out.var_rpy_body = ned_frd.var_rpy_body;
   return out;
 }

@@ -22,7 +22,7 @@
 // width only); lateral variance per axis ≈ l^2 (sigma_c^2 + sigma_e^2 / 2) / f^2.
 #include "wingman/localizer/sphere_localizer.hpp"
 
-#include "wingman/localizer/sphere_projection.hpp"
+#include <wingman/geometry/sphere_projection.hpp>
 #include "wingman/localizer/thesis_range.hpp"
 
 #include <fmt/format.h>
@@ -86,9 +86,10 @@ Eigen::Vector2d edge_point(int i, double e_i, double s) {
 
 /// Unit normal of the plane through the camera centre tangent to the back-projection of edge i at coordinate s,
 /// oriented so that the ray `interior` (the box centre's) is on its positive side.
-Eigen::Vector3d edge_normal(const CameraModel& camera, int i, double e_i, double s, const Eigen::Vector3d& interior) {
+Eigen::Vector3d edge_normal(const geometry::CameraModel& camera, int i, double e_i, double s,
+                            const Eigen::Vector3d& interior) {
   Eigen::Vector3d n;
-  if (camera.distortion() == Distortion::kNone) {
+  if (camera.distortion() == geometry::Distortion::kNone) {
     n = i < kTop ? Eigen::Vector3d(1, 0, -(e_i - camera.cx()) / camera.fx())
                  : Eigen::Vector3d(0, 1, -(e_i - camera.cy()) / camera.fy());
   } else {
@@ -181,12 +182,12 @@ struct ExactState {
   int iterations = 0;
 };
 
-Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole,
+Solution solve_exact(const geometry::CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole,
                      const EdgeRadii& radii, ExactState& state) {
   const Eigen::Vector2d centre = edges.centre();
   state.centre_ray = camera.unproject(centre);
   state.s = {centre.y(), centre.y(), centre.x(), centre.x()};
-  const bool distorted = camera.distortion() != Distortion::kNone;
+  const bool distorted = camera.distortion() != geometry::Distortion::kNone;
   Solution solution;
   for (state.iterations = 1; state.iterations <= 30; ++state.iterations) {
     for (int i = 0; i < 4; ++i)
@@ -199,7 +200,7 @@ Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::a
     // The silhouette of the sphere of the mean edge radius (the ratios differ by tens of percent at most, and the
     // tangency coordinate moves little with the radius).
     const double radius = 0.25 * (radii[0] + radii[1] + radii[2] + radii[3]);
-    const SphereImageBox image = project_sphere(camera, solution.p_in_cam, radius, 1e-3);
+    const geometry::SphereImageBox image = geometry::project_sphere(camera, solution.p_in_cam, radius, 1e-3);
     if (!image.valid) {
       solution.ok = false;
       solution.reason = "no sphere in front of the camera fits the box edges (" + image.reason + ")";
@@ -221,7 +222,7 @@ Solution solve_exact(const CameraModel& camera, const Edges& edges, const std::a
 
 /// The thesis's method: eq. 24 direction of the box centre, eq. 27-32 (or eq. 33) distance from the rays
 /// through the midpoints of the left and right edges (top and bottom if the width is cut).
-Solution solve_thesis(const CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole,
+Solution solve_thesis(const geometry::CameraModel& camera, const Edges& edges, const std::array<bool, 4>& whole,
                       const EdgeRadii& radii, bool eq33, int& edges_used) {
   Solution out;
   const Eigen::Vector2d centre = edges.centre();
@@ -252,7 +253,7 @@ Solution solve_thesis(const CameraModel& camera, const Edges& edges, const std::
   return out;
 }
 
-std::string check_box(const PixelBox& box, const CameraModel& camera) {
+std::string check_box(const geometry::PixelBox& box, const geometry::CameraModel& camera) {
   const std::pair<const char*, double> fields[] = {
       {"box.cx", box.cx}, {"box.cy", box.cy}, {"box.w", box.w}, {"box.h", box.h}};
   for (const auto& [name, value] : fields)
@@ -268,8 +269,8 @@ std::string check_box(const PixelBox& box, const CameraModel& camera) {
 
 }  // namespace
 
-LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, const SphereLocalizerOptions& options,
-                            const BoxScale& scale) {
+LocalizeResult localize_box(const geometry::PixelBox& box, const geometry::CameraModel& camera,
+                            const SphereLocalizerOptions& options, const BoxScale& scale) {
   LocalizeResult result;
   if (std::string bad = check_box(box, camera); !bad.empty()) {
     result.reason = std::move(bad);
@@ -280,8 +281,8 @@ LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, cons
   const double left = box.cx - 0.5 * box.w, right = box.cx + 0.5 * box.w;
   const double top = box.cy - 0.5 * box.h, bottom = box.cy + 0.5 * box.h;
   const std::array<bool, 4> whole = {left > m, right<camera.width() - m, top> m, bottom < camera.height() - m};
-  Edges edges{
-      {left - kBoxToCameraPixel, right - kBoxToCameraPixel, top - kBoxToCameraPixel, bottom - kBoxToCameraPixel}};
+  Edges edges{{left - geometry::kBoxToCameraPixel, right - geometry::kBoxToCameraPixel,
+               top - geometry::kBoxToCameraPixel, bottom - geometry::kBoxToCameraPixel}};
 
   const RangeMethod method = options.method();
   const EdgeRadii r = edge_radii(options.radius_m, scale);

@@ -2,7 +2,7 @@
 // Tracker-driven windows: a track's predicted box in the next image.
 #include "wingman/localizer/track_windows.hpp"
 
-#include "wingman/localizer/sphere_projection.hpp"
+#include <wingman/geometry/sphere_projection.hpp>
 
 #include <Eigen/Eigenvalues>
 #include <wingman/common/config.hpp>
@@ -21,14 +21,14 @@ std::vector<std::string> TrackWindowOptions::validate() const {
 }
 
 std::optional<wingman::track_window_t> predict_track_window(const TrackOutput& track, double radius_m,
-                                                            const CameraModel& camera, const CameraAtExposure& cam,
-                                                            const BoxRelation& relation) {
+                                                            const geometry::CameraModel& camera,
+                                                            const CameraAtExposure& cam, const BoxRelation& relation) {
   const Eigen::Matrix3d R_world_to_cam = cam.R_cam_to_world.transpose();
   const Eigen::Vector3d p_target_in_cam = R_world_to_cam * (track.p_target_in_world - cam.p_cam_in_world);
   const double radius = track.size_scale * radius_m;
-  const SphereImageBox sphere = project_sphere(camera, p_target_in_cam, radius);
+  const geometry::SphereImageBox sphere = geometry::project_sphere(camera, p_target_in_cam, radius);
   if (!sphere.valid) return std::nullopt;
-  const PixelBox sphere_box = sphere.pixel_box();
+  const geometry::PixelBox sphere_box = sphere.pixel_box();
   // The detector's box for this sphere: its ratios depend on the model box itself, reached in two steps.
   double w = sphere_box.w, h = sphere_box.h;
   for (int step = 0; step < 2; ++step) {

@@ -2,7 +2,7 @@
 // The setpoint stream's states, conversion to NED and clamps.
 #include "wingman/mavlink_bridge/offboard_streamer.hpp"
 
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 #include <wingman/own_pose_t.hpp>
 
@@ -190,7 +190,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
   t.coordinate_frame = mavlink::kMavFrameLocalNed;
   if (sp.mode == wingman::setpoint_t::MODE_POSITION) {
     Eigen::Vector3d p(sp.position[0], sp.position[1], sp.position[2]);
-    if (enu) p = common::swap_ned_enu(p);
+    if (enu) p = geometry::swap_ned_enu(p);
     const double up = std::clamp(-p.z(), o_.min_altitude_m, o_.max_altitude_m);
     if (up != -p.z())
       refuse("altitude_clamped", "a position setpoint outside limits.min_altitude_m..max_altitude_m was clamped");
@@ -198,7 +198,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
     t.x = static_cast<float>(p.x());
     t.y = static_cast<float>(p.y());
     t.z = static_cast<float>(p.z());
-    t.yaw = static_cast<float>(enu ? common::swap_ned_enu_yaw(sp.yaw) : sp.yaw);
+    t.yaw = static_cast<float>(enu ? geometry::swap_ned_enu_yaw(sp.yaw) : sp.yaw);
     t.type_mask =
         mavlink::kTypemaskVelocityIgnore | mavlink::kTypemaskAccelerationIgnore | mavlink::kTypemaskYawRateIgnore;
     last_v_ned_.setZero();
@@ -206,7 +206,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
     return t;
   }
   Eigen::Vector3d v(sp.velocity[0], sp.velocity[1], sp.velocity[2]);
-  if (enu) v = common::swap_ned_enu(v);
+  if (enu) v = geometry::swap_ned_enu(v);
   // Speeds.
   const double h = std::hypot(v.x(), v.y());
   if (h > o_.max_horizontal_speed_mps) {

@@ -3,14 +3,17 @@
 // model's box (the box relation looked up, per-edge radii), side by side; and one track's window for the next frame
 // (tracker-driven windows: up to windows.max_windows per detections message). Numbers: docs/benchmarks.md.
 #include <benchmark/benchmark.h>
+#include <wingman/geometry/sphere_projection.hpp>
 #include <wingman/localizer/box_relation.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
-#include <wingman/localizer/sphere_projection.hpp>
 #include <wingman/localizer/track_windows.hpp>
 
 namespace {
 
 using namespace wingman::localizer;
+using wingman::geometry::CameraModel;
+using wingman::geometry::PixelBox;
+using wingman::geometry::project_sphere;
 
 struct Scene {
   CameraModel camera = CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5);

@@ -10,8 +10,8 @@
 namespace {
 
 namespace sim = wingman::sim;
-using wingman::localizer::CameraModel;
-using wingman::localizer::Distortion;
+using wingman::geometry::CameraModel;
+using wingman::geometry::Distortion;
 
 /// A 1280x720 camera with a Raspberry Pi v2-like barrel lens.
 CameraModel camera() {

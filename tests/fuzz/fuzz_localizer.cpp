@@ -18,8 +18,8 @@ localizer::Localizer make(bool scale_to_image) {
   o.camera.focal_px = 400.0;
   o.camera.scale_to_image = scale_to_image;
   return localizer::Localizer(
-      o, localizer::CameraModel::pinhole(o.camera.width, o.camera.height, o.camera.focal_px, o.camera.focal_px,
-                                         0.5 * o.camera.width - 0.5, 0.5 * o.camera.height - 0.5));
+      o, geometry::CameraModel::pinhole(o.camera.width, o.camera.height, o.camera.focal_px, o.camera.focal_px,
+                                        0.5 * o.camera.width - 0.5, 0.5 * o.camera.height - 0.5));
 }
 
 }  // namespace

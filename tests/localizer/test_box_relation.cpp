@@ -4,9 +4,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <wingman/detector/model_loader.hpp>
+#include <wingman/geometry/sphere_projection.hpp>
 #include <wingman/localizer/box_relation.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
-#include <wingman/localizer/sphere_projection.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -15,6 +15,10 @@
 
 namespace wingman::localizer {
 namespace {
+
+using geometry::CameraModel;
+using geometry::project_sphere;
+using geometry::SphereImageBox;
 
 /// Two size bins (centres at 0.02 and 0.08 of the image width: geometric means of the edges) and two aspect bins.
 constexpr const char* kTwoByTwo = R"(box_relation:

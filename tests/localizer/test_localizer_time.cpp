@@ -12,7 +12,7 @@
 
 namespace {
 
-using wingman::localizer::CameraModel;
+using wingman::geometry::CameraModel;
 using wingman::localizer::Localizer;
 using wingman::localizer::LocalizerOptions;
 using wingman::localizer::LocalizerOutput;

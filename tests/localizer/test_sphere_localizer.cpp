@@ -9,9 +9,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <wingman/common/config.hpp>
-#include <wingman/localizer/calibration.hpp>
+#include <wingman/geometry/calibration.hpp>
+#include <wingman/geometry/sphere_projection.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
-#include <wingman/localizer/sphere_projection.hpp>
 #include <wingman/localizer/thesis_range.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -24,9 +24,16 @@
 namespace wingman::localizer {
 namespace {
 
-using testing::angle_deg;
-using testing::reference_sphere_box;
-using testing::test_cameras;
+using geometry::CameraModel;
+using geometry::Distortion;
+using geometry::load_calibration;
+using geometry::pixel_from_box;
+using geometry::PixelBox;
+using geometry::project_sphere;
+using geometry::SphereImageBox;
+using geometry::testing::angle_deg;
+using geometry::testing::reference_sphere_box;
+using geometry::testing::test_cameras;
 
 constexpr double kRadius = 0.348;  // DJI F450, the default
 
@@ -75,28 +82,15 @@ TEST(SphereLocalizerOptions, LoadsFromYamlAndRejectsUnknownKeys) {
                common::ConfigError);  // below the radius
 }
 
-// --- The forward model ---
+// --- The camera model against the thesis (the forward model: tests/geometry/test_sphere_projection.cpp) ---
 
-TEST(SphereProjection, MatchesTheIndependentOpenCvProjectionForEveryModel) {
-  for (const auto& [label, camera] : test_cameras()) {
-    for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(1.2, -0.5, 2.0),
-                                     Eigen::Vector3d(-0.9, 0.6, 1.5), Eigen::Vector3d(4, 2, 6)}) {
-      const SphereImageBox box = project_sphere(camera, p, kRadius);
-      ASSERT_TRUE(box.valid) << label << ": " << box.reason;
-      const testing::ReferenceBox ref = reference_sphere_box(camera, p, kRadius, 40000);
-      EXPECT_NEAR(box.u_min, ref.u_min, 1e-4) << label << " at " << p.transpose();
-      EXPECT_NEAR(box.u_max, ref.u_max, 1e-4) << label << " at " << p.transpose();
-      EXPECT_NEAR(box.v_min, ref.v_min, 1e-4) << label << " at " << p.transpose();
-      EXPECT_NEAR(box.v_max, ref.v_max, 1e-4) << label << " at " << p.transpose();
-    }
-  }
-}
-
-TEST(SphereProjection, RejectsASphereAroundOrBehindTheCamera) {
-  const CameraModel c = test_cameras()[0].camera;
-  EXPECT_FALSE(project_sphere(c, Eigen::Vector3d(0, 0, 0.3), kRadius).valid);
-  EXPECT_FALSE(project_sphere(c, Eigen::Vector3d(5, 0, 0.1), kRadius).valid);
-  EXPECT_FALSE(project_sphere(c, Eigen::Vector3d(0, 0, -5), kRadius).valid);
+TEST(CameraModel, UnprojectIsEquation24ForAPinhole) {
+  const CameraModel c = CameraModel::pinhole(1280, 720, 640, 600, 639.5, 359.5);
+  const Eigen::Vector2d uv(1100.25, 80.5);
+  const Eigen::Vector3d expected =
+      Eigen::Vector3d((uv.x() - c.cx()) / c.fx(), (uv.y() - c.cy()) / c.fy(), 1.0).normalized();
+  EXPECT_NEAR((c.unproject(uv) - expected).norm(), 0, 1e-15);
+  EXPECT_NEAR((thesis_direction(c.undistort_to_normalized(uv)) - expected).norm(), 0, 1e-15);
 }
 
 // --- Accuracy over the field of view ---
@@ -138,7 +132,7 @@ TEST(SphereLocalizerAccuracy, ExactMethodRecoversPositionsAcrossTheFieldOfViewFo
             ++skipped;
             continue;
           }
-          const testing::ReferenceBox ref = reference_sphere_box(camera, p_true, kRadius);
+          const geometry::testing::ReferenceBox ref = reference_sphere_box(camera, p_true, kRadius);
           const PixelBox box = ref.pixel_box();
           if (box.cx - box.w / 2 <= 1 || box.cx + box.w / 2 >= camera.width() - 1 || box.cy - box.h / 2 <= 1 ||
               box.cy + box.h / 2 >= camera.height() - 1) {

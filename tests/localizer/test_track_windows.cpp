@@ -15,9 +15,9 @@
 
 namespace {
 
+using wingman::geometry::CameraModel;
 using wingman::localizer::BoxRelation;
 using wingman::localizer::CameraAtExposure;
-using wingman::localizer::CameraModel;
 using wingman::localizer::Localizer;
 using wingman::localizer::LocalizerOptions;
 using wingman::localizer::predict_track_window;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The setpoint stream's safety rules: mode gating, the PX4 ready stream, hover then stop, re-engaging, clamps, rate.
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 #include <wingman/mavlink_bridge/offboard_streamer.hpp>
 #include <wingman/own_pose_t.hpp>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Own poses from ATTITUDE_QUATERNION + LOCAL_POSITION_NED and from ODOMETRY, and their ENU conversion.
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 #include <wingman/mavlink_bridge/own_pose_assembler.hpp>
 

@@ -2,7 +2,7 @@
 // The simulated autopilot's MAVLink rules: PX4 OFFBOARD gating and stream loss, ArduPilot GUIDED and its velocity
 // timeout, TIMESYNC, message intervals, commands, telemetry in NED.
 #include <gtest/gtest.h>
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 #include <wingman/mavlink/parser.hpp>
 #include <wingman/own_pose_t.hpp>

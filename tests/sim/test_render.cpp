@@ -4,7 +4,7 @@
 #include "test_render_support.hpp"
 
 #include <gtest/gtest.h>
-#include <wingman/localizer/calibration.hpp>
+#include <wingman/geometry/calibration.hpp>
 #include <wingman/sim/renderer.hpp>
 
 #include <fmt/format.h>
@@ -73,7 +73,7 @@ struct View {
 /// the border) and checks the truth box against the box of the drone's pixels: from the mask (pixel centres)
 /// always, from the colours when view.from_colour. Every edge within 1 px. Places whose drone would reach beyond
 /// the renderer's field of view (fisheyes wider than max_half_fov_deg) are left out.
-void expect_pixels_match_truth(const localizer::CameraModel& camera, const DroneModel& model, const View& view) {
+void expect_pixels_match_truth(const geometry::CameraModel& camera, const DroneModel& model, const View& view) {
   const RenderOptions options = flat_options();
   Renderer renderer(camera, options);
   const double down = view.look_down_deg * kPi / 180.0;
@@ -151,8 +151,8 @@ TEST(RendererPixels, DefaultQuadWithBladesMatchesTheMaskNearby) {
 TEST(RendererPixels, RealCalibrationBoxMatchesPixels) {
   const std::string missing = test::missing_shared("calibrations/raspicam_v2_1280x720.yaml");
   if (!missing.empty()) GTEST_SKIP() << "real calibrations not available: " << missing << " is absent";
-  const localizer::CameraModel camera =
-      localizer::load_calibration(test::shared_path("calibrations/raspicam_v2_1280x720.yaml"));
+  const geometry::CameraModel camera =
+      geometry::load_calibration(test::shared_path("calibrations/raspicam_v2_1280x720.yaml"));
   const DroneModel model = DroneModel::procedural(solid_red_drone());
   expect_pixels_match_truth(camera, model, View{9.0, true, 0.0, 0.6, 5});
 }
@@ -162,7 +162,7 @@ TEST(RendererPixels, RealFisheyeCalibrationBoxMatchesPixelsWithinItsRenderedFiel
   const std::string name = "calibrations/vswarm_firefly_s_720x540_camera_info.yaml";
   const std::string missing = test::missing_shared(name);
   if (!missing.empty()) GTEST_SKIP() << "real calibrations not available: " << missing << " is absent";
-  const localizer::CameraModel camera = localizer::load_calibration(test::shared_path(name));
+  const geometry::CameraModel camera = geometry::load_calibration(test::shared_path(name));
   const DroneModel model = DroneModel::procedural(solid_red_drone());
   expect_pixels_match_truth(camera, model, View{0.012 * camera.fx(), true, 0.0, 0.6, 6});
 }
@@ -170,7 +170,7 @@ TEST(RendererPixels, RealFisheyeCalibrationBoxMatchesPixelsWithinItsRenderedFiel
 TEST(RendererPixels, SharedAirframeMeshesMatchTheirTruthBoxes) {
   const std::string missing = test::missing_shared("meshes");
   if (!missing.empty()) GTEST_SKIP() << "airframe meshes not available: " << missing << " is absent";
-  const localizer::CameraModel camera = test::strong_radtan();
+  const geometry::CameraModel camera = test::strong_radtan();
   for (const char* name : {"dji_f450.glb", "holybro_x500v2.glb", "tarot_t650.glb", "3dr_iris.glb"}) {
     DroneSpec spec;
     spec.frame = "mesh";
@@ -183,7 +183,7 @@ TEST(RendererPixels, SharedAirframeMeshesMatchTheirTruthBoxes) {
 }
 
 TEST(Renderer, NearerDroneOccludesAndHidesAFartherOne) {
-  const localizer::CameraModel camera = test::pinhole();
+  const geometry::CameraModel camera = test::pinhole();
   Renderer renderer(camera, flat_options());
   const DroneModel model = DroneModel::procedural(DroneSpec{});
   DroneSpec block;  // a drone with a 0.8 m cube for a body: solid enough to hide another
@@ -216,7 +216,7 @@ TEST(Renderer, NearerDroneOccludesAndHidesAFartherOne) {
 }
 
 TEST(Renderer, DroneBehindTheCameraOrOutOfViewIsNotVisible) {
-  const localizer::CameraModel camera = test::pinhole();
+  const geometry::CameraModel camera = test::pinhole();
   Renderer renderer(camera, flat_options());
   const DroneModel model = DroneModel::procedural(DroneSpec{});
   const Eigen::Isometry3d T_cam_to_world = look_at({0, 0, 10}, {0, 10, 10});
@@ -281,7 +281,7 @@ TEST(Renderer, ExposureGainScalesLinearLight) {
 }
 
 TEST(Renderer, MotionBlurSmearsAlongTheMotionOnly) {
-  const localizer::CameraModel camera = test::pinhole();
+  const geometry::CameraModel camera = test::pinhole();
   RenderOptions options = flat_options();
   const DroneModel model = DroneModel::procedural(DroneSpec{});
   const Eigen::Isometry3d T_cam_to_world = look_at({0, 0, 10}, {0, 10, 10});

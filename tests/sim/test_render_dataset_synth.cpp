@@ -114,11 +114,11 @@ TEST(DatasetSynth, WritesAYoloDatasetWhoseLabelsAreTheTruthBoxesOfItsMetadata) {
       const nlohmann::json meta = read_meta(request.out_dir + "/meta/" + split + "/" + stem.string() + ".json");
       const nlohmann::json& c = meta.at("camera");
       const std::string model = c.at("distortion_model").get<std::string>();
-      const localizer::Distortion distortion =
-          model == "equidistant" ? localizer::Distortion::kEquidistant : localizer::Distortion::kRadTan;
-      const localizer::CameraModel camera(320, 240, c.at("fx").get<double>(), c.at("fy").get<double>(),
-                                          c.at("cx").get<double>(), c.at("cy").get<double>(), distortion,
-                                          c.at("coefficients").get<std::vector<double>>());
+      const geometry::Distortion distortion =
+          model == "equidistant" ? geometry::Distortion::kEquidistant : geometry::Distortion::kRadTan;
+      const geometry::CameraModel camera(320, 240, c.at("fx").get<double>(), c.at("fy").get<double>(),
+                                         c.at("cx").get<double>(), c.at("cy").get<double>(), distortion,
+                                         c.at("coefficients").get<std::vector<double>>());
       const nlohmann::json& target = meta.at("target");
       const sim::DroneSpec spec = spec_from(target.at("spec"));
       const sim::DroneModel drone = sim::DroneModel::from_spec(spec);

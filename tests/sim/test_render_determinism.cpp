@@ -33,7 +33,7 @@ bool same(const cv::Mat& a, const cv::Mat& b) {
 TEST(RendererDeterminism, SameSeedSamePixelsInOneRendererAndInTwo) {
   RenderOptions options;  // the default scene with sensor noise
   options.exposure_jitter = 0.2;
-  const localizer::CameraModel camera = test::strong_radtan();
+  const geometry::CameraModel camera = test::strong_radtan();
   Renderer first(camera, options);
   const DroneModel quad = DroneModel::procedural(DroneSpec{});
   DroneSpec hex;

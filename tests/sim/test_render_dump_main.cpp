@@ -15,8 +15,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const localizer::CameraModel camera(1280, 720, 820.0, 815.0, 645.3, 355.8, localizer::Distortion::kRadTan,
-                                        {-0.32, 0.11, 0.0012, -0.0009, -0.015});
+    const geometry::CameraModel camera(1280, 720, 820.0, 815.0, 645.3, 355.8, geometry::Distortion::kRadTan,
+                                       {-0.32, 0.11, 0.0012, -0.0009, -0.015});
     sim::RenderOptions options;
     options.exposure_jitter = 0.2;
     sim::Renderer renderer(camera, options);

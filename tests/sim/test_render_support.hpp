@@ -4,7 +4,7 @@
 
 #include "test_support.hpp"
 
-#include <wingman/localizer/camera_model.hpp>
+#include <wingman/geometry/camera_model.hpp>
 #include <wingman/sim/renderer.hpp>
 
 #include <Eigen/Geometry>
@@ -25,20 +25,20 @@ inline std::string missing_shared(const std::string& sub) {
 inline std::string shared_path(const std::string& sub) { return wingman::testing::source_path("../shared/" + sub); }
 
 /// A 1280x720 plumb_bob camera with strong barrel distortion (corners pulled in by ~60 px).
-inline localizer::CameraModel strong_radtan() {
-  return localizer::CameraModel(1280, 720, 820.0, 815.0, 645.3, 355.8, localizer::Distortion::kRadTan,
-                                {-0.32, 0.11, 0.0012, -0.0009, -0.015}, "strong_radtan");
+inline geometry::CameraModel strong_radtan() {
+  return geometry::CameraModel(1280, 720, 820.0, 815.0, 645.3, 355.8, geometry::Distortion::kRadTan,
+                               {-0.32, 0.11, 0.0012, -0.0009, -0.015}, "strong_radtan");
 }
 
 /// A 1280x720 equidistant (fisheye) camera, about 130 degrees across.
-inline localizer::CameraModel fisheye() {
-  return localizer::CameraModel(1280, 720, 560.0, 560.0, 639.5, 359.5, localizer::Distortion::kEquidistant,
-                                {0.02, -0.01, 0.003, -0.0005}, "fisheye");
+inline geometry::CameraModel fisheye() {
+  return geometry::CameraModel(1280, 720, 560.0, 560.0, 639.5, 359.5, geometry::Distortion::kEquidistant,
+                               {0.02, -0.01, 0.003, -0.0005}, "fisheye");
 }
 
 /// An ideal 1280x720 pinhole, 70 degrees across.
-inline localizer::CameraModel pinhole() {
-  return localizer::CameraModel::pinhole(1280, 720, 914.0, 914.0, 639.5, 359.5, "pinhole");
+inline geometry::CameraModel pinhole() {
+  return geometry::CameraModel::pinhole(1280, 720, 914.0, 914.0, 639.5, 359.5, "pinhole");
 }
 
 /// The camera-to-world pose of a camera at `eye` looking at `target` (world ENU), image x level with the horizon.
@@ -57,7 +57,7 @@ inline Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector
 }
 
 /// World position that the camera sees at calibration pixel `uv`, `range` metres away.
-inline Eigen::Vector3d world_at_pixel(const localizer::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
+inline Eigen::Vector3d world_at_pixel(const geometry::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
                                       const Eigen::Vector2d& uv, double range) {
   return T_cam_to_world * (camera.unproject(uv) * range);
 }

@@ -14,7 +14,7 @@ namespace {
 using test::look_at;
 
 struct Scene {
-  localizer::CameraModel camera = test::pinhole();
+  geometry::CameraModel camera = test::pinhole();
   DroneModel model = DroneModel::procedural(DroneSpec{});
   Eigen::Isometry3d T_cam_to_world = look_at({0, 0, 10}, {0, 10, 10});
 };
@@ -90,8 +90,8 @@ TEST(TruthBox, BehindOrBesideTheCameraIsNotVisible) {
 TEST(TruthBox, RadTanFoldBackIsOutsideTheFieldOfView) {
   // The Raspberry Pi v2 lens: r_d = r (1 + k1 r^2 + k2 r^4) stops growing at r ~ 1.0 and folds back into the image
   // beyond it (r = 1.5 lands on the other side of the centre).
-  const localizer::CameraModel camera(1280, 720, 1276.7, 1274.3, 634.9, 379.8, localizer::Distortion::kRadTan,
-                                      {0.1465, -0.2847, 0.0013, -0.0043, 0.0});
+  const geometry::CameraModel camera(1280, 720, 1276.7, 1274.3, 634.9, 379.8, geometry::Distortion::kRadTan,
+                                     {0.1465, -0.2847, 0.0013, -0.0043, 0.0});
   const TruthBoxProjector projector(camera);
   const Eigen::Vector3d folded(1.5, 0.0, 1.0);
   ASSERT_GT(camera.project(folded).x(), 0.0);

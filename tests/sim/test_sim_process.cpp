@@ -91,8 +91,8 @@ double fake_follower_velocity(int64_t utime) { return utime < kStart + 500000 ? 
 /// Own poses the library gives for the tiny scenario with the fake follower's setpoint after every frame.
 std::vector<std::vector<uint8_t>> library_own_poses(const std::string& scenario_path) {
   wingman::sim::Simulator sim(wingman::sim::load_scenario(scenario_path),
-                              {wingman::localizer::CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5),
-                               wingman::localizer::Extrinsics::from_options({}), 30.0, 0});
+                              {wingman::geometry::CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5),
+                               wingman::geometry::Extrinsics::from_options({}), 30.0, 0});
   std::vector<std::vector<uint8_t>> out;
   while (!sim.done()) {
     const auto f = sim.step();

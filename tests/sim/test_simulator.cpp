@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <wingman/common/message_validation.hpp>
-#include <wingman/localizer/sphere_projection.hpp>
+#include <wingman/geometry/sphere_projection.hpp>
 #include <wingman/sim/scenario.hpp>
 #include <wingman/sim/simulator.hpp>
 #include <wingman/sim/truth_detections.hpp>
@@ -27,8 +27,8 @@ constexpr int64_t kStart = 1767225600000000;
 
 /// The localizer's built-in camera (config/localizer.yaml): pinhole 1280x720, f = 640 px, looking along body +x.
 SimCamera default_camera(double rate_hz = 30.0) {
-  return SimCamera{wingman::localizer::CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5),
-                   wingman::localizer::Extrinsics::from_options({}), rate_hz, 0};
+  return SimCamera{wingman::geometry::CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5),
+                   wingman::geometry::Extrinsics::from_options({}), rate_hz, 0};
 }
 
 Scenario scenario(const std::string& name) {
@@ -300,7 +300,7 @@ TEST(Simulator, SameScenarioAndSetpointsGiveTheSameTruthBitForBit) {
   EXPECT_NE(a, c);
 }
 
-const wingman::localizer::CameraModel kCamera = default_camera().model;
+const wingman::geometry::CameraModel kCamera = default_camera().model;
 
 TEST(TruthDetections, VisibleBoxesOfThisCameraBecomeGroundTruthDetections) {
   wingman::ground_truth_t t{};
@@ -389,7 +389,7 @@ TEST(TruthDetections, SphereBoxesAreTheBoundingSpheresExactBoxWhichTheLocalizerI
   ASSERT_EQ(d.num_detections, 1);
   const auto& leader = truth_of(f, 1);
   const Eigen::Vector3d p_in_cam = f.T_cam_to_world.inverse() * vec(leader.p_body_in_world);
-  const auto expected = wingman::localizer::project_sphere(kCamera, p_in_cam, leader.bounding_radius).pixel_box();
+  const auto expected = wingman::geometry::project_sphere(kCamera, p_in_cam, leader.bounding_radius).pixel_box();
   EXPECT_GT(std::abs(expected.cx - 640), 20.0);  // off-axis
   EXPECT_NEAR(d.detections[0].cx, expected.cx, 1e-3);
   EXPECT_NEAR(d.detections[0].cy, expected.cy, 1e-3);

@@ -80,7 +80,7 @@ TEST(SequenceEvalOptions, DefaultsAreValidOnceDataIsGivenAndBadFieldsAreNamed) {
 TEST(NominalPinhole, FocalLengthFromTheFieldOfView) {
   // 90 deg over 640 px: f = 320 / tan(45 deg) = 320 px; 24 deg: 320 / tan(12 deg) = 1505.48 px.
   EXPECT_NEAR(nominal_pinhole(640, 512, 90.0).fx(), 320.0, 1e-9);
-  const localizer::CameraModel c = nominal_pinhole(640, 512, 24.0);
+  const geometry::CameraModel c = nominal_pinhole(640, 512, 24.0);
   EXPECT_NEAR(c.fx(), 1505.4816, 1e-4);
   EXPECT_NEAR(c.fy(), c.fx(), 1e-12);
   EXPECT_EQ(c.width(), 640);

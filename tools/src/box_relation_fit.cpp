@@ -10,7 +10,7 @@
 #include <wingman/detector/model_loader.hpp>
 #include <wingman/detector/sized_detector.hpp>
 #include <wingman/detector/track_windows.hpp>
-#include <wingman/localizer/camera_model.hpp>
+#include <wingman/geometry/camera_model.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
 
 #include <fmt/format.h>
@@ -39,15 +39,15 @@ struct Sample {
   double det_w = 0, det_h = 0, image_w = 0;
   double sphere_w = 0, sphere_h = 0;
   double width_ratio = 0, height_ratio = 0;  // detected / sphere box
-  localizer::PixelBox det;
-  std::shared_ptr<const localizer::CameraModel> camera;
+  geometry::PixelBox det;
+  std::shared_ptr<const geometry::CameraModel> camera;
 };
 
-localizer::Distortion distortion_of(const std::string& name, const std::string& file) {
-  if (name == "none") return localizer::Distortion::kNone;
-  if (name == "plumb_bob") return localizer::Distortion::kRadTan;
-  if (name == "rational_polynomial") return localizer::Distortion::kRationalPolynomial;
-  if (name == "equidistant") return localizer::Distortion::kEquidistant;
+geometry::Distortion distortion_of(const std::string& name, const std::string& file) {
+  if (name == "none") return geometry::Distortion::kNone;
+  if (name == "plumb_bob") return geometry::Distortion::kRadTan;
+  if (name == "rational_polynomial") return geometry::Distortion::kRationalPolynomial;
+  if (name == "equidistant") return geometry::Distortion::kEquidistant;
   throw std::runtime_error(fmt::format("{}: camera.distortion_model '{}' is not one the localizer knows", file, name));
 }
 
@@ -73,7 +73,7 @@ RangeErrorStats stats_of(const std::vector<double>& e) {
   return s;
 }
 
-localizer::PixelBox read_box(const nlohmann::json& n) {
+geometry::PixelBox read_box(const nlohmann::json& n) {
   return {n.at("cx").get<double>(), n.at("cy").get<double>(), n.at("w").get<double>(), n.at("h").get<double>()};
 }
 
@@ -203,7 +203,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   if (dopt.windows.enabled)
     windows = std::make_unique<detector::WindowDetector>(dopt.windows, dopt.detection,
                                                          detector::load_model(dopt.cfg, dopt.weights), make_backend);
-  auto detect = [&](const cv::Mat& bgr, const localizer::PixelBox& outline) {
+  auto detect = [&](const cv::Mat& bgr, const geometry::PixelBox& outline) {
     std::vector<detector::Box> boxes = pipeline.detect(bgr);
     if (!windows) return boxes;
     wingman::track_windows_t m{};
@@ -245,7 +245,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
         continue;
       }
       const int W = meta.at("width").get<int>(), H = meta.at("height").get<int>();
-      const localizer::PixelBox sphere = read_box(meta["sphere_box"]), outline = read_box(meta["box"]);
+      const geometry::PixelBox sphere = read_box(meta["sphere_box"]), outline = read_box(meta["box"]);
       if (sphere.cx - sphere.w / 2 < 1 || sphere.cx + sphere.w / 2 > W - 1 || sphere.cy - sphere.h / 2 < 1 ||
           sphere.cy + sphere.h / 2 > H - 1) {
         ++summary.skipped_truncated;  // the sphere's box leaves the image: no whole ratio
@@ -253,7 +253,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       }
       const nlohmann::json& cam = meta.at("camera");
       const std::string distortion = cam.at("distortion_model").get<std::string>();
-      auto camera = std::make_shared<const localizer::CameraModel>(
+      auto camera = std::make_shared<const geometry::CameraModel>(
           W, H, cam.at("fx").get<double>(), cam.at("fy").get<double>(), cam.at("cx").get<double>(),
           cam.at("cy").get<double>(), distortion_of(distortion, file),
           distortion == "none" ? std::vector<double>{} : cam.at("coefficients").get<std::vector<double>>());
@@ -261,7 +261,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       const cv::Mat bgr = cv::imread(image, cv::IMREAD_COLOR);
       if (bgr.empty()) throw std::runtime_error(image + ": cannot read the image");
       double best = 0;
-      localizer::PixelBox det;
+      geometry::PixelBox det;
       detector::Box truth;
       truth.cx = static_cast<float>(outline.cx), truth.cy = static_cast<float>(outline.cy);
       truth.w = static_cast<float>(outline.w), truth.h = static_cast<float>(outline.h);

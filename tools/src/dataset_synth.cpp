@@ -10,8 +10,8 @@
 #include <wingman/common/config.hpp>
 #include <wingman/common/json.hpp>
 #include <wingman/common/progress.hpp>
-#include <wingman/localizer/camera_model.hpp>
-#include <wingman/localizer/sphere_projection.hpp>
+#include <wingman/geometry/camera_model.hpp>
+#include <wingman/geometry/sphere_projection.hpp>
 #include <wingman/sim/drone_model.hpp>
 #include <wingman/sim/renderer.hpp>
 #include <wingman/sim/truth_box.hpp>
@@ -63,7 +63,7 @@ const std::vector<Colour> kAirframe = {{0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}, {
                                        {0.1, 0.5, 0.2},    {0.03, 0.74, 1.0}};
 
 // A random calibrated camera: field of view, principal point, and a radtan or equidistant lens.
-localizer::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, int k) {
+geometry::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, int k) {
   const double half_fov = 0.5 * rng.uniform(c.hfov_min_deg, c.hfov_max_deg) * kDeg;
   const double cx = 0.5 * c.width - 0.5 + rng.normal() * 0.01 * c.width;
   const double cy = 0.5 * c.height - 0.5 + rng.normal() * 0.01 * c.height;
@@ -71,8 +71,8 @@ localizer::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, i
   const std::string name = fmt::format("synth_camera_{}", k);
   if (rng.chance(c.fisheye_fraction)) {
     const double f = 0.5 * c.width / half_fov;  // equidistant: r = f theta at the image edge
-    return localizer::CameraModel(
-        c.width, c.height, f, f * aspect, cx, cy, localizer::Distortion::kEquidistant,
+    return geometry::CameraModel(
+        c.width, c.height, f, f * aspect, cx, cy, geometry::Distortion::kEquidistant,
         {rng.uniform(-0.04, 0.04), rng.uniform(-0.01, 0.01), rng.uniform(-0.003, 0.003), rng.uniform(-0.001, 0.001)},
         name);
   }
@@ -80,8 +80,8 @@ localizer::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, i
   // Focal length from the field of view of the distorted image edge: r_d = r (1 + k1 r^2 + k2 r^4).
   const double r = std::tan(half_fov), k2 = -0.3 * k1 + rng.uniform(-0.02, 0.02);
   const double f = 0.5 * c.width / (r * std::max(0.3, 1.0 + k1 * r * r + k2 * r * r * r * r));
-  return localizer::CameraModel(c.width, c.height, f, f * aspect, cx, cy, localizer::Distortion::kRadTan,
-                                {k1, k2, rng.uniform(-0.002, 0.002), rng.uniform(-0.002, 0.002), 0.0}, name);
+  return geometry::CameraModel(c.width, c.height, f, f * aspect, cx, cy, geometry::Distortion::kRadTan,
+                               {k1, k2, rng.uniform(-0.002, 0.002), rng.uniform(-0.002, 0.002), 0.0}, name);
 }
 
 }  // namespace
@@ -225,7 +225,7 @@ std::vector<std::string> mesh_files(const std::vector<std::string>& args) {
 
 // One camera of the pool.
 struct Camera {
-  localizer::CameraModel model;
+  geometry::CameraModel model;
   std::unique_ptr<sim::Renderer> renderer;
   sim::TruthBoxProjector field_of_view;
 };
@@ -299,11 +299,11 @@ namespace {
 /// The "sphere_box" of an image's metadata: the exact box of the target's bounding sphere (the box a sphere
 /// detector would draw, not clipped to the image; `wingman model box-relation` relates a model's boxes to it), or
 /// null when the sphere reaches behind the camera.
-common::Json sphere_box_json(const localizer::CameraModel& camera, const Eigen::Vector3d& p_target_in_cam,
+common::Json sphere_box_json(const geometry::CameraModel& camera, const Eigen::Vector3d& p_target_in_cam,
                              double radius_m) {
-  const localizer::SphereImageBox s = localizer::project_sphere(camera, p_target_in_cam, radius_m);
+  const geometry::SphereImageBox s = geometry::project_sphere(camera, p_target_in_cam, radius_m);
   if (!s.valid) return nullptr;
-  const localizer::PixelBox b = s.pixel_box();
+  const geometry::PixelBox b = s.pixel_box();
   return {{"cx", b.cx}, {"cy", b.cy}, {"w", b.w}, {"h", b.h}};
 }
 }  // namespace
@@ -336,7 +336,7 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
   std::vector<Camera> cameras;
   for (int k = 0; k < config.cameras; ++k) {
     Random rng(request.seed, kCameraStream, static_cast<uint64_t>(k));
-    localizer::CameraModel model = random_camera(config, rng, k);
+    geometry::CameraModel model = random_camera(config, rng, k);
     auto renderer = std::make_unique<sim::Renderer>(model, config.render);
     cameras.push_back(
         Camera{model, std::move(renderer), sim::TruthBoxProjector(model, config.render.max_half_fov_deg)});
@@ -419,7 +419,7 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
       label.h = static_cast<float>(box.h / config.height);
       training::write_yolo_labels((out / "labels" / split / (name + ".txt")).string(), {label});
 
-      const localizer::CameraModel& cam = camera.model;
+      const geometry::CameraModel& cam = camera.model;
       const Eigen::Vector3d p_target_in_cam = T_cam_to_world.inverse() * target.T_body_to_world.translation();
       const std::string meta_path = (out / "meta" / split / (name + ".json")).string();
       common::Json j;

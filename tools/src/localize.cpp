@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 #include <wingman/common/json.hpp>
-#include <wingman/localizer/calibration.hpp>
+#include <wingman/geometry/calibration.hpp>
 
 #include <cmath>
 #include <exception>
@@ -46,13 +46,13 @@ int run_localize(const LocalizeToolOptions& o, std::ostream& out, std::ostream& 
   }
 
   // Calibration.
-  std::optional<localizer::CameraModel> loaded;
+  std::optional<geometry::CameraModel> loaded;
   try {
-    loaded = localizer::load_calibration(o.calibration, o.kalibr_camera);
-  } catch (const localizer::CalibrationError& e) {
+    loaded = geometry::load_calibration(o.calibration, o.kalibr_camera);
+  } catch (const geometry::CalibrationError& e) {
     return fail(1, e.what());
   }
-  localizer::CameraModel camera = *loaded;
+  geometry::CameraModel camera = *loaded;
   if (image_w > 0) {
     if (const std::string bad = camera.check_image_size(image_w, image_h); !bad.empty()) {
       if (!o.scale_calibration) return fail(1, fmt::format("{}: {}", o.calibration, bad));
@@ -61,7 +61,7 @@ int run_localize(const LocalizeToolOptions& o, std::ostream& out, std::ostream& 
   }
 
   // Localization.
-  const localizer::PixelBox box{o.box[0], o.box[1], o.box[2], o.box[3]};
+  const geometry::PixelBox box{o.box[0], o.box[1], o.box[2], o.box[3]};
   const localizer::LocalizeResult r = localizer::localize_box(box, camera, o.localizer);
   if (!r.ok) return fail(1, r.reason);
   const localizer::CameraMeasurement& m = r.measurement;

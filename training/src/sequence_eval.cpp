@@ -150,7 +150,7 @@ std::vector<std::string> SequenceEvalOptions::validate() const {
   return p;
 }
 
-localizer::CameraModel nominal_pinhole(int width, int height, double hfov_deg) {
+geometry::CameraModel nominal_pinhole(int width, int height, double hfov_deg) {
   if (width < 1 || height < 1)
     throw std::invalid_argument(fmt::format("nominal_pinhole: image size {}x{}: must be positive", width, height));
   if (!(hfov_deg > 0.0 && hfov_deg < 180.0))
@@ -158,14 +158,14 @@ localizer::CameraModel nominal_pinhole(int width, int height, double hfov_deg) {
   const double f = 0.5 * width / std::tan(0.5 * hfov_deg * kPi / 180.0);
   // Principal point at the image centre in the calibration convention (pixel centres at integers), as
   // wingman-localizer's built-in pinhole.
-  return localizer::CameraModel::pinhole(width, height, f, f, 0.5 * width - 0.5, 0.5 * height - 0.5,
-                                         fmt::format("nominal pinhole {}x{}, HFOV {} deg", width, height, hfov_deg));
+  return geometry::CameraModel::pinhole(width, height, f, f, 0.5 * width - 0.5, 0.5 * height - 0.5,
+                                        fmt::format("nominal pinhole {}x{}, HFOV {} deg", width, height, hfov_deg));
 }
 
 // ---------------------------------------------------------------------------------------------------------------------
 // ClipTracker
 
-ClipTracker::ClipTracker(const localizer::LocalizerOptions& options, localizer::CameraModel camera, double fps)
+ClipTracker::ClipTracker(const localizer::LocalizerOptions& options, geometry::CameraModel camera, double fps)
     : options_(options), camera_(std::move(camera)), fps_(fps) {
   if (!(fps > 0.0) || !std::isfinite(fps))
     throw std::invalid_argument(fmt::format("ClipTracker: fps = {}: must be > 0", fps));
@@ -221,7 +221,7 @@ void ClipTracker::add_frame(int frame_index, const std::vector<detector::Box>& b
   std::vector<Eigen::Vector3d> p_in_cam(drone.size(),
                                         Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (size_t i = 0; i < drone.size(); ++i) {
-    const localizer::PixelBox box{drone[i]->cx, drone[i]->cy, drone[i]->w, drone[i]->h};
+    const geometry::PixelBox box{drone[i]->cx, drone[i]->cy, drone[i]->w, drone[i]->h};
     const localizer::LocalizeResult r = localizer::localize_box(
         box, camera_, options_.sphere, relation_.at(box.w, box.h, static_cast<double>(camera_.width())));
     if (r.ok && r.measurement.range_valid) p_in_cam[i] = r.measurement.p_target_in_cam;
@@ -642,7 +642,7 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
     std::unique_ptr<ClipTracker> tracker;
     // The clip's tracker, on the nominal pinhole of its frame size (the first clip's focal length is reported).
     const auto start_tracker = [&](int width, int height, double fps) {
-      const localizer::CameraModel camera = nominal_pinhole(width, height, o.hfov_deg);
+      const geometry::CameraModel camera = nominal_pinhole(width, height, o.hfov_deg);
       if (result.focal_px == 0) result.focal_px = camera.fx();
       return std::make_unique<ClipTracker>(loc_options, camera, fps);
     };

@@ -14,7 +14,7 @@ constexpr double kToleranceNormalized = 1e-11;  // Newton's stopping residual, n
 constexpr double kMaxReprojectionPx = 1e-6;
 
 // Solves distort_normalized(xy) = target from `xy`; true on convergence.
-bool newton(const localizer::CameraModel& camera, const Eigen::Vector2d& target, Eigen::Vector2d& xy) {
+bool newton(const geometry::CameraModel& camera, const Eigen::Vector2d& target, Eigen::Vector2d& xy) {
   constexpr double h = 1e-7;
   for (int iteration = 0; iteration < 20; ++iteration) {
     const Eigen::Vector2d f = camera.distort_normalized(xy);
@@ -33,7 +33,7 @@ bool newton(const localizer::CameraModel& camera, const Eigen::Vector2d& target,
 
 }  // namespace
 
-LensMap compute_lens_map(const localizer::CameraModel& camera, const TruthBoxProjector& field_of_view) {
+LensMap compute_lens_map(const geometry::CameraModel& camera, const TruthBoxProjector& field_of_view) {
   LensMap map;
   map.width = camera.width();
   map.height = camera.height();
@@ -43,7 +43,7 @@ LensMap compute_lens_map(const localizer::CameraModel& camera, const TruthBoxPro
   map.min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   map.max = -map.min;
 
-  const bool distorted = camera.distortion() != localizer::Distortion::kNone;
+  const bool distorted = camera.distortion() != geometry::Distortion::kNone;
   Eigen::Vector2d row_start = Eigen::Vector2d::Zero();
   bool have_row_start = false;
   for (int j = 0; j < rows; ++j) {
@@ -51,7 +51,7 @@ LensMap compute_lens_map(const localizer::CameraModel& camera, const TruthBoxPro
     bool have_guess = have_row_start;
     bool first_in_row = true;
     for (int i = 0; i < cols; ++i) {
-      const Eigen::Vector2d uv(i - localizer::kBoxToCameraPixel, j - localizer::kBoxToCameraPixel);
+      const Eigen::Vector2d uv(i - geometry::kBoxToCameraPixel, j - geometry::kBoxToCameraPixel);
       const Eigen::Vector2d target((uv.x() - camera.cx()) / camera.fx(), (uv.y() - camera.cy()) / camera.fy());
       Eigen::Vector2d xy = target;
       bool ok = true;

@@ -4,7 +4,7 @@
 
 #include "wingman/sim/truth_box.hpp"
 
-#include <wingman/localizer/camera_model.hpp>
+#include <wingman/geometry/camera_model.hpp>
 
 #include <Eigen/Core>
 
@@ -27,6 +27,6 @@ struct LensMap {
 
 /// Computes the map: Newton's method on CameraModel::distort_normalized, warm-started from the neighbouring corner,
 /// falling back to CameraModel::undistort_to_normalized; every kept corner re-projects to within 1e-6 px.
-LensMap compute_lens_map(const localizer::CameraModel& camera, const TruthBoxProjector& field_of_view);
+LensMap compute_lens_map(const geometry::CameraModel& camera, const TruthBoxProjector& field_of_view);
 
 }  // namespace wingman::sim::detail

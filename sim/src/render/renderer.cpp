@@ -99,7 +99,7 @@ struct Posed {
 }  // namespace
 
 struct Renderer::Impl {
-  localizer::CameraModel camera;
+  geometry::CameraModel camera;
   RenderOptions options;
   TruthBoxProjector projector;
   detail::EglContext egl;
@@ -127,7 +127,7 @@ struct Renderer::Impl {
   uint64_t frame = 0;
   cv::Mat rgba;
 
-  Impl(const localizer::CameraModel& cam, const RenderOptions& opts)
+  Impl(const geometry::CameraModel& cam, const RenderOptions& opts)
       : camera(cam), options(checked(opts)), projector(cam, opts.max_half_fov_deg) {
     drone_program.emplace("drone layer", source(detail::kDroneVertexShader, ""),
                           source(detail::kDroneFragmentShader, ""));
@@ -779,7 +779,7 @@ struct Renderer::Impl {
   }
 };
 
-Renderer::Renderer(const localizer::CameraModel& camera, const RenderOptions& options)
+Renderer::Renderer(const geometry::CameraModel& camera, const RenderOptions& options)
     : impl_(std::make_unique<Impl>(camera, options)) {}
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
@@ -791,7 +791,7 @@ RenderResult Renderer::render(const Eigen::Isometry3d& T_cam_to_world, const std
 }
 
 void Renderer::set_options(const RenderOptions& options) { impl_->set_options(options); }
-const localizer::CameraModel& Renderer::camera() const { return impl_->camera; }
+const geometry::CameraModel& Renderer::camera() const { return impl_->camera; }
 const RenderOptions& Renderer::options() const { return impl_->options; }
 std::string Renderer::gl_renderer() const { return impl_->egl.renderer(); }
 cv::Size Renderer::pinhole_size() const { return {impl_->layer_w, impl_->layer_h}; }

@@ -17,7 +17,7 @@ constexpr int kDirections = 720;  // directions of the field-of-view table, over
 
 }  // namespace
 
-TruthBoxProjector::TruthBoxProjector(const localizer::CameraModel& camera, double max_half_fov_deg)
+TruthBoxProjector::TruthBoxProjector(const geometry::CameraModel& camera, double max_half_fov_deg)
     : camera_(camera), max_half_fov_deg_(max_half_fov_deg) {
   if (!(max_half_fov_deg > 0.0 && max_half_fov_deg < 90.0)) {
     throw std::invalid_argument(fmt::format("max_half_fov_deg = {}: must be in (0, 90)", max_half_fov_deg));
@@ -111,7 +111,7 @@ RenderedBox TruthBoxProjector::project(const DroneModel& model, const Eigen::Iso
     v0 = std::min(v0, p.y());
     v1 = std::max(v1, p.y());
   };
-  const Eigen::Vector2d to_box = Eigen::Vector2d::Constant(localizer::kBoxToCameraPixel);
+  const Eigen::Vector2d to_box = Eigen::Vector2d::Constant(geometry::kBoxToCameraPixel);
   bool any_in_view = false, any_outside = false;
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d p = T_body_to_cam * points[i];

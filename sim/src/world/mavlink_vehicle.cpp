@@ -3,7 +3,7 @@
 #include "wingman/sim/mavlink_vehicle.hpp"
 
 #include <wingman/common/config.hpp>
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 #include <wingman/own_pose_t.hpp>
 
@@ -292,9 +292,9 @@ void MavlinkVehicle::on_frame_time(int64_t now_utime, const MultirotorState& sta
   }
   // Telemetry: NED world, FRD body, boot time.
   const int64_t boot_us = now_utime - boot_epoch_utime_;
-  const Eigen::Vector3d p_ned = common::swap_ned_enu(state.p_body_in_world);
-  const Eigen::Vector3d v_ned = common::swap_ned_enu(state.v_body_in_world);
-  const Eigen::Quaterniond q_frd_to_ned = common::swap_ned_frd_enu_flu(state.q_body_to_world);
+  const Eigen::Vector3d p_ned = geometry::swap_ned_enu(state.p_body_in_world);
+  const Eigen::Vector3d v_ned = geometry::swap_ned_enu(state.v_body_in_world);
+  const Eigen::Quaterniond q_frd_to_ned = geometry::swap_ned_frd_enu_flu(state.q_body_to_world);
   // FLU -> FRD body rates: (x, -y, -z).
   const Eigen::Vector3d w_frd(state.w_body_in_body.x(), -state.w_body_in_body.y(), -state.w_body_in_body.z());
   if (due(Odometry::kId, now_utime)) {  // first: the companion takes it over the pair once seen

@@ -4,7 +4,7 @@
 
 #include "trapezoid.hpp"
 
-#include <wingman/localizer/sphere_projection.hpp>
+#include <wingman/geometry/sphere_projection.hpp>
 
 #include <algorithm>
 
@@ -14,13 +14,13 @@ namespace {
 
 /// The exact box of vehicle `vehicle_id`'s bounding sphere in the camera (PixelBox convention, not clipped); false
 /// when the vehicle is unknown or its sphere reaches behind the camera.
-bool sphere_box(const wingman::ground_truth_t& truth, int32_t vehicle_id, const localizer::CameraModel& camera,
-                const Eigen::Isometry3d& T_cam_to_world, localizer::PixelBox* box) {
+bool sphere_box(const wingman::ground_truth_t& truth, int32_t vehicle_id, const geometry::CameraModel& camera,
+                const Eigen::Isometry3d& T_cam_to_world, geometry::PixelBox* box) {
   for (const auto& v : truth.vehicles) {
     if (v.vehicle_id != vehicle_id) continue;
     const Eigen::Vector3d p_in_world(v.p_body_in_world[0], v.p_body_in_world[1], v.p_body_in_world[2]);
-    const localizer::SphereImageBox s =
-        localizer::project_sphere(camera, T_cam_to_world.inverse() * p_in_world, v.bounding_radius);
+    const geometry::SphereImageBox s =
+        geometry::project_sphere(camera, T_cam_to_world.inverse() * p_in_world, v.bounding_radius);
     if (!s.valid) return false;
     *box = s.pixel_box();
     return true;
@@ -31,7 +31,7 @@ bool sphere_box(const wingman::ground_truth_t& truth, int32_t vehicle_id, const 
 }  // namespace
 
 wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int64_t seq,
-                                       const localizer::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
+                                       const geometry::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
                                        int32_t camera_id, const TruthDetectionOptions& options) {
   const int32_t width = camera.width(), height = camera.height();
   const bool sphere = options.box == "sphere";
@@ -47,7 +47,7 @@ wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int
   for (const auto& b : truth.boxes) {
     if (!b.visible || b.camera_id != camera_id) continue;
     if (options.max_range_m > 0 && b.range > options.max_range_m) continue;
-    localizer::PixelBox box{b.cx, b.cy, b.w, b.h};
+    geometry::PixelBox box{b.cx, b.cy, b.w, b.h};
     if (sphere && !sphere_box(truth, b.vehicle_id, camera, T_cam_to_world, &box)) continue;
     double left = box.cx - 0.5 * box.w, right = box.cx + 0.5 * box.w;
     double top = box.cy - 0.5 * box.h, bottom = box.cy + 0.5 * box.h;

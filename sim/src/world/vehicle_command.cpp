@@ -2,7 +2,7 @@
 // setpoint_t (ENU or NED) to VehicleCommand (ENU).
 #include "wingman/sim/vehicle_command.hpp"
 
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/own_pose_t.hpp>
 
 #include <cmath>
@@ -14,7 +14,7 @@ namespace {
 
 Eigen::Vector3d to_enu(const double (&v)[3], bool ned) {
   const Eigen::Vector3d p(v[0], v[1], v[2]);
-  return ned ? common::swap_ned_enu(p) : p;
+  return ned ? geometry::swap_ned_enu(p) : p;
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 // The follower's own state in Wingman's ENU world / FLU body frames, and the NED <-> ENU conversions.
 #pragma once
 
-#include <wingman/common/ned_enu.hpp>
+#include <wingman/geometry/ned_enu.hpp>
 #include <wingman/own_pose_t.hpp>
 
 #include <Eigen/Core>
@@ -31,14 +31,14 @@ struct OwnState {
 
 /// Converts a decoded own_pose_t (ENU/FLU or NED/FRD) into an OwnState in ENU/FLU:
 /// p_enu = (e, n, -d), R_flu_to_enu = R_ned_to_enu R_frd_to_ned R_flu_to_frd (the localizer's
-/// pose_ned_frd_to_enu_flu, common::swap_ned_frd_enu_flu). Precondition: validate_message(pose) passed (unit
+/// pose_ned_frd_to_enu_flu, geometry::swap_ned_frd_enu_flu). Precondition: validate_message(pose) passed (unit
 /// quaternion, known frame).
 OwnState own_state_from_message(const wingman::own_pose_t& pose);
 
-// The NED <-> ENU conversions and angle wrapping live in common/ (ned_enu.hpp), shared with wingman-mavlink.
-using common::swap_ned_enu;
-using common::swap_ned_enu_yaw;
-using common::wrap_pi;
+// The NED <-> ENU conversions and angle wrapping live in geometry/ (ned_enu.hpp), shared with wingman-mavlink.
+using geometry::swap_ned_enu;
+using geometry::swap_ned_enu_yaw;
+using geometry::wrap_pi;
 
 /// Azimuth in the world (radians from ENU east towards north) of the horizontal part of
 /// `v_in_world`, or false when that part is shorter than `min_horizontal` (v nearly vertical).

@@ -2,9 +2,9 @@
 // The localizer's logic without LCM: detections and own poses in, targets out.
 #pragma once
 
+#include <wingman/geometry/camera_model.hpp>
+#include <wingman/geometry/extrinsics.hpp>
 #include "wingman/localizer/box_relation.hpp"
-#include "wingman/localizer/camera_model.hpp"
-#include "wingman/localizer/extrinsics.hpp"
 #include "wingman/localizer/localizer_options.hpp"
 #include "wingman/localizer/pose_buffer.hpp"
 #include "wingman/localizer/tracker.hpp"
@@ -63,7 +63,7 @@ class Localizer {
   /// their own time (a bad first message latched the order), the clock re-anchors on them: an own-pose resync
   /// empties the pose buffer, a detections resync restarts the tracker (new tracks, as after a restart).
   /// Throws std::invalid_argument for invalid options.
-  Localizer(const LocalizerOptions& options, CameraModel camera);
+  Localizer(const LocalizerOptions& options, geometry::CameraModel camera);
 
   /// Adds an own pose. Throws std::invalid_argument naming the field when it cannot be used
   /// (out of order, duplicate, dated too far ahead); the caller drops and counts it.
@@ -96,8 +96,8 @@ class Localizer {
 
   LocalizerOptions options_;
   BoxRelation cnn_relation_;  // options_.sphere.box_relation, for SOURCE_CNN detections
-  CameraModel camera_;
-  Extrinsics extrinsics_;
+  geometry::CameraModel camera_;
+  geometry::Extrinsics extrinsics_;
   PoseBuffer poses_;
   Tracker tracker_;
   common::StageClock clock_;  ///< admits own poses and detections by message time

@@ -2,7 +2,7 @@
 // Options of wingman-localizer (config/localizer.yaml).
 #pragma once
 
-#include "wingman/localizer/extrinsics.hpp"
+#include <wingman/geometry/extrinsics.hpp>
 #include "wingman/localizer/pose_buffer.hpp"
 #include "wingman/localizer/sphere_localizer.hpp"
 #include "wingman/localizer/track_windows.hpp"
@@ -63,7 +63,7 @@ struct LocalizerOptions {
   std::string class_decision = "box";
   CameraOptions camera;
   SphereLocalizerOptions sphere;
-  ExtrinsicsOptions extrinsics;
+  geometry::ExtrinsicsOptions extrinsics;
   PoseBufferOptions pose;
   TrackerOptions tracker;
   TrackWindowOptions windows;  ///< tracker-driven windows (windows.*)

@@ -1,21 +1,14 @@
 // SPDX-License-Identifier: MIT
-// The data that flows inside the localizer: a box, its camera-frame localization, and its world-frame form.
+// The data that flows inside the localizer: a box's camera-frame localization and its world-frame form (the box
+// itself is geometry::PixelBox).
 #pragma once
 
 #include <Eigen/Core>
+#include <wingman/geometry/pixel_box.hpp>  // geometry::PixelBox, the detected box these come from
 
 #include <cstdint>
 
 namespace wingman::localizer {
-
-/// A detected box in pixels of the source (distorted) image; (0, 0) is the top-left corner of the
-/// top-left pixel, as in detections_t.
-struct PixelBox {
-  double cx = 0;  ///< centre x, pixels
-  double cy = 0;  ///< centre y, pixels
-  double w = 0;   ///< width, pixels
-  double h = 0;   ///< height, pixels
-};
 
 /// One detection localized in the camera optical frame (x right, y down, z forward).
 struct CameraMeasurement {

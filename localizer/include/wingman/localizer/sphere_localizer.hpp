@@ -2,8 +2,8 @@
 // Box -> 3D: the target is a sphere of known radius; its position in the camera frame from a detection box.
 #pragma once
 
+#include <wingman/geometry/camera_model.hpp>
 #include "wingman/localizer/box_relation.hpp"
-#include "wingman/localizer/camera_model.hpp"
 #include "wingman/localizer/measurement.hpp"
 
 #include <string>
@@ -109,7 +109,7 @@ struct LocalizeResult {
 ///
 /// Rejected (ok = false): a non-finite box field, w or h <= 0, a centre outside the image, no sphere fitting the
 /// edges, a distance outside [min_range_m, max_range_m]. Precondition: options.validate() is empty.
-LocalizeResult localize_box(const PixelBox& box, const CameraModel& camera, const SphereLocalizerOptions& options,
-                            const BoxScale& scale = {});
+LocalizeResult localize_box(const geometry::PixelBox& box, const geometry::CameraModel& camera,
+                            const SphereLocalizerOptions& options, const BoxScale& scale = {});
 
 }  // namespace wingman::localizer

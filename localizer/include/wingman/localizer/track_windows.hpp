@@ -2,8 +2,8 @@
 // Tracker-driven windows (issue 31): where each track will be in a camera's image at its next exposure.
 #pragma once
 
+#include <wingman/geometry/camera_model.hpp>
 #include "wingman/localizer/box_relation.hpp"
-#include "wingman/localizer/camera_model.hpp"
 #include "wingman/localizer/tracker.hpp"
 
 #include <Eigen/Core>
@@ -54,7 +54,7 @@ struct CameraAtExposure {
 /// nullopt when the sphere does not lie in front of the camera (project_sphere() invalid) or its box lies wholly
 /// outside the image.
 std::optional<wingman::track_window_t> predict_track_window(const TrackOutput& track, double radius_m,
-                                                            const CameraModel& camera, const CameraAtExposure& cam,
-                                                            const BoxRelation& relation);
+                                                            const geometry::CameraModel& camera,
+                                                            const CameraAtExposure& cam, const BoxRelation& relation);
 
 }  // namespace wingman::localizer

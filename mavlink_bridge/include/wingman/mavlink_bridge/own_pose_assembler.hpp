@@ -57,7 +57,7 @@ class OwnPoseAssembler {
 constexpr int64_t kEpochTimeThresholdUs = 1000000000000000;
 
 /// `pose` as an own_pose_t stamped `utime` (epoch us): in NED with the FRD body as the autopilot gave it, or converted
-/// to ENU with an FLU body (common/ned_enu.hpp).
+/// to ENU with an FLU body (geometry/ned_enu.hpp).
 wingman::own_pose_t own_pose_message(const NedPose& pose, int64_t utime, bool enu);
 
 }  // namespace wingman::mavlink_bridge

@@ -7,7 +7,7 @@
 #include "wingman/sim/render_options.hpp"
 #include "wingman/sim/truth_box.hpp"
 
-#include <wingman/localizer/camera_model.hpp>
+#include <wingman/geometry/camera_model.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -61,7 +61,7 @@ class Renderer {
   /// when no EGL display or OpenGL ES 3 context can be made, or when the camera's field of view exceeds what
   /// can be rendered in one pinhole image (the pixels beyond max_half_fov_deg are then black; only if the whole
   /// central region cannot be covered is it an error).
-  Renderer(const localizer::CameraModel& camera, const RenderOptions& options);
+  Renderer(const geometry::CameraModel& camera, const RenderOptions& options);
   ~Renderer();
   Renderer(Renderer&&) noexcept;
   Renderer& operator=(Renderer&&) noexcept;
@@ -81,7 +81,7 @@ class Renderer {
   /// render targets, which costs as much as construction.
   void set_options(const RenderOptions& options);
 
-  const localizer::CameraModel& camera() const;
+  const geometry::CameraModel& camera() const;
   const RenderOptions& options() const;
   /// The OpenGL renderer string, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
   std::string gl_renderer() const;

@@ -7,7 +7,7 @@
 #include "wingman/sim/render_options.hpp"
 
 #include <wingman/camera_driver/preview.hpp>
-#include <wingman/localizer/extrinsics.hpp>
+#include <wingman/geometry/extrinsics.hpp>
 
 #include <cstdint>
 #include <string>
@@ -124,7 +124,7 @@ struct SimOptions {
   /// the drone models (no occlusion).
   bool render = true;
   SimCameraOptions camera;
-  localizer::ExtrinsicsOptions extrinsics;
+  geometry::ExtrinsicsOptions extrinsics;
   TruthDetectionOptions detections;
   SyncOptions sync;
   RenderOptions render_options;

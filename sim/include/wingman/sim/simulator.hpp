@@ -11,10 +11,10 @@
 #include "wingman/sim/scenario.hpp"
 #include "wingman/sim/truth_box.hpp"
 
+#include <wingman/geometry/camera_model.hpp>
+#include <wingman/geometry/extrinsics.hpp>
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
-#include <wingman/localizer/camera_model.hpp>
-#include <wingman/localizer/extrinsics.hpp>
 #include <wingman/own_pose_t.hpp>
 #include <wingman/setpoint_t.hpp>
 
@@ -33,10 +33,10 @@ class Renderer;
 
 /// The onboard camera of the camera vehicle (id 0).
 struct SimCamera {
-  localizer::CameraModel model;  ///< intrinsics and distortion, for the image size the simulator renders
-  localizer::Extrinsics mount;   ///< camera optical frame -> body (FLU); the camera tilts with the body
-  double rate_hz = 30.0;         ///< frames per simulated second
-  int32_t camera_id = 0;         ///< copied into images, truth boxes and detections
+  geometry::CameraModel model;  ///< intrinsics and distortion, for the image size the simulator renders
+  geometry::Extrinsics mount;   ///< camera optical frame -> body (FLU); the camera tilts with the body
+  double rate_hz = 30.0;        ///< frames per simulated second
+  int32_t camera_id = 0;        ///< copied into images, truth boxes and detections
 };
 
 /// One simulated camera frame.

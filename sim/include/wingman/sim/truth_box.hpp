@@ -4,7 +4,7 @@
 
 #include "wingman/sim/drone_model.hpp"
 
-#include <wingman/localizer/camera_model.hpp>
+#include <wingman/geometry/camera_model.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -36,7 +36,7 @@ struct RenderedBox {
 class TruthBoxProjector {
  public:
   /// Precondition: 0 < max_half_fov_deg < 90 (std::invalid_argument otherwise).
-  explicit TruthBoxProjector(const localizer::CameraModel& camera, double max_half_fov_deg = 80.0);
+  explicit TruthBoxProjector(const geometry::CameraModel& camera, double max_half_fov_deg = 80.0);
 
   /// The tight box of the drone's projection in the image: its vertices (propellers at `prop_angle_rad`) projected
   /// with CameraModel::project (distortion applied); where the drone is cut by the image border, its triangles
@@ -53,10 +53,10 @@ class TruthBoxProjector {
   /// Largest normalized radius |(x, y)| in the field of view in the direction atan2(y, x) of `xy`.
   double max_normalized_radius(const Eigen::Vector2d& xy) const;
 
-  const localizer::CameraModel& camera() const { return camera_; }
+  const geometry::CameraModel& camera() const { return camera_; }
 
  private:
-  localizer::CameraModel camera_;
+  geometry::CameraModel camera_;
   double max_half_fov_deg_;
   std::vector<double> r_max_;  // max normalized radius per direction, kDirections entries over [0, 2 pi)
 };

@@ -5,8 +5,8 @@
 #include "wingman/sim/sim_options.hpp"
 
 #include <wingman/detections_t.hpp>
+#include <wingman/geometry/camera_model.hpp>
 #include <wingman/ground_truth_t.hpp>
-#include <wingman/localizer/camera_model.hpp>
 
 #include <Eigen/Geometry>
 
@@ -24,7 +24,7 @@ namespace wingman::sim {
 /// seeded by options.seed and `seq`), then the box is clipped to the image. Boxes narrower or shorter than
 /// options.min_size_px, and drones farther than options.max_range_m (when > 0), are left out.
 wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int64_t seq,
-                                       const localizer::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
+                                       const geometry::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
                                        int32_t camera_id, const TruthDetectionOptions& options);
 
 }  // namespace wingman::sim

@@ -4,7 +4,7 @@
 
 #include <wingman/detector/box.hpp>
 #include <wingman/detector/detection_pipeline.hpp>
-#include <wingman/localizer/camera_model.hpp>
+#include <wingman/geometry/camera_model.hpp>
 #include <wingman/localizer/localizer.hpp>
 #include <wingman/localizer/localizer_options.hpp>
 
@@ -92,7 +92,7 @@ class ClipTracker {
   /// @param options  the localizer's options (config/localizer.yaml); its camera.* keys are not used: `camera` is.
   /// @param camera   the camera of the clip's images (its size must be the frames' size).
   /// @param fps      the video's frame rate, frames/s; > 0 (std::invalid_argument otherwise).
-  ClipTracker(const localizer::LocalizerOptions& options, localizer::CameraModel camera, double fps);
+  ClipTracker(const localizer::LocalizerOptions& options, geometry::CameraModel camera, double fps);
   ~ClipTracker();
 
   /// One frame: its video index (strictly increasing; std::invalid_argument otherwise), the detector's boxes of every
@@ -107,11 +107,11 @@ class ClipTracker {
   int64_t rejected_boxes() const { return rejected_boxes_; }
   /// Frames given to add_frame.
   int frames() const { return frames_; }
-  const localizer::CameraModel& camera() const { return camera_; }
+  const geometry::CameraModel& camera() const { return camera_; }
 
  private:
   localizer::LocalizerOptions options_;
-  localizer::CameraModel camera_;
+  geometry::CameraModel camera_;
   localizer::BoxRelation relation_;  // options_.sphere.box_relation, as the Localizer applies it
   double fps_;
   std::unique_ptr<localizer::Localizer> localizer_;
@@ -124,7 +124,7 @@ class ClipTracker {
 /// A nominal pinhole camera: `width` x `height` pixels, horizontal field of view `hfov_deg`, square pixels, the
 /// principal point at the image centre, no distortion. fx = fy = (width / 2) / tan(hfov / 2).
 /// Throws std::invalid_argument for a size <= 0 or hfov_deg outside (0, 180).
-localizer::CameraModel nominal_pinhole(int width, int height, double hfov_deg);
+geometry::CameraModel nominal_pinhole(int width, int height, double hfov_deg);
 
 /// What `wingman val --sequences` evaluates and how.
 struct SequenceEvalOptions {

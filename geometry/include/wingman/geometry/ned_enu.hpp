@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-namespace wingman::common {
+namespace wingman::geometry {
 
 /// NED <-> ENU for a vector or point: (x, y, z) -> (y, x, -z). The map is its own inverse.
 inline Eigen::Vector3d swap_ned_enu(const Eigen::Vector3d& v) { return {v.y(), v.x(), -v.z()}; }
@@ -49,4 +49,4 @@ inline Eigen::Quaterniond swap_ned_frd_enu_flu(const Eigen::Quaterniond& q_body_
   return Eigen::Quaterniond(swap_ned_frd_enu_flu(q_body_to_world.normalized().toRotationMatrix())).normalized();
 }
 
-}  // namespace wingman::common
+}  // namespace wingman::geometry

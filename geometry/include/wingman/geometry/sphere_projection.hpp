@@ -2,14 +2,14 @@
 // The forward model: the exact bounding box of a sphere's image through a calibrated camera (distortion included).
 #pragma once
 
-#include "wingman/localizer/camera_model.hpp"
-#include "wingman/localizer/measurement.hpp"
+#include "wingman/geometry/camera_model.hpp"
+#include "wingman/geometry/pixel_box.hpp"
 
 #include <Eigen/Core>
 
 #include <string>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 /// The bounding box of a sphere's image: the extremes in u and v of the projected silhouette (the tangent cone
 /// from the camera centre), in calibration pixel coordinates (see CameraModel).
@@ -33,4 +33,4 @@ struct SphereImageBox {
 SphereImageBox project_sphere(const CameraModel& camera, const Eigen::Vector3d& p_centre_in_cam, double radius_m,
                               double min_ray_z = 0.02);
 
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

@@ -1,15 +1,15 @@
 // SPDX-License-Identifier: MIT
-// CameraModel: projection against OpenCV, undistortion round trips at the corners, eq. 24, scaling, size checks.
+// CameraModel: projection against OpenCV, undistortion round trips at the corners, scaling, size checks (eq. 24, the
+// thesis's ray: tests/localizer/test_sphere_localizer.cpp).
 #include "geometry_reference.hpp"
 
 #include <gtest/gtest.h>
-#include <wingman/localizer/camera_model.hpp>
-#include <wingman/localizer/thesis_range.hpp>
+#include <wingman/geometry/camera_model.hpp>
 
 #include <random>
 #include <stdexcept>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 namespace {
 
 using testing::test_cameras;
@@ -87,15 +87,6 @@ TEST(CameraModel, UndistortThenDistortRoundTripsAtImageCornersAndEdges) {
   }
 }
 
-TEST(CameraModel, UnprojectIsEquation24ForAPinhole) {
-  const CameraModel c = CameraModel::pinhole(1280, 720, 640, 600, 639.5, 359.5);
-  const Eigen::Vector2d uv(1100.25, 80.5);
-  const Eigen::Vector3d expected =
-      Eigen::Vector3d((uv.x() - c.cx()) / c.fx(), (uv.y() - c.cy()) / c.fy(), 1.0).normalized();
-  EXPECT_NEAR((c.unproject(uv) - expected).norm(), 0, 1e-15);
-  EXPECT_NEAR((thesis_direction(c.undistort_to_normalized(uv)) - expected).norm(), 0, 1e-15);
-}
-
 TEST(CameraModel, UndistortionIsTighterThanOpenCvsDefaultFiveIterations) {
   // OpenCV's default undistortPoints stops after 5 iterations; at the corner of a distorted lens that leaves a
   // visible error, which the polish removes.
@@ -135,4 +126,4 @@ TEST(CameraModel, CheckImageSizeNamesBothSizes) {
 }
 
 }  // namespace
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // project_sphere(): coarse sampling of the silhouette circle, then golden-section search per extreme.
-#include "wingman/localizer/sphere_projection.hpp"
+#include "wingman/geometry/sphere_projection.hpp"
 
 #include <fmt/format.h>
 #include <Eigen/Geometry>
@@ -9,7 +9,7 @@
 #include <array>
 #include <cmath>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 PixelBox SphereImageBox::pixel_box() const {
   PixelBox b;
@@ -112,4 +112,4 @@ SphereImageBox project_sphere(const CameraModel& camera, const Eigen::Vector3d& 
   return out;
 }
 
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

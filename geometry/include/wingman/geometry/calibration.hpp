@@ -2,12 +2,12 @@
 // Camera calibration files read as they are: ROS camera_info YAML, OpenCV FileStorage YAML, Kalibr camchain YAML.
 #pragma once
 
-#include "wingman/localizer/camera_model.hpp"
+#include "wingman/geometry/camera_model.hpp"
 
 #include <stdexcept>
 #include <string>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 /// A calibration file that cannot be read or used. what() is one line naming the file, the key and what was
 /// expected, e.g. "cam.yaml: key 'camera_matrix.data': expected 9 numbers, got 6".
@@ -44,4 +44,4 @@ CameraModel load_calibration(const std::string& path, const std::string& kalibr_
 /// The format load_calibration() would read `path` as. Throws CalibrationError if it is none of them.
 CalibrationFormat detect_calibration_format(const std::string& path);
 
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

@@ -2,8 +2,8 @@
 // Test cameras for the four distortion models and an independent sphere projection through OpenCV.
 #pragma once
 
-#include <wingman/localizer/camera_model.hpp>
-#include <wingman/localizer/measurement.hpp>
+#include <wingman/geometry/camera_model.hpp>
+#include <wingman/geometry/pixel_box.hpp>
 
 #include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-namespace wingman::localizer::testing {
+namespace wingman::geometry::testing {
 
 /// One test camera per distortion model. The distortion is monotonic well beyond each image's corners.
 struct TestCamera {
@@ -92,4 +92,4 @@ inline double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
 }
 
-}  // namespace wingman::localizer::testing
+}  // namespace wingman::geometry::testing

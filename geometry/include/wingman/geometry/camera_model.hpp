@@ -2,12 +2,14 @@
 // A calibrated camera: pinhole intrinsics and lens distortion (none, radtan, rational polynomial, equidistant).
 #pragma once
 
+#include "wingman/geometry/pixel_box.hpp"  // kBoxToCameraPixel, pixel_from_box()
+
 #include <Eigen/Core>
 
 #include <string>
 #include <vector>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 /// Lens distortion models. The coefficient order is OpenCV's (and ROS camera_info's):
 /// - kNone: no coefficients (an ideal pinhole).
@@ -26,7 +28,7 @@ const char* distortion_name(Distortion d);
 /// - Camera optical frame: x right, y down, z forward (thesis Fig. 10), metres.
 /// - Pixel coordinates are those of the calibration (OpenCV, ROS): the centre of the top-left pixel is (0, 0),
 ///   so the image spans [-0.5, width - 0.5] x [-0.5, height - 0.5]. A PixelBox (detections_t) puts (0, 0) at the
-///   top-left corner of that pixel instead: u_camera = u_box - kBoxToCameraPixel (see pixel_from_box()).
+///   top-left corner of that pixel instead: u_camera = u_box - kBoxToCameraPixel (pixel_box.hpp: pixel_from_box()).
 /// - "Normalized" coordinates are the undistorted image plane at z = 1: (x, y) = (X / Z, Y / Z).
 ///
 /// The object is immutable and cheap to copy; project() and unproject() allocate nothing but unproject()'s call
@@ -95,13 +97,4 @@ class CameraModel {
   std::string name_;
 };
 
-/// Offset from PixelBox coordinates (origin at the top-left pixel's corner) to calibration coordinates (origin at
-/// the top-left pixel's centre): u_camera = u_box - kBoxToCameraPixel.
-inline constexpr double kBoxToCameraPixel = 0.5;
-
-/// Calibration pixel coordinates of a point given in PixelBox coordinates.
-inline Eigen::Vector2d pixel_from_box(double u_box, double v_box) {
-  return {u_box - kBoxToCameraPixel, v_box - kBoxToCameraPixel};
-}
-
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

@@ -1,22 +1,20 @@
 // SPDX-License-Identifier: MIT
-// Camera-to-body extrinsics and the camera -> body -> world mapping of one measurement.
+// Camera-to-body extrinsics: where the camera sits on the body and which way it looks.
 #pragma once
-
-#include "wingman/localizer/measurement.hpp"
-#include "wingman/localizer/pose_buffer.hpp"
 
 #include <Eigen/Core>
 
-#include <cstdint>
 #include <string>
 #include <vector>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 /// Frames and sign conventions (docs/localization.md, "Frames"):
 /// - camera optical frame: x right, y down, z forward (out of the lens), origin at the optical centre;
 /// - body frame: FLU, x forward, y left, z up, origin at the body reference point of own_pose_t;
-/// - world frame: ENU (own_pose_t.FRAME_ENU); NED/FRD poses are converted by pose_ned_frd_to_enu_flu().
+/// - world frame: ENU (own_pose_t.FRAME_ENU); NED/FRD poses are converted by the localizer's
+///   pose_ned_frd_to_enu_flu() (with ned_enu.hpp).
+/// The camera -> body -> world mapping of a measurement is the localizer's (localizer/camera_to_world.hpp).
 ///
 /// A point maps as p_in_body = R_cam_to_body * p_in_cam + p_cam_in_body, where p_cam_in_body is the
 /// camera's optical centre expressed in the body frame. Hand-worked case: a camera 0.24 m in front
@@ -49,6 +47,11 @@ struct ExtrinsicsOptions {
   std::vector<std::string> validate() const;
 };
 
+/// The check of a camera -> body rotation given as 3x3 row-major values under `key` (the localizer's and the
+/// follower's `extrinsics.R_cam_to_body`): 9 finite numbers, orthonormal (|R R^T - I| <= 1e-6), determinant +1.
+/// Returns at most one "key = value: rule" line; empty when valid.
+std::vector<std::string> rotation_problems(const std::string& key, const std::vector<double>& R_row_major);
+
 /// A rigid camera mount on the body.
 struct Extrinsics {
   Eigen::Matrix3d R_cam_to_body = Eigen::Matrix3d::Identity();  ///< rotates camera-frame vectors into body
@@ -68,24 +71,4 @@ inline Eigen::Matrix3d rotate_covariance(const Eigen::Matrix3d& R_a_to_b, const 
   return R_a_to_b * cov_in_a * R_a_to_b.transpose();
 }
 
-/// The camera's pose in the world frame at a body pose: R_cam_to_world = R_body_to_world R_cam_to_body and the optical
-/// centre p_cam_in_world = R_body_to_world p_cam_in_body + p_body_in_world.
-struct CameraPoseInWorld {
-  Eigen::Matrix3d R_cam_to_world = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d p_cam_in_world = Eigen::Vector3d::Zero();  ///< metres
-};
-CameraPoseInWorld camera_pose_in_world(const Extrinsics& extrinsics, const PoseSample& pose);
-
-/// Maps a camera-frame measurement into the world frame with the body pose at the image's exposure
-/// time (`pose_at_exposure`, from PoseBuffer::at(image_utime)):
-/// p_in_world = R_body_to_world (R_cam_to_body p_in_cam + p_cam_in_body) + p_body_in_world,
-/// cov_in_world = R_cam_to_world cov_in_cam R_cam_to_world^T with R_cam_to_world = R_body_to_world R_cam_to_body,
-/// plus the own pose's uncertainty to first order (both zero where the pose reports none):
-/// + cov_p_body_in_world, the body position's, and
-/// + R_body_to_world [p_b]x diag(var_rpy_body) [p_b]x^T R_body_to_world^T, the attitude's, with p_b the target in the
-///   body frame (a small body rotation dtheta moves the target by -R_body_to_world [p_b]x dtheta).
-/// `image_utime` and `camera_id` are copied to the result, as are p_target_in_cam, range and confidence.
-WorldMeasurement to_world(const CameraMeasurement& m, const Extrinsics& extrinsics, const PoseSample& pose_at_exposure,
-                          int64_t image_utime, int32_t camera_id);
-
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

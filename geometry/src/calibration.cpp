@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Calibration file readers: ROS camera_info, Kalibr and OpenCV FileStorage (YAML), all with yaml-cpp.
-#include "wingman/localizer/calibration.hpp"
+#include "wingman/geometry/calibration.hpp"
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 const char* calibration_format_name(CalibrationFormat format) {
   switch (format) {
@@ -331,4 +331,4 @@ CameraModel load_calibration(const std::string& path, const std::string& kalibr_
   return read_kalibr(path, root, kalibr_camera);
 }
 
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

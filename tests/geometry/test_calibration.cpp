@@ -3,14 +3,14 @@
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
-#include <wingman/localizer/calibration.hpp>
+#include <wingman/geometry/calibration.hpp>
 
 #include <opencv2/core.hpp>
 
 #include <sys/stat.h>
 #include <fstream>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 namespace {
 
 using wingman::testing::TempDir;
@@ -309,4 +309,4 @@ TEST(RealCalibrations, RoundTripAtTheCornersOfEveryRealCalibration) {
 }
 
 }  // namespace
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // CameraModel: projection with distortion, undistortion with OpenCV polished by Newton steps, scaling.
-#include "wingman/localizer/camera_model.hpp"
+#include "wingman/geometry/camera_model.hpp"
 
 #include <fmt/format.h>
 #include <Eigen/Dense>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace wingman::localizer {
+namespace wingman::geometry {
 
 const char* distortion_name(Distortion d) {
   switch (d) {
@@ -197,4 +197,4 @@ std::string CameraModel::check_image_size(int width, int height) const {
       width_, height_, width, height);
 }
 
-}  // namespace wingman::localizer
+}  // namespace wingman::geometry
