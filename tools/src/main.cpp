@@ -11,6 +11,7 @@
 #include "wingman/tools/model_cli.hpp"
 #include "wingman/tools/predict.hpp"
 #include "wingman/tools/replay.hpp"
+#include "wingman/tools/report.hpp"
 #include "wingman/tools/spy.hpp"
 #include "wingman/tools/train_cli.hpp"
 #ifdef WINGMAN_WITH_SIM
@@ -283,6 +284,7 @@ int main(int argc, char** argv) {
       }
       if (!quiet) o->progress = &std::cerr;
       const EvalResult result = evaluate_log(*o);
+      if (!o->report_path.empty()) write_html_report(result, *o, o->report_path);
       if (cmd == ev) std::cout << (eval_json_stdout ? result.json() + "\n" : result.report()) << std::flush;
       if (!o->report_path.empty()) std::cerr << "report written to " << o->report_path << std::endl;
     }

@@ -43,7 +43,7 @@ struct EvalOptions {
   std::vector<double> range_bins_m = {5, 10, 15, 20, 30};
   std::string json_path;                 ///< write the result as JSON here ("" = no)
   std::string csv_path;                  ///< write the per-target time series as CSV here ("" = no)
-  std::string report_path;               ///< write a self-contained HTML report here ("" = no)
+  std::string report_path;               ///< the HTML report's file ("" = no): write_html_report (report.hpp)
   std::string title = "Wingman flight";  ///< report title
   int report_frames = 6;                 ///< the report shows up to this many camera frames (0 = none)
   /// Progress (percent of the log read, every few seconds) goes here; nullptr = quiet.
@@ -205,9 +205,10 @@ struct EvalResult {
 bool box_on_leader(const wingman::detection_t& box, int camera_id, const std::vector<wingman::truth_box_t>& truth_boxes,
                    int leader_id);
 
-/// Reads the log and computes the errors; writes json_path, csv_path and report_path when set. Throws
-/// std::invalid_argument naming the option for bad options, std::runtime_error naming the file when it cannot be
-/// read or written or holds no ground truth.
+/// Reads the log and computes the errors; writes json_path and csv_path when set. Throws std::invalid_argument
+/// naming the option for bad options, std::runtime_error naming the file when it cannot be read or written or holds
+/// no ground truth. report_path is the caller's to write, after this: write_html_report (report.hpp, which builds on
+/// this header; nothing here depends on it).
 EvalResult evaluate_log(const EvalOptions& options);
 
 }  // namespace wingman::tools
