@@ -68,7 +68,8 @@ std::unique_ptr<InferenceBackend> Detector::build_backend(const DarknetModel& si
   const bool reuse = backend == "auto" && !auto_kind_.empty();
   auto made = make_backend(reuse ? auto_kind_ : backend, sized, options_.opencl, options_.opencl.max_batch, &why);
   if (reuse) {
-    why = fmt::format("{}; kept for the {}x{} network", auto_why_, sized.net.width, sized.net.height);
+    // The heartbeat keeps naming the first network and why its backend was chosen; this one is added to it.
+    why = fmt::format("{}; the same backend also runs the {}x{} network", auto_why_, sized.net.width, sized.net.height);
   } else if (backend == "auto") {
     auto_kind_ = made->name().rfind("opencl", 0) == 0 ? "opencl" : "cpu";
     auto_why_ = why;
