@@ -5,7 +5,6 @@ add_library(wingman_sim_world
   src/world/multirotor.cpp
   src/world/vehicle_command.cpp
   src/world/motion_script.cpp
-  src/world/yaml_reader.cpp
   src/world/scenario.cpp
   src/world/sim_options.cpp
   src/world/simulator.cpp

@@ -3,24 +3,17 @@
 #include "wingman/common/config.hpp"
 
 #include "wingman/common/yaml_limits.hpp"
+#include "yaml_convert.hpp"
 
 #include <fmt/format.h>
 
 #include <cctype>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <sstream>
 
 namespace wingman::common {
 namespace {
-
-std::string scalar_text(const YAML::Node& node) {
-  if (node.IsScalar()) return "'" + node.Scalar() + "'";
-  if (node.IsSequence()) return "a sequence";
-  if (node.IsMap()) return "a mapping";
-  return "nothing";
-}
 
 std::string quote(const std::string& s) {
   std::string out = "\"";
@@ -58,8 +51,8 @@ ConfigLoader ConfigLoader::from_string(const std::string& yaml_text, const std::
   }
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // an empty file means all defaults
   if (!root.IsMap()) {
-    throw ConfigError(
-        fmt::format("{}: expected a mapping of sections at the top level, got {}", source_name, scalar_text(root)));
+    throw ConfigError(fmt::format("{}: expected a mapping of sections at the top level, got {}", source_name,
+                                  yaml_convert::describe_node(root)));
   }
   return ConfigLoader(source_name, root);
 }
@@ -126,21 +119,14 @@ void ConfigLoader::add_set(const std::string& assignment) {
 }
 
 void ConfigLoader::flatten(const YAML::Node& node, const std::string& prefix, const std::string& source) {
-  for (const auto& kv : node) {
-    if (!kv.first.IsScalar()) {  // e.g. "? mode: x" or "? [a, b]": YAML allows it, a configuration does not
-      const std::string at = prefix.empty() ? std::string("(top level)") : prefix;
-      errors_.push_back(fmt::format("{}: a key must be a plain name, got {}",
-                                    where(at, kv.first, source, source != "--set"), scalar_text(kv.first)));
-      continue;
-    }
-    const std::string name = kv.first.as<std::string>();
-    const std::string key = prefix.empty() ? name : prefix + "." + name;
-    if (kv.second.IsMap()) {
-      flatten(kv.second, key, source);
-    } else {
-      leaves_[key] = Leaf{kv.second, source, source != "--set"};
-    }
-  }
+  const bool has_lines = source != "--set";
+  const auto on_leaf = [&](const std::string& key, const YAML::Node& value) {
+    leaves_[key] = Leaf{value, source, has_lines};
+  };
+  const auto on_bad_key = [&](const std::string& at, const YAML::Node& key, const std::string& message) {
+    errors_.push_back(fmt::format("{}: {}", where(at.empty() ? "(top level)" : at, key, source, has_lines), message));
+  };
+  yaml_convert::flatten(node, prefix, on_leaf, on_bad_key);
 }
 
 std::string ConfigLoader::where(const std::string& key, const YAML::Node& node) const {
@@ -156,103 +142,30 @@ std::string ConfigLoader::where(const std::string& key, const YAML::Node& node, 
   return fmt::format("{}: {}", source, key);
 }
 
+// Every conversion is the shared one (the texts of YamlMappingReader); a problem names the leaf's source and line.
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, bool& out) {
-  bool v;
-  if (node.IsScalar() && YAML::convert<bool>::decode(node, v)) {
-    out = v;
-  } else {
-    errors_.push_back(fmt::format("{}: expected true or false, got {}", where(key, node), scalar_text(node)));
-  }
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
-
-void ConfigLoader::convert(const std::string& key, const YAML::Node& node, int64_t& out) {
-  long long v;
-  if (node.IsScalar() && YAML::convert<long long>::decode(node, v)) {
-    out = v;
-  } else {
-    errors_.push_back(fmt::format("{}: expected an integer, got {}", where(key, node), scalar_text(node)));
-  }
-}
-
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, int& out) {
-  int64_t v = 0;
-  const size_t before = errors_.size();
-  convert(key, node, v);
-  if (errors_.size() != before) return;
-  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
-    errors_.push_back(fmt::format("{}: integer {} out of range", where(key, node), v));
-    return;
-  }
-  out = static_cast<int>(v);
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
-
+void ConfigLoader::convert(const std::string& key, const YAML::Node& node, int64_t& out) {
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
+}
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, double& out) {
-  double v;
-  if (node.IsScalar() && YAML::convert<double>::decode(node, v)) {
-    out = v;
-  } else {
-    errors_.push_back(fmt::format("{}: expected a number, got {}", where(key, node), scalar_text(node)));
-  }
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
-
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::string& out) {
-  if (node.IsScalar()) {
-    out = node.Scalar();
-  } else if (node.IsNull()) {
-    out.clear();
-  } else {
-    errors_.push_back(fmt::format("{}: expected a string, got {}", where(key, node), scalar_text(node)));
-  }
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
-
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::vector<double>& out) {
-  if (!node.IsSequence()) {
-    errors_.push_back(fmt::format("{}: expected a sequence of numbers, got {}", where(key, node), scalar_text(node)));
-    return;
-  }
-  std::vector<double> v;
-  for (size_t i = 0; i < node.size(); ++i) {
-    double x;
-    if (!node[i].IsScalar() || !YAML::convert<double>::decode(node[i], x)) {
-      errors_.push_back(fmt::format("{}[{}]: expected a number, got {}", where(key, node), i, scalar_text(node[i])));
-      return;
-    }
-    v.push_back(x);
-  }
-  out = v;
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
-
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::vector<int>& out) {
-  if (!node.IsSequence()) {
-    errors_.push_back(fmt::format("{}: expected a sequence of integers, got {}", where(key, node), scalar_text(node)));
-    return;
-  }
-  std::vector<int> v;
-  for (size_t i = 0; i < node.size(); ++i) {
-    int x;
-    if (!node[i].IsScalar() || !YAML::convert<int>::decode(node[i], x)) {
-      errors_.push_back(fmt::format("{}[{}]: expected an integer, got {}", where(key, node), i, scalar_text(node[i])));
-      return;
-    }
-    v.push_back(x);
-  }
-  out = v;
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
-
 void ConfigLoader::convert(const std::string& key, const YAML::Node& node, std::vector<std::string>& out) {
-  if (!node.IsSequence()) {
-    errors_.push_back(fmt::format("{}: expected a sequence of strings, got {}", where(key, node), scalar_text(node)));
-    return;
-  }
-  std::vector<std::string> v;
-  for (size_t i = 0; i < node.size(); ++i) {
-    if (!node[i].IsScalar()) {
-      errors_.push_back(fmt::format("{}[{}]: expected a string, got {}", where(key, node), i, scalar_text(node[i])));
-      return;
-    }
-    v.push_back(node[i].Scalar());
-  }
-  out = v;
+  if (const auto bad = yaml_convert::convert(node, out)) errors_.push_back(bad->at(where(key, node)));
 }
 
 void ConfigLoader::finish(const std::vector<std::string>& validation_errors) const {

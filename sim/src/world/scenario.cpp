@@ -2,12 +2,12 @@
 // Scenario files: parsing with every problem reported at once.
 #include "wingman/sim/scenario.hpp"
 
-#include "yaml_reader.hpp"
-
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 #include <wingman/common/yaml_limits.hpp>
+#include <wingman/common/yaml_mapping_reader.hpp>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,8 +18,15 @@
 namespace wingman::sim {
 namespace {
 
-using detail::YamlReader;
+using common::YamlMappingReader;
 constexpr double kDegToRad = M_PI / 180.0;
+
+/// Reads the 3-vector leaf `key` ([x, y, z]) into `value`; absent or not three numbers: `value` is kept.
+void read_vector3(YamlMappingReader& r, const std::string& key, Eigen::Vector3d& value) {
+  std::array<double, 3> xyz{value.x(), value.y(), value.z()};
+  r(key, xyz, "");
+  value = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+}
 
 MotionSpec::Type parse_motion_type(const std::string& text, bool* ok) {
   *ok = true;
@@ -31,7 +38,7 @@ MotionSpec::Type parse_motion_type(const std::string& text, bool* ok) {
   return MotionSpec::Type::kHover;
 }
 
-void read_waypoints(YamlReader& vr, MotionSpec& m, std::vector<std::string>* problems) {
+void read_waypoints(YamlMappingReader& vr, MotionSpec& m, std::vector<std::string>* problems) {
   const YAML::Node list = vr.take("motion.waypoints");
   if (!list.IsDefined()) {
     vr.problem("motion.waypoints", "missing: motion.type waypoints needs a list of {position, speed, stop_s, yaw_deg}");
@@ -39,14 +46,15 @@ void read_waypoints(YamlReader& vr, MotionSpec& m, std::vector<std::string>* pro
   }
   if (!list.IsSequence()) {
     vr.problem("motion.waypoints", "expected a sequence of mappings {position, speed, stop_s, yaw_deg}, got " +
-                                       detail::describe_node(list));
+                                       YamlMappingReader::describe(list));
     return;
   }
   for (size_t i = 0; i < list.size(); ++i) {
-    YamlReader wr(vr.source_name(), list[i], fmt::format("{}motion.waypoints[{}].", vr.path_prefix(), i), problems);
+    YamlMappingReader wr(vr.source_name(), list[i], fmt::format("{}motion.waypoints[{}].", vr.path_prefix(), i),
+                         problems);
     Waypoint w;
     if (!wr.has("position")) wr.problem("position", "missing: every waypoint needs position [x, y, z]");
-    wr("position", w.p_in_world, "");
+    read_vector3(wr, "position", w.p_in_world);
     wr("speed", w.speed, "");
     wr("stop_s", w.stop_s, "");
     if (wr.has("yaw_deg")) {
@@ -59,7 +67,7 @@ void read_waypoints(YamlReader& vr, MotionSpec& m, std::vector<std::string>* pro
   }
 }
 
-void read_motion(YamlReader& vr, VehicleSpec& v, std::vector<std::string>* problems) {
+void read_motion(YamlMappingReader& vr, VehicleSpec& v, std::vector<std::string>* problems) {
   MotionSpec& m = v.motion;
   std::string type = "hover";
   vr("motion.type", type, "");
@@ -76,8 +84,8 @@ void read_motion(YamlReader& vr, VehicleSpec& v, std::vector<std::string>* probl
     case MotionSpec::Type::kRandomWalk:
       if (!vr.has("motion.from")) vr.problem("motion.from", "missing: random_walk needs the segment's from [x, y, z]");
       if (!vr.has("motion.to")) vr.problem("motion.to", "missing: random_walk needs the segment's to [x, y, z]");
-      vr("motion.from", m.segment_from, "");
-      vr("motion.to", m.segment_to, "");
+      read_vector3(vr, "motion.from", m.segment_from);
+      read_vector3(vr, "motion.to", m.segment_to);
       vr("motion.max_speed", m.max_speed, "");
       m.min_speed = m.max_speed;  // default: every leg at max_speed
       vr("motion.min_speed", m.min_speed, "");
@@ -93,7 +101,7 @@ void read_motion(YamlReader& vr, VehicleSpec& v, std::vector<std::string>* probl
     case MotionSpec::Type::kTeleportSteps:
       if (!vr.has("motion.step")) vr.problem("motion.step", "missing: teleport_steps needs step [dx, dy, dz]");
       if (!vr.has("motion.steps")) vr.problem("motion.steps", "missing: teleport_steps needs the number of steps");
-      vr("motion.step", m.step, "");
+      read_vector3(vr, "motion.step", m.step);
       vr("motion.steps", m.steps, "");
       vr("motion.frames_per_step", m.frames_per_step, "");
       break;
@@ -104,7 +112,7 @@ VehicleSpec read_vehicle(const std::string& source, const YAML::Node& node, size
                          std::vector<std::string>* problems) {
   VehicleSpec v;
   const size_t before = problems->size();
-  YamlReader vr(source, node, fmt::format("vehicles[{}].", index), problems);
+  YamlMappingReader vr(source, node, fmt::format("vehicles[{}].", index), problems);
   if (problems->size() != before) return v;  // not a mapping
   if (!vr.has("name")) vr.problem("name", "missing: every vehicle needs a name");
   if (!vr.has("id")) vr.problem("id", "missing: every vehicle needs an id (0 = the camera vehicle)");
@@ -121,7 +129,7 @@ VehicleSpec read_vehicle(const std::string& source, const YAML::Node& node, size
   } else {
     vr.problem("control", fmt::format("'{}': must be setpoints or script", control));
   }
-  vr("initial.position", v.p_initial_in_world, "");
+  read_vector3(vr, "initial.position", v.p_initial_in_world);
   double yaw_deg = 0;
   vr("initial.yaw_deg", yaw_deg, "");
   v.yaw_initial_rad = yaw_deg * kDegToRad;
@@ -182,9 +190,9 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source_
   if (!root.IsMap()) {
     throw ScenarioError(
         fmt::format("{}: expected a mapping with name, start_utime, vehicles, ... at the top level, got {}",
-                    source_name, detail::describe_node(root)));
+                    source_name, YamlMappingReader::describe(root)));
   }
-  YamlReader top(source_name, root, "", &problems);
+  YamlMappingReader top(source_name, root, "", &problems);
   top("name", s.name, "");
   top("description", s.description, "");
   top("start_utime", s.start_utime, "");
@@ -203,7 +211,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source_
   if (!vehicles.IsDefined()) {
     top.problem("vehicles", "missing: a scenario needs a list of vehicles (id 0 = the camera vehicle)");
   } else if (!vehicles.IsSequence() || vehicles.size() == 0) {
-    top.problem("vehicles", "expected a non-empty sequence of vehicles, got " + detail::describe_node(vehicles));
+    top.problem("vehicles", "expected a non-empty sequence of vehicles, got " + YamlMappingReader::describe(vehicles));
   } else {
     for (size_t i = 0; i < vehicles.size(); ++i) {
       s.vehicles.push_back(read_vehicle(source_name, vehicles[i], i, base_dir, &problems));
