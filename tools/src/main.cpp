@@ -16,6 +16,7 @@
 #include "wingman/tools/train_cli.hpp"
 #ifdef WINGMAN_WITH_SIM
 #include "wingman/tools/dataset_synth.hpp"
+#include "wingman/tools/fly_cli.hpp"
 #include "wingman/tools/scenario_random.hpp"
 #endif
 
@@ -224,6 +225,7 @@ int main(int argc, char** argv) {
 #ifdef WINGMAN_WITH_SIM
   DatasetVerbs dataset(app);    // dataset synth
   ScenarioVerbs scenario(app);  // scenario random
+  FlyVerb fly(app);             // fly (a simulated flight through the pipeline)
 #endif
 
   try {
@@ -252,6 +254,7 @@ int main(int argc, char** argv) {
 #ifdef WINGMAN_WITH_SIM
     if (const int rc = dataset.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
     if (const int rc = scenario.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+    if (const int rc = fly.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #endif
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+// `wingman fly`'s command line: tools/fly.sh's flags, bound to FlyOptions.
+#include "wingman/tools/fly_cli.hpp"
+
+#include "run_verb.hpp"
+#include "wingman/tools/fly.hpp"
+
+#include <CLI/CLI.hpp>
+
+namespace wingman::tools {
+
+struct FlyVerb::State {
+  CLI::App* fly = nullptr;
+  FlyOptions options;
+  bool render = false, no_render = false;
+};
+
+FlyVerb::FlyVerb(CLI::App& app) : s_(std::make_unique<State>()) {
+  FlyOptions& o = s_->options;
+  auto* f = s_->fly = app.add_subcommand(
+      "fly",
+      "Fly a simulated scenario through the real pipeline: wingman-sim, wingman-detector, wingman-localizer and "
+      "wingman-follower-ctrl as separate processes on the LCM bus, in lockstep (deterministic); record the bus, print "
+      "the localization and formation errors and write an HTML report. Run it in a private network namespace "
+      "(tools/fly.sh does)");
+  f->add_option("--scenario", o.scenario, "config/scenarios/NAME.yaml (under --config-dir) or a scenario file");
+  f->add_option("--out", o.out,
+                "Output folder: flight.lcmlog, sim.yaml, eval.json, targets.csv, report.html "
+                "(empty: build/flights/NAME)");
+  f->add_option("--duration", o.duration_s, "Stop after this many simulated seconds (0: the scenario's own length)");
+  f->add_option("--detections", o.detections,
+                "cnn: the detector finds the leader in the rendered images with its model; truth: the simulator "
+                "publishes boxes projected from ground truth (flagged as such down to the setpoints) and the detector "
+                "runs without a model")
+      ->check(CLI::IsMember({"cnn", "truth"}));
+  f->add_flag("--render", s_->render, "Render the camera images (1280x720); always with cnn");
+  f->add_flag("--no-render", s_->no_render, "No images (ground-truth detections need none); the default with truth");
+  f->add_flag("--record-images", o.record_images, "Also record the camera images in the log (2.7 MB a frame)");
+  f->add_option("--truth-box", o.truth_box,
+                "Ground-truth detections: the bounding sphere's exact box (the localizer's model) or the drone's "
+                "silhouette box")
+      ->check(CLI::IsMember({"sphere", "silhouette"}));
+  f->add_flag("--zoom-in", o.zoom_in, "The detector re-detects each box in a full-resolution crop");
+  f->add_flag("--flip-fusion", o.flip_fusion, "The detector also detects in the mirrored frame and fuses both passes");
+  f->add_flag("--coarse-pass", o.coarse_pass, "The detector also detects at half the network input (close drones)");
+  f->add_flag("--windows", o.windows,
+              "Tracker-driven windows: the localizer publishes where its tracks will be in the next frame and the "
+              "detector searches there at full resolution (windows.* of both; docs/detector.md)");
+  f->add_option("--localizer-config", o.localizer_config,
+                "The localizer's config (empty: config/flights/NAME.localizer.yaml if any, else its defaults)");
+  f->add_option("--follower-config", o.follower_config,
+                "The follower's config (empty: config/flights/NAME.follower_ctrl.yaml if any, else its defaults); its "
+                "formation.offset_m is also what the formation error is measured against");
+  f->add_option("--render-config", o.render_config,
+                "The simulator's render.* keys (lighting, scene) from this file (wingman-sim --render-config)");
+  f->add_option("--autopilot", o.autopilot,
+                "lcm: the simulator takes SETPOINT and publishes OWN_POSE; mavlink: the simulator is a MAVLink "
+                "vehicle on UDP loopback and wingman-mavlink bridges it (config/mavlink_bridge.sim.yaml)")
+      ->check(CLI::IsMember({"lcm", "mavlink"}));
+  f->add_option("--firmware", o.firmware, "With --autopilot mavlink: the simulated autopilot's rules")
+      ->check(CLI::IsMember({"px4", "ardupilot"}));
+  f->add_option("--own-pose-error", o.own_pose_error,
+                "M,RAD[,TAU]: the follower's reported pose drifts (Gauss-Markov, correlation time TAU s, default 2) "
+                "by M metres per position axis and RAD radians per rotation (standard deviations); empty: exact")
+      ->type_name("M,RAD[,TAU]");
+  f->add_option("--model-cfg", o.model_cfg,
+                "The detector's network (empty: beside --model-weights, or the built-in shipped model)")
+      ->envname("WINGMAN_MODEL_CFG");
+  f->add_option("--model-weights", o.model_weights, "The detector's weights (empty: the built-in shipped model)")
+      ->envname("WINGMAN_MODEL_WEIGHTS");
+  f->add_option("--config-dir", o.config_dir, "The checkout's config folder (scenarios, flights, MAVLink bridge)");
+  f->add_option("--bin-dir", o.bin_dir, "The executables (empty: the folder of this wingman)");
+  f->add_option("--lcm-url", o.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+}
+
+FlyVerb::~FlyVerb() = default;
+
+int FlyVerb::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (!*s_->fly) return -1;
+  return run_verb("wingman fly", err, [&] {
+    FlyOptions o = s_->options;
+    if (s_->render && s_->no_render) throw std::invalid_argument("--render and --no-render: give one");
+    if (s_->render) o.render = "on";
+    if (s_->no_render) o.render = "off";
+    return fly(plan_flight(o), out, err);
+  });
+}
+
+}  // namespace wingman::tools
