@@ -501,7 +501,7 @@ DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->synth->add_option("--out", s_->request.out_dir, "Dataset folder to create (must not hold images yet)")
       ->required();
   s_->synth->add_option("--count", s_->request.count, "Number of images")->required()->check(CLI::PositiveNumber);
-  s_->synth->add_option("--seed", s_->request.seed, "Seed (default 1): the same seed gives the same dataset");
+  s_->synth->add_option("--seed", s_->request.seed, "Seed: the same seed gives the same dataset");
   s_->synth->add_option("--config", s_->request.config, "YAML with synth.* and render.* keys (see --print-config)");
   s_->synth->add_option("--meshes", s_->request.meshes,
                         "Airframe mesh file or folder (repeatable), e.g. ../shared/meshes");
@@ -514,15 +514,15 @@ DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "boxes, as a YOLO dataset");
   s_->from_log->add_option("logs", f.logs, "LCM logs with images and GROUND_TRUTH")->required();
   s_->from_log->add_option("--out", f.out_dir, "Dataset folder (created, or extended with more logs)")->required();
-  s_->from_log->add_option("--split", f.split, "train or val: where all images of these logs go (default train)");
-  s_->from_log->add_option("--every", f.every, "Keep every Nth image of each log (default 1)");
+  s_->from_log->add_option("--split", f.split, "train or val: where all images of these logs go");
+  s_->from_log->add_option("--every", f.every, "Keep every Nth image of each log");
   s_->from_log->add_option("--min-box-px", f.min_box_px,
-                           "Drop visible boxes narrower or lower than this after clipping, pixels (default 2)");
+                           "Drop visible boxes narrower or lower than this after clipping, pixels");
   s_->from_log->add_flag("--skip-negatives", s_->skip_negatives, "Leave out frames without a visible drone");
-  s_->from_log->add_option("--format", f.image_format, "Image format: jpg (default) or png");
-  s_->from_log->add_option("--jpeg-quality", f.jpeg_quality, "JPEG quality 1..100 (default 92)");
-  s_->from_log->add_option("--image-channel", f.image_channel, "image_t channel (default IMAGE_CAM0)");
-  s_->from_log->add_option("--truth-channel", f.truth_channel, "ground_truth_t channel (default GROUND_TRUTH)");
+  s_->from_log->add_option("--format", f.image_format, "Image format: jpg or png");
+  s_->from_log->add_option("--jpeg-quality", f.jpeg_quality, "JPEG quality 1..100");
+  s_->from_log->add_option("--image-channel", f.image_channel, "image_t channel");
+  s_->from_log->add_option("--truth-channel", f.truth_channel, "ground_truth_t channel");
 }
 
 DatasetVerbs::~DatasetVerbs() = default;

@@ -26,12 +26,33 @@
 #include <wingman/common/version.hpp>
 
 #include <iostream>
+#include <string>
 #include <tuple>
+
+namespace {
+
+/// Every option's help shows its default, the value of the variable it is bound to (always_capture_default), but
+/// not a required option's (it has none) nor an empty list's ("[]": not given; the description says what that does).
+/// A default with a space is quoted, so that it does not run into the description.
+void tidy_defaults(CLI::App& app) {
+  for (CLI::Option* o : app.get_options()) {
+    const std::string d = o->get_default_str();
+    if (o->get_required() || d == "[]")
+      o->default_str("");
+    else if (d.find(' ') != std::string::npos)
+      o->default_str('"' + d + '"');
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) tidy_defaults(*sub);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace wingman::tools;
   CLI::App app{"Wingman tools: replay logs through the pipeline, monitor and inspect it", "wingman"};
   app.require_subcommand(1);
+  // Every verb's help shows each option's default from the variable it is bound to (subcommands inherit this).
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", std::string("wingman ") + wingman::common::version(),
                        "Print the version (and the commit built from) and exit");
 
@@ -39,11 +60,11 @@ int main(int argc, char** argv) {
   auto* r = app.add_subcommand(
       "replay", "Play an LCM log into the pipeline; with --wait-for, in lockstep with the named processes");
   r->add_option("log", replay.input_log, "Input LCM log file")->required();
-  r->add_option("--lcm-url", replay.lcm_url, "LCM URL to publish on and listen to (default: LCM_DEFAULT_URL)");
+  r->add_option("--lcm-url", replay.lcm_url, "LCM URL to publish on and listen to (empty: LCM_DEFAULT_URL)");
   r->add_option("--wait-for", replay.stages,
                 "Process instance names (as in their status) to run in lockstep with; each must run with --lockstep")
       ->delimiter(',');
-  r->add_option("--channels", replay.channels, "Regular expression of channels to play (default: all but STATUS_*)");
+  r->add_option("--channels", replay.channels, "Regular expression of channels to play (empty: all but STATUS_*)");
   r->add_option("--exclude", replay.exclude,
                 "Regular expression of channels not to play (e.g. the stages' own outputs)");
   r->add_option("--record", replay.record_log, "Write every message seen on the bus (but status) to this LCM log");
@@ -55,23 +76,23 @@ int main(int argc, char** argv) {
   bool replay_quiet = false;
   r->add_flag("--quiet", replay_quiet, "No progress on stderr");
   r->add_flag("--skip-corrupt", replay.skip_corrupt,
-              "Skip and count corrupt log events (default: stop at the first with an error naming its byte offset)");
+              "Skip and count corrupt log events (without it: stop at the first with an error naming its byte offset)");
 
   SpyOptions spy;
   auto* s = app.add_subcommand("spy", "Start lcm-spy with the Wingman message types");
-  s->add_option("--lcm-url", spy.lcm_url, "LCM URL to listen on (default: LCM_DEFAULT_URL)");
-  s->add_option("--java", spy.java, "Java runtime (default: java)");
-  s->add_option("--types-jar", spy.types_jar, "Jar with the wingman message classes (default: the built one)");
+  s->add_option("--lcm-url", spy.lcm_url, "LCM URL to listen on (empty: LCM_DEFAULT_URL)");
+  s->add_option("--java", spy.java, "Java runtime");
+  s->add_option("--types-jar", spy.types_jar, "Jar with the wingman message classes (empty: the built one)");
   s->add_flag("--dry-run", spy.dry_run, "Print the java command instead of running it");
 
   MakeVideoOptions video;
   auto* mv =
       app.add_subcommand("make-video", "Write a synthetic test clip (MJPG .avi) for the camera driver's file source");
   mv->add_option("output", video.output, "Output .avi file")->required();
-  mv->add_option("--frames", video.frames, "Number of frames (default 90)");
-  mv->add_option("--width", video.width, "Width, pixels (default 640)");
-  mv->add_option("--height", video.height, "Height, pixels (default 480)");
-  mv->add_option("--fps", video.fps, "Frames per second (default 30)");
+  mv->add_option("--frames", video.frames, "Number of frames");
+  mv->add_option("--width", video.width, "Width, pixels");
+  mv->add_option("--height", video.height, "Height, pixels");
+  mv->add_option("--fps", video.fps, "Frames per second");
 
   std::string info_log, info_snapshot;
   bool info_skip_corrupt = false;
@@ -79,8 +100,9 @@ int main(int argc, char** argv) {
       app.add_subcommand("loginfo", "Summarize an LCM log: channels, types, counts, time spans, process statuses");
   li->add_option("log", info_log, "LCM log file")->required();
   li->add_option("--snapshot", info_snapshot, "Save the last image_t as this PNG file");
-  li->add_flag("--skip-corrupt", info_skip_corrupt,
-               "Skip and count corrupt log events (default: stop at the first with an error naming its byte offset)");
+  li->add_flag(
+      "--skip-corrupt", info_skip_corrupt,
+      "Skip and count corrupt log events (without it: stop at the first with an error naming its byte offset)");
 
   LocalizeToolOptions localize;
   auto* lo = app.add_subcommand(
@@ -92,18 +114,17 @@ int main(int argc, char** argv) {
       ->required()
       ->expected(4)
       ->delimiter(',');
-  lo->add_option("--radius", localize.localizer.radius_m,
-                 "Target bounding-sphere radius, metres (default 0.348, F450)");
-  lo->add_option("--method", localize.localizer.range_method, "exact (default), thesis (eq. 32) or thesis_eq33");
-  lo->add_option("--min-range", localize.localizer.min_range_m, "Reject ranges below this, metres (default 0.5)");
-  lo->add_option("--max-range", localize.localizer.max_range_m, "Reject ranges above this, metres (default 100)");
-  lo->add_option("--edge-noise", localize.localizer.edge_noise_px, "Box edge noise, pixels (default 1)");
+  lo->add_option("--radius", localize.localizer.radius_m, "Target bounding-sphere radius, metres (the default: F450)");
+  lo->add_option("--method", localize.localizer.range_method, "exact, thesis (eq. 32) or thesis_eq33");
+  lo->add_option("--min-range", localize.localizer.min_range_m, "Reject ranges below this, metres");
+  lo->add_option("--max-range", localize.localizer.max_range_m, "Reject ranges above this, metres");
+  lo->add_option("--edge-noise", localize.localizer.edge_noise_px, "Box edge noise, pixels");
   lo->add_option("--edge-noise-rel", localize.localizer.edge_noise_rel,
-                 "Plus this fraction of the box width/height per edge, in quadrature (default 0)");
-  lo->add_option("--centre-noise", localize.localizer.centre_noise_px, "Box centre noise, pixels (default 0.5)");
+                 "Plus this fraction of the box width/height per edge, in quadrature");
+  lo->add_option("--centre-noise", localize.localizer.centre_noise_px, "Box centre noise, pixels");
   lo->add_option("--border-margin", localize.localizer.border_margin_px,
-                 "An edge this close to the image edge is cut, pixels (default 1)");
-  lo->add_option("--kalibr-camera", localize.kalibr_camera, "Camera entry of a Kalibr camchain (default cam0)");
+                 "An edge this close to the image edge is cut, pixels");
+  lo->add_option("--kalibr-camera", localize.kalibr_camera, "Camera entry of a Kalibr camchain");
   lo->add_option("--image-size", localize.image_size, "WxH of the images the box comes from; a mismatch is an error");
   lo->add_flag("--scale-calibration", localize.scale_calibration,
                "With --image-size: scale the calibration to that size (a uniform resize) instead of failing");
@@ -113,17 +134,16 @@ int main(int argc, char** argv) {
   auto* pr = app.add_subcommand(
       "predict", "Run the detector on image files or folders; write YOLO-format labels (and drawn images)");
   pr->add_option("inputs", predict.inputs, "Image files and/or folders of images")->required();
-  pr->add_option("--cfg", predict.cfg, "Darknet .cfg, or builtin:wingman-small (default) or builtin:tiny-yolo-thesis");
+  pr->add_option("--cfg", predict.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
   pr->add_option("--weights", predict.weights,
-                 "Darknet .weights, or builtin:wingman-small (default: the shipped model, models/wingman-small.md)");
-  pr->add_option("--backend", predict.backend, "Inference backend: auto (default), opencl or cpu");
+                 "Darknet .weights, or builtin:wingman-small (the shipped model, models/wingman-small.md)");
+  pr->add_option("--backend", predict.backend, "Inference backend: auto, opencl or cpu");
   pr->add_option("--input-size", predict.input_size,
-                 "Network input: auto (default: the cfg's longer side, the other fitted to each image's aspect), cfg "
-                 "or WxH");
-  pr->add_option("--out", predict.out_dir, "Output folder for <stem>.txt (default predictions)");
+                 "Network input: auto (the cfg's longer side, the other fitted to each image's aspect), cfg or WxH");
+  pr->add_option("--out", predict.out_dir, "Output folder for <stem>.txt");
   pr->add_flag("--draw", predict.draw, "Also write <stem>.pred.jpg with the boxes drawn");
-  pr->add_option("--p-thresh", predict.detection.p_thresh, "Confidence threshold (default 0.2)");
-  pr->add_option("--o-thresh", predict.detection.o_thresh, "Non-max suppression IoU threshold (default 0.2)");
+  pr->add_option("--p-thresh", predict.detection.p_thresh, "Confidence threshold");
+  pr->add_option("--o-thresh", predict.detection.o_thresh, "Non-max suppression IoU threshold");
   pr->add_flag("--subsquare", predict.detection.subsquare, "Detect in the centred h x h square of a wide image");
   pr->add_flag("--zoom-in", predict.detection.zoom_in, "Re-detect in full-resolution crops around detections");
   pr->add_flag("--drone-first", predict.detection.drone_first,
@@ -132,14 +152,14 @@ int main(int argc, char** argv) {
   pr->add_flag("--flip-fusion", predict.detection.flip_fusion,
                "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
   pr->add_option("--fusion-iou", predict.detection.fusion_iou,
-                 "--flip-fusion, --coarse-pass: fuse the passes' boxes overlapping above this IoU (default 0.3)");
+                 "--flip-fusion, --coarse-pass: fuse the passes' boxes overlapping above this IoU");
   pr->add_flag("--coarse-pass", predict.detection.coarse_pass,
                "Also detect at --coarse-scale of the network input and fuse its large boxes (close drones)");
   pr->add_option("--coarse-scale", predict.detection.coarse_scale,
-                 "--coarse-pass: network input sides times this, multiples of 32 (default 0.5)");
+                 "--coarse-pass: network input sides times this, multiples of 32");
   pr->add_option("--coarse-min-size", predict.detection.coarse_min_size,
-                 "--coarse-pass: drop its boxes below this sqrt(w h), image pixels (default 48)");
-  pr->add_option("--policy", predict.detection.policy, "all (default) or most_confident");
+                 "--coarse-pass: drop its boxes below this sqrt(w h), image pixels");
+  pr->add_option("--policy", predict.detection.policy, "all or most_confident");
   pr->add_option("--max-detections", predict.detection.max_detections, "At most this many boxes per image");
 
   // `eval` and `report` read a flight's log the same way; both take the matching options.
@@ -167,20 +187,22 @@ int main(int argc, char** argv) {
                   "The flight's scenario file (read with wingman-sim's loader): the vehicles' start for a pid_1d "
                   "follower (ids --follower-id and --leader-id); with it and no --follower-config, the follower's "
                   "built-in defaults are its configuration");
-    c->add_option("--formation-height", o.formation_height_m, "The follower's constant height, metres");
-    c->add_option("--settle", o.settle_s, "Skip this many seconds before measuring formation error (default 5)");
-    c->add_option("--leader-id", o.leader_id, "vehicle_id of the leader in ground truth (default 1)");
-    c->add_option("--follower-id", o.follower_id, "vehicle_id of the camera vehicle (default 0)");
-    c->add_option("--match-radius", o.match_radius_m, "Farther targets are false targets, metres (default 3)");
+    c->add_option("--formation-height", o.formation_height_m,
+                  "The follower's constant height, metres (negative: the formation offset's z)");
+    c->add_option("--settle", o.settle_s, "Skip this many seconds before measuring formation error");
+    c->add_option("--leader-id", o.leader_id, "vehicle_id of the leader in ground truth");
+    c->add_option("--follower-id", o.follower_id, "vehicle_id of the camera vehicle");
+    c->add_option("--match-radius", o.match_radius_m, "Farther targets are false targets, metres");
     c->add_option("--range-bins", o.range_bins_m,
-                  "Upper edges of the range bins, metres, increasing (default 5,10,15,20,30: 0-5, ..., 30+)")
+                  "Upper edges of the range bins, metres, increasing; the last bin is open (the default: 0-5, ..., "
+                  "30+)")
         ->delimiter(',');
-    c->add_option("--truth-channel", o.truth_channel, "ground_truth_t channel (default GROUND_TRUTH)");
-    c->add_option("--targets-channel", o.targets_channel, "targets_t channel (default TARGETS)");
-    c->add_option("--detections-channel", o.detections_channel, "detections_t channel (default DETECTIONS_CAM0)");
-    c->add_option("--image-channel", o.image_channel, "image_t channel (default IMAGE_CAM0)");
+    c->add_option("--truth-channel", o.truth_channel, "ground_truth_t channel");
+    c->add_option("--targets-channel", o.targets_channel, "targets_t channel");
+    c->add_option("--detections-channel", o.detections_channel, "detections_t channel");
+    c->add_option("--image-channel", o.image_channel, "image_t channel");
     c->add_option("--title", o.title, "Report title");
-    c->add_option("--frames", o.report_frames, "Camera frames shown in the report (default 6)");
+    c->add_option("--frames", o.report_frames, "Camera frames shown in the report");
     c->add_flag("--quiet", quiet, "No progress on stderr");
   };
   auto* ev = app.add_subcommand(
@@ -202,22 +224,20 @@ int main(int argc, char** argv) {
   auto* be = app.add_subcommand("bench", "Benchmarks (numbers, not tests)");
   be->require_subcommand(1);
   auto* bd = be->add_subcommand("detector",
-                                "A network (default: the thesis network) per frame: OpenCL vs CpuBackend vs bare "
-                                "OpenCV DNN, and the whole pipeline");
-  bd->add_option(
-        "--sizes", bench_detector.sizes,
-        "Network input sizes: N (N x N) or WxH, multiples of 32, or cfg (the network's own) (default 416,320,256)")
+                                "A network (the thesis network unless --cfg) per frame: OpenCL vs CpuBackend vs "
+                                "bare OpenCV DNN, and the whole pipeline");
+  bd->add_option("--sizes", bench_detector.sizes,
+                 "Network input sizes: N (N x N) or WxH, multiples of 32, or cfg (the network's own)")
       ->delimiter(',');
-  bd->add_option("--threads", bench_detector.threads,
-                 "OpenCV thread counts (default 1,2); OpenCL: POCL_MAX_PTHREAD_COUNT")
+  bd->add_option("--threads", bench_detector.threads, "OpenCV thread counts; OpenCL: POCL_MAX_PTHREAD_COUNT")
       ->delimiter(',');
-  bd->add_option("--repetitions", bench_detector.repetitions, "Timed runs per row (default 7)");
-  bd->add_option("--warmup", bench_detector.warmup, "Untimed runs before each row (default 2)");
+  bd->add_option("--repetitions", bench_detector.repetitions, "Timed runs per row");
+  bd->add_option("--warmup", bench_detector.warmup, "Untimed runs before each row");
   bd->add_option("--cfg", bench_detector.cfg,
-                 "Network: a .cfg or builtin:tiny-yolo-thesis (default) or builtin:wingman-small (the shipped model)");
+                 "Network: a .cfg, builtin:tiny-yolo-thesis or builtin:wingman-small (the shipped model)");
   bd->add_option("--weights", bench_detector.weights,
-                 "Darknet .weights or builtin:wingman-small (default: random weights, fixed seed)");
-  bd->add_option("--seed", bench_detector.seed, "Seed of the random weights (default 42)");
+                 "Darknet .weights or builtin:wingman-small (empty: random weights, --seed)");
+  bd->add_option("--seed", bench_detector.seed, "Seed of the random weights");
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
   TrainingVerbs training(app);  // train, val, import-halmstad
@@ -227,6 +247,7 @@ int main(int argc, char** argv) {
   ScenarioVerbs scenario(app);  // scenario random
   FlyVerb fly(app);             // fly (a simulated flight through the pipeline)
 #endif
+  tidy_defaults(app);
 
   try {
     app.parse(argc, argv);

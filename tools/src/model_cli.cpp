@@ -44,17 +44,15 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "widen-classes",
       "Grow a trained model's [yolo] heads to more classes (new classes start at zero weights and a low bias; the "
       "model's drone boxes are unchanged), to fine-tune with distractor classes");
-  s.widen->add_option("--cfg", s.cfg, "The trained model's .cfg or builtin:wingman-small (default)");
-  s.widen->add_option("--weights", s.weights, "Its .weights or builtin:wingman-small (default)");
-  s.widen->add_option("--classes", s.classes,
-                      "Classes of the widened heads (default 4: drone, airplane, bird, "
-                      "helicopter)");
-  s.widen->add_option("--new-class-bias", s.bias, "Logit of the new classes' bias (default -4.595: probability 0.01)");
+  s.widen->add_option("--cfg", s.cfg, "The trained model's .cfg or builtin:wingman-small");
+  s.widen->add_option("--weights", s.weights, "Its .weights or builtin:wingman-small");
+  s.widen->add_option("--classes", s.classes, "Classes of the widened heads (4: drone, airplane, bird, helicopter)");
+  s.widen->add_option("--new-class-bias", s.bias, "Logit of the new classes' bias (the default: probability 0.01)");
   s.widen->add_option("--iou-loss", s.iou_loss,
-                      "Training box loss written into every [yolo] of the new .cfg: mse, giou, diou or ciou (default: "
+                      "Training box loss written into every [yolo] of the new .cfg: mse, giou, diou or ciou (empty: "
                       "the model's)");
   s.widen->add_option("--iou-normalizer", s.iou_normalizer,
-                      "Weight of that box loss written into every [yolo] (default: the model's)");
+                      "Weight of that box loss written into every [yolo] (0: the model's)");
   s.widen->add_option("--out-cfg", s.out_cfg, "The widened .cfg to write")->required();
   s.widen->add_option("--out-weights", s.out_weights, "The widened .weights to write")->required();
 
@@ -66,25 +64,22 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "localizer reads (target.box_relation); or --check a relation on other images");
   s.relation->add_option("--data", rq.data, "A `wingman dataset synth` folder (images and meta with sphere_box)")
       ->required();
-  s.relation->add_option("--split", rq.split, "Its split (default val)");
+  s.relation->add_option("--split", rq.split, "Its split");
   s.relation->add_option("--detector-config", rq.detector_config,
-                         "The detector's process configuration (default: its built-in defaults, as installed)");
+                         "The detector's process configuration (empty: its built-in defaults, as installed)");
   s.relation->add_option("--out", rq.out, "Fit: the relation file to write (beside the model's weights)");
   s.relation->add_option("--check", rq.check,
                          "Evaluate this relation instead of fitting: sphere, builtin:wingman-small or a file");
-  s.relation->add_option("--model-name", rq.model_name,
-                         "The model's name written into the file (default wingman-small)");
-  s.relation->add_option("--min-iou", rq.min_iou,
-                         "A detection is the target's at this IoU with its outline box (default 0.3)");
-  s.relation->add_option("--max-images", rq.max_images, "At most this many images (default 0: all)");
+  s.relation->add_option("--model-name", rq.model_name, "The model's name written into the file");
+  s.relation->add_option("--min-iou", rq.min_iou, "A detection is the target's at this IoU with its outline box");
+  s.relation->add_option("--max-images", rq.max_images, "At most this many images (0: all)");
   s.relation->add_option("--samples", rq.samples_csv,
                          "Also write every matched target (geometry, detected and sphere boxes, ratios) to this CSV");
   s.relation->add_option("--max-median-error", s.max_median_error,
-                         "Exit 1 when |median range error| over all targets exceeds this (a guard; default: none)");
+                         "Exit 1 when |median range error| over all targets exceeds this (a guard; negative: none)");
   s.relation->add_option("--max-mad", s.max_mad,
-                         "Exit 1 when the range error's 1.4826 MAD over all targets exceeds this (default: none)");
-  s.relation->add_option("--min-targets", s.min_targets,
-                         "Exit 1 when the detector finds fewer targets than this (default 0)");
+                         "Exit 1 when the range error's 1.4826 MAD over all targets exceeds this (negative: none)");
+  s.relation->add_option("--min-targets", s.min_targets, "Exit 1 when the detector finds fewer targets than this");
 }
 
 ModelVerbs::~ModelVerbs() = default;

@@ -449,12 +449,12 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "Write a seeded random formation flight for wingman-sim (leader on a random 3-D path at 0.3-3 m/s for 30-60 s, "
       "follower 4-20 m away) and, beside it, FILE.localizer.yaml (the leader's bounding radius), "
       "FILE.follower_ctrl.yaml (the formation offset) and FILE.render.yaml (lighting) for tools/fly.sh");
-  s_->random->add_option("--seed", o.seed, "Seed (default 1001): the same seed gives the same files")->required();
+  s_->random->add_option("--seed", o.seed, "Seed: the same seed gives the same files")->required();
   s_->random->add_option("--airframe", o.airframe,
                          "quad, hex or octo (procedural, drawn as dataset synth draws them) or a mesh file, e.g. "
-                         "../shared/meshes/holybro_x500v2.glb (default quad)");
-  s_->random->add_option("--view", o.view, "behind (the leader's rear faces the camera) or side (default behind)");
-  s_->random->add_option("--lighting", o.lighting, "A (midday, clear) or B (evening, low sun, haze; default A)");
+                         "../shared/meshes/holybro_x500v2.glb");
+  s_->random->add_option("--view", o.view, "behind (the leader's rear faces the camera) or side");
+  s_->random->add_option("--lighting", o.lighting, "A (midday, clear) or B (evening, low sun, haze)");
   s_->random->add_option("--out", o.out, "The scenario file to write, FILE.yaml")->required();
 
   ScenarioSweepOptions& w = s_->sweep_options;
@@ -463,16 +463,14 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "Write a range sweep for wingman-sim: the airframe hovers, the camera steps away from it along the line of "
       "sight (--from to --to in --step, --frames-per-step frames each), and beside it FILE.localizer.yaml (the "
       "airframe's bounding radius), FILE.render.yaml (lighting) and FILE.json for tools/fly.sh");
-  s_->sweep->add_option("--airframe", w.airframe,
-                        "quad, hex or octo (procedural, drawn with --seed) or a mesh file (default quad)");
-  s_->sweep->add_option("--seed", w.seed,
-                        "Seed of a procedural airframe, the scene and the image noise (default 2001)");
-  s_->sweep->add_option("--view", w.view, "behind (the rear faces the camera) or side (default behind)");
-  s_->sweep->add_option("--lighting", w.lighting, "A (midday) or B (evening; default A)");
-  s_->sweep->add_option("--from", w.from_m, "First distance, m (default 3)");
-  s_->sweep->add_option("--to", w.to_m, "Last distance, m (default 30)");
-  s_->sweep->add_option("--step", w.step_m, "Step, m (default 0.5)");
-  s_->sweep->add_option("--frames-per-step", w.frames_per_step, "Frames at each distance (default 8)");
+  s_->sweep->add_option("--airframe", w.airframe, "quad, hex or octo (procedural, drawn with --seed) or a mesh file");
+  s_->sweep->add_option("--seed", w.seed, "Seed of a procedural airframe, the scene and the image noise");
+  s_->sweep->add_option("--view", w.view, "behind (the rear faces the camera) or side");
+  s_->sweep->add_option("--lighting", w.lighting, "A (midday) or B (evening)");
+  s_->sweep->add_option("--from", w.from_m, "First distance, m");
+  s_->sweep->add_option("--to", w.to_m, "Last distance, m");
+  s_->sweep->add_option("--step", w.step_m, "Step, m");
+  s_->sweep->add_option("--frames-per-step", w.frames_per_step, "Frames at each distance");
   s_->sweep->add_option("--out", w.out, "The scenario file to write, FILE.yaml")->required();
 
   s_->get = scenario->add_subcommand(

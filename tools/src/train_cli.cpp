@@ -75,19 +75,10 @@ struct TrainingVerbs::State {
   CLI::App* val = nullptr;
   CLI::App* halmstad = nullptr;
 
-  // train: the .cfg gives the defaults; only options given on the command line override them.
-  std::string cfg, data, out_dir = "train-out", init_weights, train_split = "train", val_split = "val";
-  bool resume = false;
-  bool partial_weights = false;
-  int batch = 0, subdivisions = 0, burn_in = 0, threads = 2, checkpoint_interval = 100, weights_interval = 1000,
-      log_interval = 1, val_max_images = 0;
-  int64_t max_batches = 0;
-  uint64_t seed = 1;
-  double learning_rate = 0, momentum = 0, decay = 0;
-  training::WeightAverageOptions ema;
-  std::vector<int> steps;
-  std::vector<double> scales;
-  training::AugmentOptions augment;
+  // train: the .cfg's [net] keys give the defaults of the fields it has; only options given on the command line
+  // override them. The other fields, and the defaults --help shows, are TrainOptions's own.
+  std::string cfg, data;
+  training::TrainOptions given;
   std::vector<std::pair<CLI::Option*, std::function<void(training::TrainOptions&)>>> overrides;
 
   training::ValOptions val_options;
@@ -114,67 +105,71 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   auto* t = s.train;
   t->add_option("--cfg", s.cfg, "Darknet .cfg: the network and, in [net], its training settings")->required();
   t->add_option("--data", s.data, "data.yaml or YOLO-layout folder (images/<split>, labels/<split>)")->required();
-  t->add_option("--out", s.out_dir,
-                "Output folder: checkpoint.pt, <cfg stem>_{last,final,N}.weights (default train-out)");
-  t->add_flag("--resume", s.resume, "Continue from <out>/checkpoint.pt (same cfg, data, seed and batch)");
-  t->add_option("--weights", s.init_weights, "Start from these Darknet .weights instead of random weights");
-  t->add_flag("--partial-weights", s.partial_weights,
+  TrainOptions& g = s.given;
+  t->add_option("--out", g.out_dir, "Output folder: checkpoint.pt, <cfg stem>_{last,final,N}.weights");
+  t->add_flag("--resume", g.resume, "Continue from <out>/checkpoint.pt (same cfg, data, seed and batch)");
+  t->add_option("--weights", g.init_weights, "Start from these Darknet .weights instead of random weights");
+  t->add_flag("--partial-weights", g.init_partial,
               "--weights may hold only the first convolutional layers (a trained network the cfg extends with "
               "appended layers): those are loaded, the others start random");
-  t->add_option("--train-split", s.train_split, "Split to train on (default train)");
-  t->add_option("--val-split", s.val_split, "Split to validate on at the end; empty: none (default val)");
-  t->add_option("--val-max-images", s.val_max_images, "Validate on at most this many images (default all)");
-  t->add_option("--seed", s.seed, "Seed of the initial weights, data order and augmentation (default 1)");
-  t->add_option("--threads", s.threads, "libtorch threads (default 2)");
-  t->add_option("--checkpoint-interval", s.checkpoint_interval, "Checkpoint every this many iterations (default 100)");
-  t->add_option("--weights-interval", s.weights_interval,
-                "Keep <stem>_<iteration>.weights every this many iterations, 0 = never (default 1000)");
-  t->add_option("--log-interval", s.log_interval, "Print progress every this many iterations (default 1)");
-  t->add_option("--ema-decay", s.ema.decay,
+  t->add_option("--train-split", g.train_split, "Split to train on");
+  t->add_option("--val-split", g.val_split, "Split to validate on at the end (empty: none)");
+  t->add_option("--val-max-images", g.val_max_images, "Validate on at most this many images (0: all)");
+  t->add_option("--seed", g.seed, "Seed of the initial weights, data order and augmentation");
+  t->add_option("--threads", g.threads, "libtorch threads");
+  t->add_option("--checkpoint-interval", g.checkpoint_interval, "Checkpoint every this many iterations");
+  t->add_option("--weights-interval", g.weights_interval,
+                "Keep <stem>_<iteration>.weights every this many iterations (0: never)");
+  t->add_option("--log-interval", g.log_interval, "Print progress every this many iterations");
+  t->add_option("--ema-decay", g.ema.decay,
                 "Keep an exponential moving average of the weights with this decay (e.g. 0.99: about the last 100 "
-                "iterations) and export it; <stem>_raw_final.weights keeps the trained weights (default 0: none)");
-  t->add_option("--ema-ramp", s.ema.ramp,
-                "The average's decay rises to --ema-decay over about this many iterations (default 100)");
+                "iterations) and export it; <stem>_raw_final.weights keeps the trained weights (0: none)");
+  t->add_option("--ema-ramp", g.ema.ramp, "The average's decay rises to --ema-decay over about this many iterations");
+  // The [net] keys: given, the option wins; not given, the cfg's key if it has it, else the default shown.
   auto over = [&](CLI::Option* o, std::function<void(TrainOptions&)> apply) { s.overrides.emplace_back(o, apply); };
-  over(t->add_option("--batch", s.batch, "Images per iteration (default: [net] batch)"),
-       [&s](TrainOptions& o) { o.batch = s.batch; });
-  over(t->add_option("--subdivisions", s.subdivisions, "Passes per iteration (default: [net] subdivisions)"),
-       [&s](TrainOptions& o) { o.subdivisions = s.subdivisions; });
-  over(t->add_option("--max-batches", s.max_batches, "Iterations to train (default: [net] max_batches)"),
-       [&s](TrainOptions& o) { o.max_batches = s.max_batches; });
-  over(t->add_option("--learning-rate", s.learning_rate, "Learning rate after warm-up (default: [net] learning_rate)"),
-       [&s](TrainOptions& o) { o.lr.base = s.learning_rate; });
-  over(t->add_option("--burn-in", s.burn_in, "Warm-up iterations (default: [net] burn_in)"),
-       [&s](TrainOptions& o) { o.lr.burn_in = s.burn_in; });
-  over(t->add_option("--steps", s.steps, "Iterations of the rate steps (default: [net] steps)")->delimiter(','),
-       [&s](TrainOptions& o) { o.lr.steps = s.steps; });
-  over(t->add_option("--scales", s.scales, "Factor at each step (default: [net] scales)")->delimiter(','),
-       [&s](TrainOptions& o) { o.lr.scales = s.scales; });
-  over(t->add_option("--momentum", s.momentum, "SGD momentum (default: [net] momentum)"),
-       [&s](TrainOptions& o) { o.momentum = s.momentum; });
-  over(t->add_option("--decay", s.decay, "Weight decay (default: [net] decay)"),
-       [&s](TrainOptions& o) { o.decay = s.decay; });
-  over(t->add_option("--hue", s.augment.hue, "Hue jitter r_h (default: [net] hue)"),
-       [&s](TrainOptions& o) { o.augment.hue = s.augment.hue; });
-  over(t->add_option("--saturation", s.augment.saturation, "Saturation jitter r_s (default: [net] saturation)"),
-       [&s](TrainOptions& o) { o.augment.saturation = s.augment.saturation; });
-  over(t->add_option("--exposure", s.augment.exposure, "Value jitter r_v (default: [net] exposure)"),
-       [&s](TrainOptions& o) { o.augment.exposure = s.augment.exposure; });
-  over(t->add_option("--jitter", s.augment.jitter, "Random crop r_c (default: [net] or the head's jitter)"),
-       [&s](TrainOptions& o) { o.augment.jitter = s.augment.jitter; });
-  over(t->add_option("--flip", s.augment.flip, "Horizontal flip probability (default 0.5; [net] flip=0: 0)"),
-       [&s](TrainOptions& o) { o.augment.flip = s.augment.flip; });
-  over(t->add_option("--scale", s.augment.scale, "Extra zoom range: factor in [1/(1+s), 1+s] (default 0)"),
-       [&s](TrainOptions& o) { o.augment.scale = s.augment.scale; });
-  over(t->add_option("--translate", s.augment.translate, "Extra shift, fraction of the crop (default 0)"),
-       [&s](TrainOptions& o) { o.augment.translate = s.augment.translate; });
-  over(t->add_option("--blur", s.augment.blur, "Probability of a Gaussian blur (default 0)"),
-       [&s](TrainOptions& o) { o.augment.blur = s.augment.blur; });
-  over(t->add_option("--noise", s.augment.noise, "Probability of pixel noise (default 0)"),
-       [&s](TrainOptions& o) { o.augment.noise = s.augment.noise; });
-  over(t->add_option("--mosaic", s.augment.mosaic,
-                     "Probability of a 2x2 mosaic sample (default 0; [net] mosaic=1: 0.5)"),
-       [&s](TrainOptions& o) { o.augment.mosaic = s.augment.mosaic; });
+  over(t->add_option("--batch", g.batch, "Images per iteration (not given: [net] batch if set)"),
+       [&g](TrainOptions& o) { o.batch = g.batch; });
+  over(t->add_option("--subdivisions", g.subdivisions, "Passes per iteration (not given: [net] subdivisions if set)"),
+       [&g](TrainOptions& o) { o.subdivisions = g.subdivisions; });
+  over(t->add_option("--max-batches", g.max_batches, "Iterations to train (not given: [net] max_batches if set)"),
+       [&g](TrainOptions& o) { o.max_batches = g.max_batches; });
+  over(t->add_option("--learning-rate", g.lr.base,
+                     "Learning rate after warm-up (not given: [net] learning_rate if set)"),
+       [&g](TrainOptions& o) { o.lr.base = g.lr.base; });
+  over(t->add_option("--burn-in", g.lr.burn_in, "Warm-up iterations (not given: [net] burn_in if set)"),
+       [&g](TrainOptions& o) { o.lr.burn_in = g.lr.burn_in; });
+  over(t->add_option("--steps", g.lr.steps, "Iterations of the rate steps (not given: [net] steps if set)")
+           ->delimiter(','),
+       [&g](TrainOptions& o) { o.lr.steps = g.lr.steps; });
+  over(t->add_option("--scales", g.lr.scales, "Factor at each step (not given: [net] scales if set)")->delimiter(','),
+       [&g](TrainOptions& o) { o.lr.scales = g.lr.scales; });
+  over(t->add_option("--momentum", g.momentum, "SGD momentum (not given: [net] momentum if set)"),
+       [&g](TrainOptions& o) { o.momentum = g.momentum; });
+  over(t->add_option("--decay", g.decay, "Weight decay (not given: [net] decay if set)"),
+       [&g](TrainOptions& o) { o.decay = g.decay; });
+  over(t->add_option("--hue", g.augment.hue, "Hue jitter r_h (not given: [net] hue if set)"),
+       [&g](TrainOptions& o) { o.augment.hue = g.augment.hue; });
+  over(
+      t->add_option("--saturation", g.augment.saturation, "Saturation jitter r_s (not given: [net] saturation if set)"),
+      [&g](TrainOptions& o) { o.augment.saturation = g.augment.saturation; });
+  over(t->add_option("--exposure", g.augment.exposure, "Value jitter r_v (not given: [net] exposure if set)"),
+       [&g](TrainOptions& o) { o.augment.exposure = g.augment.exposure; });
+  over(t->add_option("--jitter", g.augment.jitter, "Random crop r_c (not given: [net] jitter, else the head's jitter)")
+           ->default_str(""),
+       [&g](TrainOptions& o) { o.augment.jitter = g.augment.jitter; });
+  over(t->add_option("--flip", g.augment.flip, "Horizontal flip probability (not given: [net] flip=0: 0)"),
+       [&g](TrainOptions& o) { o.augment.flip = g.augment.flip; });
+  over(t->add_option("--scale", g.augment.scale, "Extra zoom range: factor in [1/(1+s), 1+s]"),
+       [&g](TrainOptions& o) { o.augment.scale = g.augment.scale; });
+  over(t->add_option("--translate", g.augment.translate, "Extra shift, fraction of the crop"),
+       [&g](TrainOptions& o) { o.augment.translate = g.augment.translate; });
+  over(t->add_option("--blur", g.augment.blur, "Probability of a Gaussian blur"),
+       [&g](TrainOptions& o) { o.augment.blur = g.augment.blur; });
+  over(t->add_option("--noise", g.augment.noise, "Probability of pixel noise"),
+       [&g](TrainOptions& o) { o.augment.noise = g.augment.noise; });
+  over(t->add_option("--mosaic", g.augment.mosaic,
+                     "Probability of a 2x2 mosaic sample (not given: [net] mosaic=1: 0.5)"),
+       [&g](TrainOptions& o) { o.augment.mosaic = g.augment.mosaic; });
 
   // ---- val ----
   s.val = app.add_subcommand(
@@ -183,50 +178,47 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   training::ValOptions& vo = s.val_options;
   vo.backend = "auto";  // as `wingman predict` and the detector process (one default per flag, issue 34)
   v->add_option("--data", vo.data, "data.yaml or YOLO-layout folder")->required();
-  v->add_option("--split", vo.split, "Split to evaluate (default val; \"\" = a folder's images/)");
+  v->add_option("--split", vo.split, "Split to evaluate (empty: a folder's images/)");
   v->add_option("--weights", vo.weights,
-                "Darknet .weights, or builtin:wingman-small (default without --predictions: the shipped model): run "
-                "the detector (Algorithm 2)");
-  v->add_option("--cfg", vo.cfg, "Darknet .cfg, or builtin:wingman-small (default) or builtin:tiny-yolo-thesis");
-  v->add_option("--backend", vo.backend, "Detector backend: auto (default), opencl or cpu");
+                "Darknet .weights, or builtin:wingman-small: run the detector (Algorithm 2) (empty without "
+                "--predictions: the shipped model)");
+  v->add_option("--cfg", vo.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
+  v->add_option("--backend", vo.backend, "Detector backend: auto, opencl or cpu");
   v->add_option("--input-size", vo.input_size,
-                "Network input: auto (default: the cfg's longer side, the other fitted to each image's aspect), cfg "
-                "or WxH");
+                "Network input: auto (the cfg's longer side, the other fitted to each image's aspect), cfg or WxH");
   s.val_predictions = v->add_option("--predictions", vo.predictions,
                                     "Instead of --weights: folder of `wingman predict` <stem>.txt files");
-  v->add_option("--conf", vo.metrics.conf_thresh,
-                "Operating confidence for precision / recall / mean IoU (default 0.2)");
-  v->add_option("--iou", vo.metrics.iou_thresh, "IoU match threshold (default 0.5)");
-  v->add_option("--size-edges", vo.metrics.size_edges_px, "Size-bin edges, sqrt(w h) in pixels (default 16,32,64)")
-      ->delimiter(',');
-  v->add_option("--pr-points", vo.metrics.pr_points, "Points of the PR curve in the JSON (default 101)");
+  v->add_option("--conf", vo.metrics.conf_thresh, "Operating confidence for precision / recall / mean IoU");
+  v->add_option("--iou", vo.metrics.iou_thresh, "IoU match threshold");
+  v->add_option("--size-edges", vo.metrics.size_edges_px, "Size-bin edges, sqrt(w h) in pixels")->delimiter(',');
+  v->add_option("--pr-points", vo.metrics.pr_points, "Points of the PR curve in the JSON");
   s.val_p_thresh = v->add_option("--p-thresh", vo.detection.p_thresh,
-                                 "Detector's confidence floor (default 0.005, for the curve; --sequences: 0.2, the "
-                                 "detector's p_thresh)");
-  v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold (default 0.2)");
+                                 "Detector's confidence floor, low for the curve (not given with --sequences: 0.2, "
+                                 "the detector's p_thresh)");
+  v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold");
   v->add_flag("--subsquare", vo.detection.subsquare, "Detect in the centred h x h square of a wide image");
   v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
   v->add_flag("--drone-first", vo.detection.drone_first,
               "Multi-class models: a box whose drone score reaches the threshold is a drone even if another class "
               "scores higher");
   v->add_option("--zoom-max-fraction", vo.detection.zoom_max_fraction,
-                "Zoom in only on boxes at most this fraction of the crop's width and height (default 0.25)");
+                "Zoom in only on boxes at most this fraction of the crop's width and height");
   v->add_flag("--flip-fusion", vo.detection.flip_fusion,
               "Also detect in the mirrored image and fuse both passes' boxes (twice the work)");
   v->add_option("--fusion-iou", vo.detection.fusion_iou,
-                "--flip-fusion, --coarse-pass: fuse the passes' boxes overlapping above this IoU (default 0.3)");
+                "--flip-fusion, --coarse-pass: fuse the passes' boxes overlapping above this IoU");
   v->add_flag("--coarse-pass", vo.detection.coarse_pass,
               "Also detect at --coarse-scale of the network input and fuse its large boxes (close drones)");
   v->add_option("--coarse-scale", vo.detection.coarse_scale,
-                "--coarse-pass: network input sides times this, multiples of 32 (default 0.5)");
+                "--coarse-pass: network input sides times this, multiples of 32");
   v->add_option("--coarse-min-size", vo.detection.coarse_min_size,
-                "--coarse-pass: drop its boxes below this sqrt(w h), image pixels (default 48)");
-  v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image (default 10)");
-  s.val_class = v->add_option("--class", vo.class_id, "Class to evaluate (default 0, drone)");
-  v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (default all)");
+                "--coarse-pass: drop its boxes below this sqrt(w h), image pixels");
+  v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image");
+  s.val_class = v->add_option("--class", vo.class_id, "Class to evaluate (0: drone)");
+  v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (0: all)");
   v->add_option("--edge-margin", vo.metrics.edge_margin_px,
-                "A truth within this many pixels of the image's border touches the edge (default 1)");
-  v->add_option("--list", s.val_list, "List this many of the largest truths not found, per criterion (default 10)");
+                "A truth within this many pixels of the image's border touches the edge");
+  v->add_option("--list", s.val_list, "List this many of the largest truths not found, per criterion");
   s.val_json = v->add_option("--json", s.val_json_path,
                              "Alone or --json -: print one JSON object (with the PR curves and every truth not found) "
                              "instead of the table; --json FILE: print the table and write the JSON to FILE")
@@ -238,24 +230,22 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "import-halmstad`, its splits.csv) through the detector and wingman-localizer's tracker; false tracks per "
       "hour, drone clips confirmed and the time to confirm (--conf, --iou, --max-images, --size-edges, "
       "--pr-points, --list do not apply)");
-  v->add_option("--halmstad-root", so.halmstad_root,
-                "--sequences: the Halmstad dataset (videos/, labels/) (default ../shared/datasets/halmstad)");
+  v->add_option("--halmstad-root", so.halmstad_root, "--sequences: the Halmstad dataset (videos/, labels/)");
   v->add_option("--localizer-config", so.localizer_config,
-                "--sequences: wingman-localizer's YAML (config/localizer.yaml keys; camera.* unused) (default: its "
+                "--sequences: wingman-localizer's YAML (config/localizer.yaml keys; camera.* unused) (empty: its "
                 "built-in defaults)");
   v->add_option("--hfov-deg", so.hfov_deg,
-                "--sequences: horizontal field of view of the static camera's nominal pinhole, degrees (default 24)");
-  v->add_option("--frame-step", so.frame_step, "--sequences: track every n-th frame (default 1: every frame)");
+                "--sequences: horizontal field of view of the static camera's nominal pinhole, degrees");
+  v->add_option("--frame-step", so.frame_step, "--sequences: track every n-th frame (1: every frame)");
   v->add_option("--clips", so.clips, "--sequences: only these clips of the split (comma-separated)")->delimiter(',');
   v->add_option("--boxes-cache", so.boxes_cache,
                 "--sequences: folder of each clip's detector boxes: a clip whose <clip>.boxes is there is tracked "
                 "from it without the detector, the others are detected and written (a file made with other "
                 "detection settings is an error)");
   v->add_option("--confirm-within", so.scoring.confirm_within_s,
-                "--sequences: a drone confirmed this long after its first label counts as in time, s (default 1)");
+                "--sequences: a drone confirmed this long after its first label counts as in time, s");
   v->add_option("--on-target-fraction", so.scoring.on_target_fraction,
-                "--sequences: a track is on the drone when more than this share of its confirmed hits is (default "
-                "0.5)");
+                "--sequences: a track is on the drone when more than this share of its confirmed hits is");
 
   // ---- import-halmstad ----
   s.halmstad = app.add_subcommand(
@@ -265,19 +255,18 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   h->add_option("root", io.root, "The dataset folder (clips.csv, videos/, labels/), e.g. ../shared/datasets/halmstad")
       ->required();
   h->add_option("out", io.out_dir, "The YOLO dataset to write")->required();
-  h->add_option("--frame-step", io.frame_step, "Every n-th frame of drone clips (default 10)");
-  h->add_option("--negative-frame-step", io.negative_frame_step,
-                "Every n-th frame of airplane/bird/helicopter clips (default 30)");
+  h->add_option("--frame-step", io.frame_step, "Every n-th frame of drone clips");
+  h->add_option("--negative-frame-step", io.negative_frame_step, "Every n-th frame of airplane/bird/helicopter clips");
   h->add_flag("--no-negatives", s.no_negatives, "Leave out the airplane/bird/helicopter clips");
   h->add_flag("--distractor-classes", io.distractor_classes,
               "Label the airplane/bird/helicopter clips' boxes as classes 1, 2, 3 instead of empty negatives");
-  h->add_option("--max-frames-per-clip", io.max_frames_per_clip, "At most this many frames per clip (default all)");
-  h->add_option("--val-fraction", io.val_fraction, "Share of clips in val, per class and distance (default 0.2)");
-  h->add_option("--seed", io.seed, "Seed of the clip split (default 1)");
+  h->add_option("--max-frames-per-clip", io.max_frames_per_clip, "At most this many frames per clip (0: all)");
+  h->add_option("--val-fraction", io.val_fraction, "Share of clips in val, per class and distance");
+  h->add_option("--seed", io.seed, "Seed of the clip split");
   h->add_flag("--no-tighten", s.no_tighten, "Keep the loose boxes as labelled");
   h->add_option("--clips", io.clips, "Only these clips (comma-separated names)")->delimiter(',');
-  h->add_option("--exclude", io.exclude, "Leave out these clips (default V_DRONE_005,V_DRONE_099)")->delimiter(',');
-  h->add_option("--jpeg-quality", io.jpeg_quality, "Quality of the written frames (default 95)");
+  h->add_option("--exclude", io.exclude, "Leave out these clips")->delimiter(',');
+  h->add_option("--jpeg-quality", io.jpeg_quality, "Quality of the written frames");
 }
 
 TrainingVerbs::~TrainingVerbs() = default;
@@ -380,20 +369,21 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       return 0;
     });
     if (cfg_rc != 0) return cfg_rc;
+    const training::TrainOptions& g = s.given;
     o.data = s.data;
-    o.out_dir = s.out_dir;
-    o.init_weights = s.init_weights;
-    o.init_partial = s.partial_weights;
-    o.resume = s.resume;
-    o.train_split = s.train_split;
-    o.val_split = s.val_split;
-    o.val_max_images = s.val_max_images;
-    o.seed = s.seed;
-    o.threads = s.threads;
-    o.checkpoint_interval = s.checkpoint_interval;
-    o.weights_interval = s.weights_interval;
-    o.log_interval = s.log_interval;
-    o.ema = s.ema;
+    o.out_dir = g.out_dir;
+    o.init_weights = g.init_weights;
+    o.init_partial = g.init_partial;
+    o.resume = g.resume;
+    o.train_split = g.train_split;
+    o.val_split = g.val_split;
+    o.val_max_images = g.val_max_images;
+    o.seed = g.seed;
+    o.threads = g.threads;
+    o.checkpoint_interval = g.checkpoint_interval;
+    o.weights_interval = g.weights_interval;
+    o.log_interval = g.log_interval;
+    o.ema = g.ema;
     for (auto& [option, apply] : s.overrides)
       if (option->count() > 0) apply(o);
     restart_with_thread_settings(err);
