@@ -8,7 +8,7 @@ out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 "$bin/wingman" make-video "$out/clip.avi" --frames 30 --width 320 --height 240
 cd "$src"
 # The executables of the build under test (build-tsan's under ThreadSanitizer), not build/bin.
-log=$(WINGMAN_BIN_DIR="$bin" timeout 120 tools/netns_run.sh tools/demo_pipeline.sh "$out/clip.avi" "$out" 2>&1) ||
+log=$(timeout 120 tools/netns_run.sh "$bin/wingman" demo-camera "$out/clip.avi" --out "$out" --bin-dir "$bin" 2>&1) ||
   { echo "$log"; exit 1; }
 echo "$log"
 fail() { echo "demo_test: $1" >&2; exit 1; }

@@ -5,6 +5,7 @@
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
 #include "wingman/tools/eval_target.hpp"
+#include "wingman/tools/launch_cli.hpp"
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
@@ -16,7 +17,6 @@
 #include "wingman/tools/train_cli.hpp"
 #ifdef WINGMAN_WITH_SIM
 #include "wingman/tools/dataset_synth.hpp"
-#include "wingman/tools/fly_cli.hpp"
 #include "wingman/tools/scenario_random.hpp"
 #endif
 
@@ -241,11 +241,11 @@ int main(int argc, char** argv) {
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
   TrainingVerbs training(app);  // train, val, import-halmstad
+  LaunchVerbs launching(app);   // fly (with the simulator), demo-camera
   ModelVerbs model_verbs(app);  // model widen-classes
 #ifdef WINGMAN_WITH_SIM
   DatasetVerbs dataset(app);    // dataset synth
   ScenarioVerbs scenario(app);  // scenario random
-  FlyVerb fly(app);             // fly (a simulated flight through the pipeline)
 #endif
   tidy_defaults(app);
 
@@ -271,11 +271,11 @@ int main(int argc, char** argv) {
     }
     if (*s) return run_spy(spy);
     if (const int rc = training.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+    if (const int rc = launching.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
     if (const int rc = model_verbs.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #ifdef WINGMAN_WITH_SIM
     if (const int rc = dataset.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
     if (const int rc = scenario.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
-    if (const int rc = fly.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #endif
     if (*lo) return run_localize(localize, std::cout, std::cerr);
     if (*pr) return run_predict(predict, std::cout, std::cerr);

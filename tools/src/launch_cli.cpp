@@ -1,21 +1,44 @@
 // SPDX-License-Identifier: MIT
-// `wingman fly`'s command line: tools/fly.sh's flags, bound to FlyOptions.
-#include "wingman/tools/fly_cli.hpp"
+// The launching verbs' command lines: `wingman fly` (tools/fly.sh's flags, bound to FlyOptions) and `wingman
+// demo-camera` (tools/demo_camera.sh's pipeline run).
+#include "wingman/tools/launch_cli.hpp"
 
 #include "run_verb.hpp"
+#include "wingman/tools/demo_camera.hpp"
+#ifdef WINGMAN_WITH_SIM
 #include "wingman/tools/fly.hpp"
+#endif
 
 #include <CLI/CLI.hpp>
 
 namespace wingman::tools {
 
-struct FlyVerb::State {
+struct LaunchVerbs::State {
+  CLI::App* demo = nullptr;
+  DemoCameraOptions demo_options;
+#ifdef WINGMAN_WITH_SIM
   CLI::App* fly = nullptr;
   FlyOptions options;
   bool render = false, no_render = false;
+#endif
 };
 
-FlyVerb::FlyVerb(CLI::App& app) : s_(std::make_unique<State>()) {
+LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
+  DemoCameraOptions& d = s_->demo_options;
+  s_->demo = app.add_subcommand(
+      "demo-camera",
+      "Play a video through wingman-camera-driver into the running pipeline (detector, localizer, follower: their "
+      "built-in defaults) on the LCM bus, record the bus and show what arrived. Run it in a private network namespace "
+      "(tools/demo_camera.sh does)");
+  s_->demo->add_option("video", d.video, "The clip to play once at its own rate")->required();
+  s_->demo->add_option("--out", d.out, "Output folder: demo.lcmlog, last_frame.png");
+  s_->demo->add_option("--start-timeout", d.start_timeout_s,
+                       "Seconds to wait for every pipeline process's first heartbeat");
+  s_->demo->add_option("--settle-timeout", d.settle_timeout_s,
+                       "Seconds to wait after the clip for the detector to account for every frame");
+  s_->demo->add_option("--bin-dir", d.bin_dir, "The executables (empty: the folder of this wingman)");
+  s_->demo->add_option("--lcm-url", d.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+#ifdef WINGMAN_WITH_SIM
   FlyOptions& o = s_->options;
   auto* f = s_->fly = app.add_subcommand(
       "fly",
@@ -71,11 +94,16 @@ FlyVerb::FlyVerb(CLI::App& app) : s_(std::make_unique<State>()) {
   f->add_option("--config-dir", o.config_dir, "The checkout's config folder (scenarios, flights, MAVLink bridge)");
   f->add_option("--bin-dir", o.bin_dir, "The executables (empty: the folder of this wingman)");
   f->add_option("--lcm-url", o.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+#endif
 }
 
-FlyVerb::~FlyVerb() = default;
+LaunchVerbs::~LaunchVerbs() = default;
 
-int FlyVerb::run_if_chosen(std::ostream& out, std::ostream& err) {
+int LaunchVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
+  if (*s_->demo) {
+    return run_verb("wingman demo-camera", err, [&] { return run_demo_camera(s_->demo_options, out, err); });
+  }
+#ifdef WINGMAN_WITH_SIM
   if (!*s_->fly) return -1;
   return run_verb("wingman fly", err, [&] {
     FlyOptions o = s_->options;
@@ -84,6 +112,9 @@ int FlyVerb::run_if_chosen(std::ostream& out, std::ostream& err) {
     if (s_->no_render) o.render = "off";
     return fly(plan_flight(o), out, err);
   });
+#else
+  return -1;
+#endif
 }
 
 }  // namespace wingman::tools

@@ -1,0 +1,172 @@
+// SPDX-License-Identifier: MIT
+// `wingman demo-camera`: the camera demo's processes through the launcher, their progress read from their heartbeats.
+#include "wingman/tools/demo_camera.hpp"
+
+#include "wingman/launcher/bus_watch.hpp"
+#include "wingman/launcher/process_group.hpp"
+#include "wingman/tools/log_info.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace wingman::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kGraceS = 10.0;  // seconds a process gets to end after SIGTERM before it is killed
+const char* kImageChannel = "IMAGE_CAM0";
+const char* kDetectionsChannel = "DETECTIONS_CAM0";
+
+launcher::ProcessSpec process(std::string name, std::vector<std::string> argv) {
+  launcher::ProcessSpec spec;
+  spec.name = std::move(name);
+  spec.argv = std::move(argv);
+  return spec;
+}
+
+std::string own_bin_dir() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot read /proc/self/exe to find the executables: give --bin-dir");
+  return self.parent_path().string();
+}
+
+}  // namespace
+
+std::vector<std::string> DemoCameraOptions::validate() const {
+  std::vector<std::string> p;
+  if (video.empty()) p.push_back("video: expected a video file");
+  if (!(start_timeout_s > 0.0)) p.push_back(fmt::format("--start-timeout {}: expected seconds > 0", start_timeout_s));
+  if (!(settle_timeout_s > 0.0))
+    p.push_back(fmt::format("--settle-timeout {}: expected seconds > 0", settle_timeout_s));
+  return p;
+}
+
+int run_demo_camera(const DemoCameraOptions& o, std::ostream& out, std::ostream& err) {
+  if (const auto problems = o.validate(); !problems.empty()) throw std::invalid_argument(problems.front());
+  if (!std::ifstream(o.video).good()) throw std::invalid_argument(fmt::format("cannot read video '{}'", o.video));
+  const std::string bin = o.bin_dir.empty() ? own_bin_dir() : o.bin_dir;
+  for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"}) {
+    const fs::path p = fs::path(bin) / exe;
+    if (::access(p.c_str(), X_OK) != 0)
+      throw std::invalid_argument(
+          fmt::format("{} is missing: build first (tools/build.sh) or give --bin-dir", p.string()));
+  }
+  const char* env_url = std::getenv("WINGMAN_LCM_URL");
+  const std::string url = !o.lcm_url.empty() ? o.lcm_url : env_url ? env_url : "";
+  if (url.empty())
+    throw std::invalid_argument(
+        "no LCM bus: run wingman demo-camera in a private network namespace (tools/netns_run.sh sets WINGMAN_LCM_URL; "
+        "tools/demo_camera.sh does it for you) or give --lcm-url");
+  fs::create_directories(o.out);
+  const std::string log = (fs::path(o.out) / "demo.lcmlog").string();
+  const std::string video = fs::absolute(o.video).string();
+  auto exe = [&](const char* name) { return (fs::path(bin) / name).string(); };
+
+  out << "demo: LCM bus " << url << " (private network namespace)" << std::endl;
+  launcher::StopSignals signals;
+  auto stop_requested = [&] { return signals.requested(); };
+  launcher::BusWatch bus(url, fmt::format("{}|{}", kImageChannel, kDetectionsChannel));
+  launcher::ProcessGroup group;
+  const size_t logger =
+      group.start(process("lcm-logger", {"lcm-logger", "--lcm-url=" + url, "--force", "--quiet", log}));
+  std::vector<size_t> pipeline;
+  for (const char* name : {"wingman-detector", "wingman-localizer", "wingman-follower-ctrl"})
+    pipeline.push_back(group.start(process(name, {exe(name), "--lcm-url", url, "--log-level", "warn"})));
+
+  // Ends the demo with `rc` after stopping the pipeline, then the logger (its last heartbeats recorded).
+  auto finish = [&](int rc) {
+    group.stop(pipeline, kGraceS);
+    bus.spin(300);
+    group.stop({logger}, kGraceS);
+    return rc;
+  };
+  // Whether a pipeline process has ended (named on `err` once).
+  bool ended_reported = false;
+  auto pipeline_ended = [&] {
+    for (const size_t i : pipeline) {
+      if (const auto code = group.poll(i)) {
+        if (!ended_reported) {
+          err << "demo: " << group.spec(i).label() << " ended (exit " << *code
+              << "); its command was: " << group.spec(i).command_line() << std::endl;
+        }
+        ended_reported = true;
+        return true;
+      }
+    }
+    return false;
+  };
+  auto interrupted = [&] {
+    if (!signals.requested()) return false;
+    err << "demo: stopped by signal " << signals.signal() << std::endl;
+    return true;
+  };
+
+  // Start-up takes seconds (the detector loads its model and builds its OpenCL kernels): every process publishes a
+  // first heartbeat once it listens.
+  const std::vector<std::string> missing =
+      bus.wait_for_status({"detector", "localizer", "follower_ctrl"}, o.start_timeout_s,
+                          [&] { return stop_requested() || pipeline_ended(); });
+  if (interrupted()) return finish(130);
+  if (!missing.empty()) {
+    if (!pipeline_ended())
+      err << "demo: no heartbeat within " << o.start_timeout_s << " s from "
+          << fmt::format("{}", fmt::join(missing, ", ")) << std::endl;
+    return finish(1);
+  }
+
+  out << "demo: playing " << o.video << " through wingman-camera-driver" << std::endl;
+  // Play the clip once at its own rate, stamped by the wall clock like a live camera.
+  const size_t camera = group.start(
+      process("wingman-camera-driver", {exe("wingman-camera-driver"), "--set", "source.kind=file", "--set",
+                                        fmt::format("file={{path: \"{}\", mode: realtime, loop: false}}", video),
+                                        "--lcm-url", url, "--status-period", "0.5"}));
+  for (;;) {  // the bus is read while the clip plays, so nothing queues up
+    bus.spin(50);
+    if (interrupted()) return finish(130);
+    if (group.poll(camera)) break;
+    if (pipeline_ended()) return finish(1);
+  }
+  if (const int code = *group.poll(camera); code != 0) {
+    err << "demo: wingman-camera-driver failed (exit " << code << ")" << std::endl;
+    return finish(1);
+  }
+  // The detector may still be working on the last frames (or building a network for the clip's frame size): wait
+  // until its heartbeat accounts for every frame on the bus (detected or counted as dropped), then one more heartbeat
+  // from every process.
+  const auto settled = [&] {
+    const int64_t images = bus.count(kImageChannel);
+    const status_t* det = bus.status("detector");
+    return images > 0 && det != nullptr && det->messages_handled >= images &&
+           bus.count(kDetectionsChannel) + det->drops_total >= images;
+  };
+  if (!bus.spin_until(settled, o.settle_timeout_s, [&] { return stop_requested() || pipeline_ended(); })) {
+    if (interrupted()) return finish(130);
+    if (!pipeline_ended()) {
+      const status_t* det = bus.status("detector");
+      err << "demo: the detector did not account for every frame within " << o.settle_timeout_s
+          << " s: " << bus.count(kImageChannel) << " images, " << bus.count(kDetectionsChannel)
+          << " detections, handled " << (det ? det->messages_handled : 0) << ", drops " << (det ? det->drops_total : 0)
+          << std::endl;
+    }
+    return finish(1);
+  }
+  bus.spin(1200);
+  finish(0);
+
+  out << "\ndemo: what arrived on the bus (recorded by lcm-logger in " << log << "):" << std::endl;
+  const std::string snapshot = (fs::path(o.out) / "last_frame.png").string();
+  const LogSummary summary = summarize_log(log, snapshot, false, &err);
+  out << summary.report() << std::flush;
+  if (summary.images_with_pixels > 0) out << "last image saved to " << snapshot << std::endl;
+  return 0;
+}
+
+}  // namespace wingman::tools
