@@ -11,6 +11,7 @@
 #include "wingman/tools/make_video.hpp"
 #include "wingman/tools/model_cli.hpp"
 #include "wingman/tools/predict.hpp"
+#include "wingman/tools/recipe_cli.hpp"
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/report.hpp"
 #include "wingman/tools/spy.hpp"
@@ -240,9 +241,10 @@ int main(int argc, char** argv) {
   bd->add_option("--seed", bench_detector.seed, "Seed of the random weights");
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
-  TrainingVerbs training(app);  // train, val, import-halmstad
-  LaunchVerbs launching(app);   // fly (with the simulator), demo-camera
-  ModelVerbs model_verbs(app);  // model widen-classes
+  TrainingVerbs training(app);    // train, val, import-halmstad
+  LaunchVerbs launching(app);     // fly (with the simulator), demo-camera
+  ModelVerbs model_verbs(app);    // model widen-classes
+  RecipeVerbs recipe_verbs(app);  // train-recipe, model derive-cfg (after ModelVerbs: `model` must exist)
 #ifdef WINGMAN_WITH_SIM
   DatasetVerbs dataset(app);    // dataset synth
   ScenarioVerbs scenario(app);  // scenario random
@@ -273,6 +275,7 @@ int main(int argc, char** argv) {
     if (const int rc = training.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
     if (const int rc = launching.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
     if (const int rc = model_verbs.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
+    if (const int rc = recipe_verbs.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
 #ifdef WINGMAN_WITH_SIM
     if (const int rc = dataset.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
     if (const int rc = scenario.run_if_chosen(std::cout, std::cerr); rc >= 0) return rc;
