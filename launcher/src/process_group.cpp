@@ -116,7 +116,21 @@ size_t ProcessGroup::start(const ProcessSpec& spec) {
   for (const auto& a : spec.argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   pid_t pid = -1;
-  const int rc = posix_spawnp(&pid, args.front(), &setup.actions_, &setup.attr_, args.data(), environ);
+  // The environment: this process's, with spec.env's KEY=VALUE entries replacing or adding keys.
+  std::vector<std::string> env_entries;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry = *e;
+    const std::string key = entry.substr(0, entry.find('='));
+    bool replaced = false;
+    for (const auto& over : spec.env) replaced = replaced || over.substr(0, over.find('=')) == key;
+    if (!replaced) env_entries.push_back(entry);
+  }
+  env_entries.insert(env_entries.end(), spec.env.begin(), spec.env.end());
+  std::vector<char*> envp;
+  envp.reserve(env_entries.size() + 1);
+  for (auto& e : env_entries) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int rc = posix_spawnp(&pid, args.front(), &setup.actions_, &setup.attr_, args.data(), envp.data());
   if (rc != 0)
     throw std::runtime_error(fmt::format("{}: cannot start {}: {}", program, spec.argv.front(), std::strerror(rc)));
   children_.push_back(Child{spec, pid, std::nullopt});

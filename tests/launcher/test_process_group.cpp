@@ -53,6 +53,18 @@ TEST(ProcessGroup, SendsOutputToFilesOrInheritsIt) {
   EXPECT_EQ(read_file(dir.file("e.txt")), "err\n");
 }
 
+TEST(ProcessGroup, GivesTheChildItsEnvironmentWithTheSpecsEntriesOver) {
+  TempDir dir;
+  ::setenv("WINGMAN_TEST_KEPT", "kept", 1);
+  ::setenv("WINGMAN_TEST_REPLACED", "old", 1);
+  ProcessSpec spec = sh("echo $WINGMAN_TEST_KEPT $WINGMAN_TEST_REPLACED $WINGMAN_TEST_ADDED");
+  spec.env = {"WINGMAN_TEST_REPLACED=new", "WINGMAN_TEST_ADDED=a=b"};
+  spec.stdout_path = dir.file("o.txt");
+  ProcessGroup group;
+  ASSERT_EQ(group.run(spec), 0);
+  EXPECT_EQ(read_file(dir.file("o.txt")), "kept new a=b\n");
+}
+
 TEST(ProcessGroup, AProgramThatCannotStartIsAnErrorNamingIt) {
   ProcessGroup group;
   ProcessSpec missing;

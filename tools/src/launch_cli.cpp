@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
-// The launching verbs' command lines: `wingman fly` (tools/fly.sh's flags, bound to FlyOptions) and `wingman
-// demo-camera` (tools/demo_camera.sh's pipeline run).
+// The launching verbs' command lines: `wingman fly` (tools/fly.sh's flags, bound to FlyOptions), `wingman demo-camera`
+// (tools/demo_camera.sh's pipeline run) and `wingman load` (tools/load_test.sh's and tools/soak.sh's).
 #include "wingman/tools/launch_cli.hpp"
 
 #include "run_verb.hpp"
 #include "wingman/tools/demo_camera.hpp"
+#include "wingman/tools/load.hpp"
 #ifdef WINGMAN_WITH_SIM
 #include "wingman/tools/fly.hpp"
 #endif
@@ -16,6 +17,8 @@ namespace wingman::tools {
 struct LaunchVerbs::State {
   CLI::App* demo = nullptr;
   DemoCameraOptions demo_options;
+  CLI::App* load = nullptr;
+  LoadOptions load_options;
 #ifdef WINGMAN_WITH_SIM
   CLI::App* fly = nullptr;
   FlyOptions options;
@@ -38,6 +41,40 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                        "Seconds to wait after the clip for the detector to account for every frame");
   s_->demo->add_option("--bin-dir", d.bin_dir, "The executables (empty: the folder of this wingman)");
   s_->demo->add_option("--lcm-url", d.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+  LoadOptions& l = s_->load_options;
+  auto* ld = s_->load = app.add_subcommand(
+      "load",
+      "The four-camera load test (the thesis's 360-degree case) through the real processes on the LCM bus: camera N "
+      "plays a 1280x720 30-fps clip in a loop, detector N (the shipped model) and localizer N (camera N's extrinsics) "
+      "work on it, one follower follows camera 0; lcm-logger records all but the images; tools/load_summary.py "
+      "computes the figures and checks. Run it in a private network namespace (tools/load_test.sh and tools/soak.sh "
+      "do)");
+  ld->add_option("--mode", l.mode,
+                 "realtime: cameras paced at 30 fps, detectors keep the newest frame when busy; checks that every "
+                 "frame received is processed or counted as dropped, that frames lost on the bus stay under 20 % and "
+                 "match kernel receive-buffer drops, the end-to-end p99 and the p50 trend. replay: the cameras write "
+                 "their frames into one LCM log, the detectors read it file to file; checks that every image got its "
+                 "detections (the input log is deleted after a passing run)")
+      ->check(CLI::IsMember({"realtime", "replay"}));
+  ld->add_option("--duration", l.duration_s, "realtime: seconds the cameras play (0: 30, or 600 with --soak)");
+  ld->add_option("--out", l.out, "Output folder (empty: build/load/MODE, build/load/soak with --soak)");
+  ld->add_option("--cameras", l.cameras, "Camera chains, 1..4")->check(CLI::Range(1, 4));
+  ld->add_flag("--soak", l.soak,
+               "Realtime, and every process's RSS sampled: fails when one grows by more than --max-rss-growth-pct "
+               "after --warmup (peak of the first third after it against the last third); prints the latency trend");
+  ld->add_option("--warmup", l.warmup_s,
+                 "Soak: seconds after the cameras start before RSS is the reference (0: 30 up to 180-s runs, else 60): "
+                 "model loading, kernel builds and buffers growing to a 2.7 MB image happen then");
+  ld->add_option("--sample-period", l.sample_period_s, "Seconds between RSS/CPU samples from /proc");
+  ld->add_option("--replay-frames", l.replay_frames, "Replay: frames per camera (2.7 MB each in the log)");
+  ld->add_option("--max-p99-s", l.max_p99_s, "Realtime: bound on the end-to-end p99, seconds");
+  ld->add_option("--max-rss-growth-pct", l.max_rss_growth_pct, "Soak: bound on RSS growth after the warm-up, percent");
+  ld->add_flag("--report-only", l.report_only,
+               "The speed and memory bounds are reported, not checked (the frame accounting and the statuses stay "
+               "checks): CI's load tests, on a shared machine");
+  ld->add_option("--summary-script", l.summary_script, "The figures and checks (Python, the generated LCM types)");
+  ld->add_option("--bin-dir", l.bin_dir, "The executables (empty: the folder of this wingman)");
+  ld->add_option("--lcm-url", l.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
 #ifdef WINGMAN_WITH_SIM
   FlyOptions& o = s_->options;
   auto* f = s_->fly = app.add_subcommand(
@@ -103,6 +140,7 @@ int LaunchVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   if (*s_->demo) {
     return run_verb("wingman demo-camera", err, [&] { return run_demo_camera(s_->demo_options, out, err); });
   }
+  if (*s_->load) return run_verb("wingman load", err, [&] { return run_load(s_->load_options, out, err); });
 #ifdef WINGMAN_WITH_SIM
   if (!*s_->fly) return -1;
   return run_verb("wingman fly", err, [&] {

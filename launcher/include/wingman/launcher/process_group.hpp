@@ -19,6 +19,7 @@ struct ProcessSpec {
   std::vector<std::string> argv;  ///< argv[0]: a path, or a name looked up on PATH; not empty
   std::string stdout_path;        ///< the child's stdout goes to this file (truncated); "" = the launcher's stdout
   std::string stderr_path;        ///< the same for stderr
+  std::vector<std::string> env;   ///< KEY=VALUE set for the child over the launcher's environment
 
   /// "name" or argv[0].
   const std::string& label() const { return name.empty() ? argv.front() : name; }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The launching verbs of `wingman`: fly (a simulated flight; a build with the simulator) and demo-camera (a video
-// through the pipeline).
+// The launching verbs of `wingman`: fly (a simulated flight; a build with the simulator), demo-camera (a video through
+// the pipeline) and load (the four-camera load test and soak).
 #pragma once
 
 #include <memory>
@@ -12,7 +12,7 @@ class App;
 
 namespace wingman::tools {
 
-/// Adds `fly` (with the simulator) and `demo-camera` to the CLI and runs the one chosen.
+/// Adds `fly` (with the simulator), `demo-camera` and `load` to the CLI and runs the one chosen.
 class LaunchVerbs {
  public:
   /// Registers the subcommand and its options on `app`.

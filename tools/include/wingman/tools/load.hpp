@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: MIT
+// `wingman load`: the four-camera load test and the soak (the thesis's 360-degree case) through the real processes.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace wingman::tools {
+
+/// What `wingman load` runs. Camera N is a wingman-camera-driver (camera_N) playing a 1280x720 30-fps clip in a loop
+/// on IMAGE_CAM<N>; detector_N (the shipped model) detects in it; localizer_N (camera N's extrinsics, yawed 90 degrees
+/// per camera) tracks on TARGETS_CAM<N>; one follower_ctrl follows camera 0's targets. Relative paths are taken from
+/// the working directory (tools/load_test.sh runs it from the checkout's root).
+struct LoadOptions {
+  std::string mode = "realtime";  ///< realtime (cameras paced at 30 fps) or replay (detectors file to file)
+  double duration_s = 0.0;        ///< realtime: seconds the cameras play (0: 30, or 600 with soak)
+  std::string out;                ///< output folder ("" = build/load/MODE, build/load/soak with soak)
+  int cameras = 4;                ///< camera chains, 1..4
+  bool soak = false;              ///< realtime, plus the RSS growth check and the latency trend
+  double warmup_s = 0.0;  ///< soak: seconds before RSS is taken as the reference (0: 30 up to 180-s runs, else 60)
+  double sample_period_s = 2.0;     ///< seconds between RSS/CPU samples from /proc
+  int replay_frames = 10;           ///< replay: frames per camera
+  double max_p99_s = 5.0;           ///< realtime: bound on the end-to-end p99, seconds
+  double max_rss_growth_pct = 5.0;  ///< soak: bound on RSS growth after the warm-up, percent
+  bool report_only = false;         ///< speed and memory bounds reported, not checked (frame accounting still is)
+  std::string summary_script = "tools/load_summary.py";  ///< the figures and checks (Python, generated LCM types)
+  std::string bin_dir;                                   ///< the executables ("" = the folder of the running wingman)
+  std::string lcm_url;  ///< realtime's bus ("" = $WINGMAN_LCM_URL, set by tools/netns_run.sh)
+
+  /// Every problem with the values, one line each ("--cameras 5: expected 1..4").
+  std::vector<std::string> validate() const;
+  /// duration_s and warmup_s with their defaults applied.
+  double effective_duration_s() const;
+  double effective_warmup_s() const;
+};
+
+/// The command-line options of process `exe` for camera chain `camera` (0-based) of a load run, as --set pairs: what
+/// the process reads over its built-in defaults. `exe`: wingman-detector, wingman-localizer, wingman-camera-driver
+/// (`clip`, `realtime` pacing or fast from a fixed start time with `max_frames`) or wingman-follower-ctrl.
+std::vector<std::string> load_process_sets(const std::string& exe, int camera, const std::string& clip, bool realtime,
+                                           int max_frames, bool detector_realtime);
+
+/// Runs the load test: prints what it does and the summary's figures on `out`, and returns 0 when every check
+/// passed, 1 when one failed (named on `err`), 130 on SIGINT/SIGTERM. Throws std::invalid_argument for bad options.
+int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err);
+
+}  // namespace wingman::tools
