@@ -67,14 +67,16 @@ void apply_override(YAML::Node root, const std::string& item, std::vector<std::s
   if (keys.size() > 1 && root["stages"].IsSequence()) {
     for (YAML::Node s : root["stages"])
       if (s.IsMap() && s["name"] && s["name"].Scalar() == keys[0]) {
-        node = s;
+        node.reset(s);  // (node = s would replace root's content: yaml-cpp assigns through a node)
         k = 1;
         break;
       }
   }
-  std::vector<YAML::Node> chain{node};
-  for (; k + 1 < keys.size(); ++k) chain.push_back(chain.back()[keys[k]]);
-  chain.back()[keys.back()] = value;
+  for (; k + 1 < keys.size(); ++k) {
+    YAML::Node child = node[keys[k]];
+    node.reset(child);
+  }
+  node[keys.back()] = value;
 }
 
 std::vector<YAML::Node> sequence(YamlMappingReader& r, const std::string& key, bool required) {
@@ -622,7 +624,12 @@ int run_recipe(const RecipeRunOptions& options, std::ostream& out, std::ostream&
     const fs::path self = fs::read_symlink("/proc/self/exe", ec);
     o.bin = ec ? "." : self.parent_path().string();
   }
-  const Recipe r = load_recipe(o.recipe, o.overrides, o.src);
+  Recipe r = load_recipe(o.recipe, o.overrides, o.src);
+  if (!o.init.empty()) {
+    if (o.stage.empty()) throw std::invalid_argument("--init: needs --stage (the stage that starts from it)");
+    for (RecipeStage& s : r.stages)
+      if (s.name == o.stage) s.init = {o.init};
+  }
   return Runner(o, r, out).run();
 }
 

@@ -58,7 +58,8 @@ RecipeVerbs::RecipeVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.recipe->add_option("--src", r.src, "The source tree (${src} in the recipe; tools/fly.sh for the flights)");
   s.recipe->add_option("--bin", r.bin, "The folder of the wingman to run (empty: this one's)");
   s.recipe->add_option("--stage", r.stage,
-                       "Train only this stage (the datasets it uses are still prepared; give its init with --set)");
+                       "Train only this stage (the datasets it uses are still prepared; its start: --init)");
+  s.recipe->add_option("--init", r.init, "With --stage: the weights it starts from (instead of the recipe's init)");
   s.recipe->add_option("--set", r.overrides,
                        "KEY=VALUE: a recipe key set before reading, STAGE.key for a stage's (e.g. stage6.batches=800, "
                        "train.threads=4); repeatable");

@@ -110,6 +110,7 @@ struct RecipeRunOptions {
   std::string out = "build/train-wingman-small";  ///< OUT
   std::string bin;                                ///< the folder of the `wingman` to run (empty: this one's)
   std::string stage;                              ///< only this stage (the datasets it uses are still prepared)
+  std::string init;                               ///< with `stage`: the weights it starts from, instead of its init
   bool data_only = false;                         ///< prepare the datasets, train nothing
   bool dry_run = false;                           ///< print the commands, run nothing
 };
