@@ -241,14 +241,15 @@ int main(int argc, char** argv) {
   bd->add_option("--seed", bench_detector.seed, "Seed of the random weights");
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
-  TrainingVerbs training(app);    // train, val, import-halmstad
-  LaunchVerbs launching(app);     // fly (with the simulator), demo-camera
-  ModelVerbs model_verbs(app);    // model widen-classes
-  RecipeVerbs recipe_verbs(app);  // train-recipe, model derive-cfg (after ModelVerbs: `model` must exist)
+  TrainingVerbs training(app);  // train, val, import-halmstad
+  LaunchVerbs launching(app);   // fly (with the simulator), demo-camera
+  ModelVerbs model_verbs(app);  // model widen-classes
 #ifdef WINGMAN_WITH_SIM
   DatasetVerbs dataset(app);    // dataset synth
   ScenarioVerbs scenario(app);  // scenario random
 #endif
+  // train-recipe, model derive-cfg, dataset mix (after ModelVerbs and DatasetVerbs: `model` and `dataset` exist)
+  RecipeVerbs recipe_verbs(app);
   tidy_defaults(app);
 
   try {

@@ -101,6 +101,23 @@ const RecipeMix* Recipe::mix(const std::string& name) const { return find_named(
 const RecipeCfg* Recipe::cfg(const std::string& name) const { return find_named(cfgs, name); }
 const RecipeStage* Recipe::stage(const std::string& name) const { return find_named(stages, name); }
 
+void write_data_yaml_mix(const std::string& file, const std::string& path, const std::vector<std::string>& train,
+                         const std::string& val, const std::vector<std::string>& names, const std::string& comment) {
+  if (val.empty()) throw std::invalid_argument("a data.yaml needs a val entry");
+  if (names.empty()) throw std::invalid_argument("a data.yaml needs class names");
+  YAML::Emitter e;
+  e << YAML::BeginMap << YAML::Key << "path" << YAML::Value << fs::absolute(path).lexically_normal().string();
+  if (!train.empty()) e << YAML::Key << "train" << YAML::Value << YAML::Flow << train;
+  e << YAML::Key << "val" << YAML::Value << val;
+  e << YAML::Key << "nc" << YAML::Value << names.size();
+  e << YAML::Key << "names" << YAML::Value << YAML::Flow << names << YAML::EndMap;
+  if (const fs::path parent = fs::path(file).parent_path(); !parent.empty()) fs::create_directories(parent);
+  std::ofstream f(file);
+  if (!comment.empty()) f << "# " << comment << "\n";
+  f << e.c_str() << "\n";
+  if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write the data.yaml", file));
+}
+
 Recipe load_recipe(const std::string& path, const std::vector<std::string>& overrides, const std::string& src) {
   YAML::Node root;
   try {
@@ -485,19 +502,11 @@ class Runner {
   /// DATA/<mix>.yaml, a data.yaml for `wingman train --data` (written every run, as the datasets are).
   void write_mix(const RecipeMix& x) {
     const fs::path file = fs::path(o_.data) / (x.name + ".yaml");
-    YAML::Emitter e;
-    e << YAML::BeginMap << YAML::Key << "path" << YAML::Value << fs::absolute(o_.data).lexically_normal().string();
-    e << YAML::Key << "train" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-    for (const std::string& d : x.train) e << d + "/images/train";
-    e << YAML::EndSeq << YAML::Key << "val" << YAML::Value << x.val + "/images/val";
-    e << YAML::Key << "nc" << YAML::Value << x.names.size();
-    e << YAML::Key << "names" << YAML::Value << YAML::Flow << x.names << YAML::EndMap;
     note(fmt::format("write {} (train: {}; val: {})", quote(file.string()), fmt::join(x.train, ", "), x.val));
     if (o_.dry_run) return;
-    std::ofstream f(file);
-    if (!x.comment.empty()) f << "# " << x.comment << "\n";
-    f << e.c_str() << "\n";
-    if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write the mix", file.string()));
+    std::vector<std::string> train;
+    for (const std::string& d : x.train) train.push_back(d + "/images/train");
+    write_data_yaml_mix(file.string(), o_.data, train, x.val + "/images/val", x.names, x.comment);
   }
 
   /// The path of a .cfg variant (derived this run, once) or of a .cfg file.

@@ -13,12 +13,16 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace wingman::tools {
 
 struct RecipeVerbs::State {
   CLI::App* derive = nullptr;
   CLI::App* recipe = nullptr;
+  CLI::App* mix = nullptr;
+  std::string mix_out, mix_path, mix_val, mix_comment;
+  std::vector<std::string> mix_train, mix_names{"drone"};
   std::string cfg_in, cfg_out, input;
   CfgDerivation d;
   RecipeRunOptions run;
@@ -45,6 +49,20 @@ RecipeVerbs::RecipeVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.derive->add_option("--iou-loss", s.d.iou_loss, "Every [yolo]'s box loss: mse, giou, diou or ciou (empty: kept)");
   s.derive->add_option("--iou-normalizer", s.d.iou_normalizer,
                        "Every [yolo]'s iou_normalizer, written as given (empty: kept)");
+
+  // `dataset mix` beside `dataset synth` (a build with the simulator has `dataset`), else on its own.
+  CLI::App* dataset = nullptr;
+  for (CLI::App* sub : app.get_subcommands([](CLI::App* a) { return a->get_name() == "dataset"; })) dataset = sub;
+  if (!dataset)
+    dataset = app.add_subcommand("dataset", "Datasets: data.yaml files of several datasets")->require_subcommand(1);
+  s.mix = dataset->add_subcommand(
+      "mix", "Write a data.yaml (path, train, val, nc, names) of datasets under one folder, for train and val --data");
+  s.mix->add_option("--out", s.mix_out, "The data.yaml to write")->required();
+  s.mix->add_option("--path", s.mix_path, "The folder the entries are under (written absolute)")->required();
+  s.mix->add_option("--train", s.mix_train, "Train entries: image folders or list files under --path")->delimiter(',');
+  s.mix->add_option("--val", s.mix_val, "The val entry: an image folder or a list file under --path")->required();
+  s.mix->add_option("--names", s.mix_names, "Class names")->delimiter(',');
+  s.mix->add_option("--comment", s.mix_comment, "A comment line at the top (empty: none)");
 
   RecipeRunOptions& r = s.run;
   s.recipe = app.add_subcommand(
@@ -82,6 +100,13 @@ int RecipeVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       }
       derive_cfg_file(s.cfg_in, s.cfg_out, s.d);
       out << "wrote " << s.cfg_out << "\n";
+      return 0;
+    });
+  }
+  if (*s.mix) {
+    return run_verb("wingman dataset mix", err, [&] {
+      write_data_yaml_mix(s.mix_out, s.mix_path, s.mix_train, s.mix_val, s.mix_names, s.mix_comment);
+      out << "wrote " << s.mix_out << "\n";
       return 0;
     });
   }

@@ -96,6 +96,12 @@ struct Recipe {
   const RecipeStage* stage(const std::string& name) const;
 };
 
+/// Writes a data.yaml for `wingman train --data` / `wingman val --data`: `# comment` (when not empty), then path (made
+/// absolute), train (a list; left out when empty), val, nc and names, with yaml-cpp. Throws std::runtime_error when
+/// it cannot write `file`.
+void write_data_yaml_mix(const std::string& file, const std::string& path, const std::vector<std::string>& train,
+                         const std::string& val, const std::vector<std::string>& names, const std::string& comment);
+
 /// Reads a recipe. `overrides` ("KEY=VALUE", e.g. "stage6.batches=800" for a stage's key, or "train.threads=4") are
 /// set before reading (the value read as YAML). ${src} in a path becomes `src`. Every problem of the file is
 /// reported at once: common::ConfigError with one "<file>:<line>: <key>: <problem>" line each.
