@@ -3,13 +3,12 @@
 #include "wingman/tools/demo_camera.hpp"
 
 #include "wingman/launcher/bus_watch.hpp"
+#include "wingman/launcher/launch_setup.hpp"
 #include "wingman/launcher/process_group.hpp"
 #include "wingman/tools/log_info.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -17,26 +16,13 @@
 namespace wingman::tools {
 
 namespace fs = std::filesystem;
+using launcher::process;
 
 namespace {
 
 constexpr double kGraceS = 10.0;  // seconds a process gets to end after SIGTERM before it is killed
 const char* kImageChannel = "IMAGE_CAM0";
 const char* kDetectionsChannel = "DETECTIONS_CAM0";
-
-launcher::ProcessSpec process(std::string name, std::vector<std::string> argv) {
-  launcher::ProcessSpec spec;
-  spec.name = std::move(name);
-  spec.argv = std::move(argv);
-  return spec;
-}
-
-std::string own_bin_dir() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw std::runtime_error("cannot read /proc/self/exe to find the executables: give --bin-dir");
-  return self.parent_path().string();
-}
 
 }  // namespace
 
@@ -52,19 +38,9 @@ std::vector<std::string> DemoCameraOptions::validate() const {
 int run_demo_camera(const DemoCameraOptions& o, std::ostream& out, std::ostream& err) {
   if (const auto problems = o.validate(); !problems.empty()) throw std::invalid_argument(problems.front());
   if (!std::ifstream(o.video).good()) throw std::invalid_argument(fmt::format("cannot read video '{}'", o.video));
-  const std::string bin = o.bin_dir.empty() ? own_bin_dir() : o.bin_dir;
-  for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"}) {
-    const fs::path p = fs::path(bin) / exe;
-    if (::access(p.c_str(), X_OK) != 0)
-      throw std::invalid_argument(
-          fmt::format("{} is missing: build first (tools/build.sh) or give --bin-dir", p.string()));
-  }
-  const char* env_url = std::getenv("WINGMAN_LCM_URL");
-  const std::string url = !o.lcm_url.empty() ? o.lcm_url : env_url ? env_url : "";
-  if (url.empty())
-    throw std::invalid_argument(
-        "no LCM bus: run wingman demo-camera in a private network namespace (tools/netns_run.sh sets WINGMAN_LCM_URL; "
-        "tools/demo_camera.sh does it for you) or give --lcm-url");
+  const std::string bin = launcher::executables_dir(
+      o.bin_dir, {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"});
+  const std::string url = launcher::private_bus_url(o.lcm_url, "wingman demo-camera", "tools/demo_camera.sh");
   fs::create_directories(o.out);
   const std::string log = (fs::path(o.out) / "demo.lcmlog").string();
   const std::string video = fs::absolute(o.video).string();

@@ -2,14 +2,13 @@
 // `wingman fly`: the flight's processes and their command lines (plan_flight), then the flight itself (fly).
 #include "wingman/tools/fly.hpp"
 
+#include "wingman/launcher/launch_setup.hpp"
 #include "wingman/tools/report.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 #include <wingman/sim/scenario.hpp>
 
 #include <chrono>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -18,6 +17,7 @@
 namespace wingman::tools {
 
 namespace fs = std::filesystem;
+using launcher::process;
 
 namespace {
 
@@ -35,14 +35,6 @@ bool readable_file(const std::string& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return false;
   return std::ifstream(path).good();
-}
-
-/// The folder of the running executable (the build's or the installation's bin/).
-std::string own_bin_dir() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw std::runtime_error("cannot read /proc/self/exe to find the executables: give --bin-dir");
-  return self.parent_path().string();
 }
 
 /// The own-pose error's --set keys for the simulator from "M,RAD[,TAU]" (the values are checked by its loader).
@@ -63,13 +55,6 @@ std::vector<std::string> own_pose_sets(const std::string& spec) {
   return {"--set", "own_pose.position_std_m=" + parts[0],
           "--set", "own_pose.attitude_std_rad=" + parts[1],
           "--set", "own_pose.correlation_time_s=" + (parts.size() == 3 ? parts[2] : std::string("2.0"))};
-}
-
-launcher::ProcessSpec process(std::string name, std::vector<std::string> argv) {
-  launcher::ProcessSpec spec;
-  spec.name = std::move(name);
-  spec.argv = std::move(argv);
-  return spec;
 }
 
 void append(std::vector<std::string>& to, const std::vector<std::string>& more) {
@@ -121,23 +106,12 @@ FlightPlan plan_flight(const FlyOptions& o) {
   // The box noise follows the scenario's seed (as the rendered noise does), so runs of different seeds differ.
   const uint64_t scenario_seed = sim::load_scenario(plan.scenario_file).seed;  // every problem of the file at once
 
-  const std::string bin = o.bin_dir.empty() ? own_bin_dir() : o.bin_dir;
   const bool mavlink = o.autopilot == "mavlink";
   std::vector<std::string> exes = {"wingman-sim", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"};
   if (mavlink) exes.push_back("wingman-mavlink");
-  for (const auto& exe : exes) {
-    const fs::path p = fs::path(bin) / exe;
-    if (::access(p.c_str(), X_OK) != 0)
-      throw std::invalid_argument(
-          fmt::format("{} is missing: build first (tools/build.sh) or give --bin-dir", p.string()));
-  }
+  const std::string bin = launcher::executables_dir(o.bin_dir, exes);
   auto exe = [&](const char* name) { return (fs::path(bin) / name).string(); };
-  const std::string url =
-      o.lcm_url.empty() ? std::string(std::getenv("WINGMAN_LCM_URL") ? std::getenv("WINGMAN_LCM_URL") : "") : o.lcm_url;
-  if (url.empty())
-    throw std::invalid_argument(
-        "no LCM bus: run wingman fly in a private network namespace (tools/netns_run.sh sets WINGMAN_LCM_URL; "
-        "tools/fly.sh does it for you) or give --lcm-url");
+  const std::string url = launcher::private_bus_url(o.lcm_url, "wingman fly", "tools/fly.sh");
 
   // Configuration files given on the command line must be readable; the per-flight ones are used when they exist.
   auto given = [&](const std::string& path, const char* flag) -> std::string {
@@ -145,8 +119,8 @@ FlightPlan plan_flight(const FlyOptions& o) {
     if (!readable_file(path)) throw std::invalid_argument(fmt::format("{} {}: cannot read it", flag, path));
     return absolute(path);
   };
-  auto flight_file = [&](const char* process) -> std::string {
-    const fs::path f = fs::path(o.config_dir) / "flights" / fmt::format("{}.{}.yaml", plan.name, process);
+  auto flight_file = [&](const char* process_name) -> std::string {
+    const fs::path f = fs::path(o.config_dir) / "flights" / fmt::format("{}.{}.yaml", plan.name, process_name);
     return readable_file(f.string()) ? absolute(f.string()) : "";
   };
   std::string localizer_config = given(o.localizer_config, "--localizer-config");

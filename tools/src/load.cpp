@@ -4,6 +4,7 @@
 #include "wingman/tools/load.hpp"
 
 #include "wingman/launcher/bus_watch.hpp"
+#include "wingman/launcher/launch_setup.hpp"
 #include "wingman/launcher/process_group.hpp"
 #include "wingman/tools/make_video.hpp"
 
@@ -24,6 +25,7 @@
 namespace wingman::tools {
 
 namespace fs = std::filesystem;
+using launcher::process;
 
 namespace {
 
@@ -37,22 +39,8 @@ const char* kFixedStartUtime = "1700000000000000";  // fast cameras: frames stam
 const char* const kExtrinsics[4] = {"0, 0, 1, -1, 0, 0, 0, -1, 0", "1, 0, 0, 0, 0, 1, 0, -1, 0",
                                     "0, 0, -1, 1, 0, 0, 0, -1, 0", "-1, 0, 0, 0, 0, -1, 0, -1, 0"};
 
-launcher::ProcessSpec process(std::string name, std::vector<std::string> argv) {
-  launcher::ProcessSpec spec;
-  spec.name = std::move(name);
-  spec.argv = std::move(argv);
-  return spec;
-}
-
 void append(std::vector<std::string>& to, const std::vector<std::string>& more) {
   to.insert(to.end(), more.begin(), more.end());
-}
-
-std::string own_bin_dir() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw std::runtime_error("cannot read /proc/self/exe to find the executables: give --bin-dir");
-  return self.parent_path().string();
 }
 
 /// The last `n` lines of a file (a process's stderr, for a failure).
@@ -181,20 +169,10 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   if (const auto problems = o.validate(); !problems.empty()) throw std::invalid_argument(problems.front());
   const bool replay = o.mode == "replay";
   const double duration_s = o.effective_duration_s();
-  const std::string bin = o.bin_dir.empty() ? own_bin_dir() : o.bin_dir;
-  for (const char* exe : {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"}) {
-    const fs::path p = fs::path(bin) / exe;
-    if (::access(p.c_str(), X_OK) != 0)
-      throw std::invalid_argument(
-          fmt::format("{} is missing: build first (tools/build.sh) or give --bin-dir", p.string()));
-  }
+  const std::string bin = launcher::executables_dir(
+      o.bin_dir, {"wingman-camera-driver", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"});
   auto exe = [&](const std::string& name) { return (fs::path(bin) / name).string(); };
-  const char* env_url = std::getenv("WINGMAN_LCM_URL");
-  const std::string url = !o.lcm_url.empty() ? o.lcm_url : env_url ? env_url : "";
-  if (!replay && url.empty())
-    throw std::invalid_argument(
-        "no LCM bus: run wingman load in a private network namespace (tools/netns_run.sh sets WINGMAN_LCM_URL; "
-        "tools/load_test.sh does it for you) or give --lcm-url");
+  const std::string url = replay ? "" : launcher::private_bus_url(o.lcm_url, "wingman load", "tools/load_test.sh");
   // load_summary.py decodes with the generated Python types: the build tree's (build/python beside the binaries) or
   // an installed prefix's; checked now, not after the run.
   const fs::path prefix = fs::path(bin).parent_path();

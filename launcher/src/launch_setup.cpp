@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// The checks every launcher makes before it starts anything.
+#include "wingman/launcher/launch_setup.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+
+namespace wingman::launcher {
+
+namespace fs = std::filesystem;
+
+ProcessSpec process(std::string name, std::vector<std::string> argv) {
+  ProcessSpec spec;
+  spec.name = std::move(name);
+  spec.argv = std::move(argv);
+  return spec;
+}
+
+std::string executable_dir() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot read /proc/self/exe to find the executables: give --bin-dir");
+  return self.parent_path().string();
+}
+
+std::string executables_dir(const std::string& bin_dir, const std::vector<std::string>& names) {
+  const std::string dir = bin_dir.empty() ? executable_dir() : bin_dir;
+  for (const auto& name : names) {
+    const fs::path p = fs::path(dir) / name;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec) || ::access(p.c_str(), X_OK) != 0)
+      throw std::invalid_argument(
+          fmt::format("{} is missing: build first (tools/build.sh) or give --bin-dir", p.string()));
+  }
+  return dir;
+}
+
+std::string private_bus_url(const std::string& given, const std::string& verb, const std::string& script) {
+  if (!given.empty()) return given;
+  const char* env = std::getenv("WINGMAN_LCM_URL");
+  if (env != nullptr && *env != '\0') return env;
+  throw std::invalid_argument(fmt::format(
+      "no LCM bus: run {} in a private network namespace (tools/netns_run.sh sets WINGMAN_LCM_URL; {} does it for "
+      "you) or give --lcm-url",
+      verb, script));
+}
+
+}  // namespace wingman::launcher
