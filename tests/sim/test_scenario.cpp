@@ -162,6 +162,18 @@ TEST(ScenarioErrors, UnknownMotionType) {
   EXPECT_NE(e.find("vehicles[1].motion.type: 'zigzag' is not a motion type"), std::string::npos) << e;
 }
 
+TEST(ScenarioErrors, AKeyThatIsNotAPlainNameHidesNoOtherProblemOfItsVehicle) {
+  const std::string e = error_of(replace(replace(kValid, "    dynamics:", "    [a, b]: 1\n    dynamics:"),
+                                         "max_speed: 0.5\n      seed", "max_speed: fast\n      seed"));
+  EXPECT_NE(e.find("vehicles[1]: a key must be a plain name, got a sequence"), std::string::npos) << e;
+  EXPECT_NE(e.find("vehicles[1].motion.max_speed: expected a number, got 'fast'"), std::string::npos) << e;
+}
+
+TEST(ScenarioErrors, AVehicleThatIsNotAMappingIsOneProblem) {
+  const std::string e = error_of(replace(kValid, "  - name: leader\n", "  - leader\n  - name: leader\n"));
+  EXPECT_NE(e.find("vehicles[1]: expected a mapping, got 'leader'"), std::string::npos) << e;
+}
+
 TEST(ScenarioErrors, NoCameraVehicle) {
   const std::string e = error_of(replace(kValid, "id: 0", "id: 2"));
   EXPECT_NE(e.find("vehicles: no vehicle has id 0 (the camera vehicle)"), std::string::npos) << e;

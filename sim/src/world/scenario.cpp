@@ -111,9 +111,8 @@ void read_motion(YamlMappingReader& vr, VehicleSpec& v, std::vector<std::string>
 VehicleSpec read_vehicle(const std::string& source, const YAML::Node& node, size_t index, const std::string& base_dir,
                          std::vector<std::string>* problems) {
   VehicleSpec v;
-  const size_t before = problems->size();
   YamlMappingReader vr(source, node, fmt::format("vehicles[{}].", index), problems);
-  if (problems->size() != before) return v;  // not a mapping
+  if (node.IsDefined() && !node.IsNull() && !node.IsMap()) return v;  // not a mapping: the reader said so
   if (!vr.has("name")) vr.problem("name", "missing: every vehicle needs a name");
   if (!vr.has("id")) vr.problem("id", "missing: every vehicle needs an id (0 = the camera vehicle)");
   if (!vr.has("initial.position")) vr.problem("initial.position", "missing: every vehicle needs initial.position");
