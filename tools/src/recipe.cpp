@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -400,9 +401,23 @@ class Runner {
 
   static int exec(const Command& c, bool report) {
     std::cout.flush();
+    // As system() does: Ctrl-C reaches the child (the trainer saves its checkpoint and stops), and this process
+    // waits for it and then reports its exit instead of leaving it behind.
+    struct sigaction ignore {};
+    struct sigaction old_int {};
+    struct sigaction old_quit {};
+    ignore.sa_handler = SIG_IGN;
+    sigaction(SIGINT, &ignore, &old_int);
+    sigaction(SIGQUIT, &ignore, &old_quit);
     const pid_t pid = fork();
-    if (pid < 0) throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
+    if (pid < 0) {
+      sigaction(SIGINT, &old_int, nullptr);
+      sigaction(SIGQUIT, &old_quit, nullptr);
+      throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
+    }
     if (pid == 0) {
+      sigaction(SIGINT, &old_int, nullptr);
+      sigaction(SIGQUIT, &old_quit, nullptr);
       for (const auto& [k, v] : c.env) setenv(k.c_str(), v.c_str(), 1);
       if (!c.output.empty()) {
         const int fd = open(c.output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -421,6 +436,8 @@ class Runner {
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGQUIT, &old_quit, nullptr);
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
