@@ -37,14 +37,15 @@ foreach(name camera_driver detector localizer follower_ctrl mavlink_bridge recor
   file(INSTALL "${WINGMAN_SOURCE_DIR}/config/${name}.yaml" DESTINATION "${confdir}")  # DESTDIR: added by file(INSTALL)
 endforeach()
 
-# The shipped files with the prefix's paths. Longest first: /usr/local/etc/wingman/ before /usr/local/.
+# The shipped files with the prefix's paths (cmake/wingman_render.cmake, also tools/supervise.sh's renderer).
+include("${CMAKE_CURRENT_LIST_DIR}/wingman_render.cmake")
 function(wingman_render in out)
   file(READ "${in}" text)
-  string(REPLACE "/usr/local/bin/" "${bindir}/" text "${text}")
-  string(REPLACE "/usr/local/etc/wingman/" "${confdir}/" text "${text}")
-  string(REPLACE "/usr/local/share/wingman/" "${datadir}/" text "${text}")
   if(out MATCHES "wingman\\.conf$")
-    string(REPLACE "/var/log/wingman/" "${localstatedir}/log/wingman/" text "${text}")
+    wingman_render_text(text "${text}" BIN "${bindir}" ETC "${confdir}" SHARE "${datadir}"
+                        RECORDINGS_LOG "${localstatedir}/log/wingman")
+  else()
+    wingman_render_text(text "${text}" BIN "${bindir}" ETC "${confdir}" SHARE "${datadir}")
   endif()
   set(mark "#")
   if(out MATCHES "\\.conf$")

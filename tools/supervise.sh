@@ -52,43 +52,10 @@ mkdir -p "$log_dir/recordings"  # the recorder's output.directory (recordings) i
 bin=$(cd "$bin" && pwd) etc=$(cd "$etc" && pwd) log_dir=$(cd "$log_dir" && pwd)
 case "$url" in *%*|*'"'*|*,*) echo "supervise: --lcm-url '$url': %, \" and , cannot be written into a supervisord environment" >&2; exit 2 ;; esac
 
-# Paths are substituted literally (sed with | as the delimiter: none of these may contain |).
-for p in "$bin" "$etc" "$log_dir" "$url"; do
-  case "$p" in *'|'*) echo "supervise: '$p': a path or URL with | cannot be substituted" >&2; exit 2 ;; esac
-done
-esc() { printf '%s' "$1" | sed 's/[&\\]/\\&/g'; }
-render() {
-  sed -e "s|/usr/local/bin/|$(esc "$bin")/|g" \
-      -e "s|/usr/local/etc/wingman/|$(esc "$etc")/|g" \
-      -e "s|/var/log/wingman/|$(esc "$log_dir")/|g" \
-      -e "s|/var/log/supervisor/|$(esc "$log_dir")/|g" \
-      -e "s|/usr/local/share/wingman/supervisor/|$(esc "$src/config/supervisor")/|g" \
-      ${url:+-e "s|udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304|$(esc "$url")|g"} \
-      "$template"
-}
-if [ -n "$out" ]; then render > "$out"; else render; fi
-
-if [ -n "$standalone" ]; then
-  cat > "$standalone/supervisord.conf" <<CONF
-; Written by tools/supervise.sh: a supervisord of its own (no root), running $out.
-[unix_http_server]
-file=$standalone/supervisor.sock
-chmod=0700
-
-[supervisord]
-nodaemon=true
-logfile=$standalone/supervisord.log
-pidfile=$standalone/supervisord.pid
-childlogdir=$log_dir
-loglevel=info
-
-[rpcinterface:supervisor]
-supervisor.rpcinterface_factory = supervisor.rpcinterface:make_main_rpcinterface
-
-[supervisorctl]
-serverurl=unix://$standalone/supervisor.sock
-
-[include]
-files=$out
-CONF
-fi
+# The one renderer of the shipped files (cmake/wingman_render.cmake, also `cmake --install`'s), run by CMake.
+command -v cmake > /dev/null || { echo "supervise: cmake is missing (tools/install_deps.sh)" >&2; exit 2; }
+target="$out"
+[ -n "$target" ] || target=$(mktemp)
+cmake -DSOURCE_DIR="$src" -DOUT="$target" -DBIN="$bin" -DETC="$etc" -DLOG_DIR="$log_dir" -DLCM_URL="$url" \
+  -DSTANDALONE="$standalone" -P "$src/cmake/render_tree.cmake"
+if [ -z "$out" ]; then cat "$target"; rm -f "$target"; fi
