@@ -176,15 +176,17 @@ Recipe load_recipe(const std::string& path, const std::vector<std::string>& over
       m("negative_frame_step", d.negative_frame_step, "");
     } else if (d.kind == "synth") {
       m("config", d.config, "");
+      const size_t before = problems.size();
       m("count", d.count, "");
       if (d.config.empty()) m.problem("config", "missing");
-      if (d.count < 1) m.problem("count", "expected at least 1 image");
+      if (d.count < 1 && problems.size() == before) m.problem("count", "expected at least 1 image");
     } else if (d.kind == "flights") {
+      const size_t before = problems.size();
       m("count", d.count, "");
       m("duration_s", d.duration_s, "");
       m("every", d.every, "");
       m("val", d.val, "");
-      if (d.count < 1) m.problem("count", "expected at least 1 flight");
+      if (d.count < 1 && problems.size() == before) m.problem("count", "expected at least 1 flight");
       for (const int v : d.val)
         if (v < 0 || v >= d.count) m.problem("val", fmt::format("flight {}: expected 0..{}", v, d.count - 1));
     } else {
