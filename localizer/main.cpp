@@ -11,17 +11,9 @@ namespace {
 
 using namespace wingman;
 
-geometry::CameraModel make_camera(const localizer::CameraOptions& o) {
-  if (o.calibration.empty()) {
-    // Principal point at the image centre, in the calibration convention (pixel centres at integers).
-    return geometry::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
-                                          0.5 * o.height - 0.5);
-  }
-  return geometry::load_calibration(o.calibration, o.kalibr_camera);
-}
-
 int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
-  localizer::Localizer loc(o, make_camera(o.camera));
+  const localizer::CameraOptions& c = o.camera;
+  localizer::Localizer loc(o, geometry::make_camera(c.calibration, c.kalibr_camera, c.width, c.height, c.focal_px));
   rt.status().declare_output(o.output_channel);
   if (o.windows.publish) rt.status().declare_output(o.windows.channel);
   // A time resync (one input re-anchored the clock) is worth a log line each time.

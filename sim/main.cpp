@@ -36,15 +36,6 @@ using namespace wingman;
 using Clock = std::chrono::steady_clock;
 namespace common = wingman::common;
 
-geometry::CameraModel make_camera(const sim::SimCameraOptions& o) {
-  if (o.calibration.empty()) {
-    // The localizer's built-in camera: principal point at the image centre (pixel centres at integers).
-    return geometry::CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5,
-                                          0.5 * o.height - 0.5);
-  }
-  return geometry::load_calibration(o.calibration, o.kalibr_camera);
-}
-
 int remaining_ms(Clock::time_point deadline, int cap_ms) {
   const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
   return static_cast<int>(std::clamp<int64_t>(left, 0, cap_ms));
@@ -200,8 +191,10 @@ std::string mavlink_detail(MavlinkSide& mav, int64_t own_pose_timeouts, int64_t 
 
 int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scenario) {
   common::StatusTracker& status = rt.status();
-  sim::SimCamera camera{make_camera(o.camera), geometry::Extrinsics::from_options(o.extrinsics), o.camera.rate_hz,
-                        o.camera.camera_id};
+  // The localizer's camera from the same keys (geometry::make_camera): their defaults agree.
+  const sim::SimCameraOptions& c = o.camera;
+  sim::SimCamera camera{geometry::make_camera(c.calibration, c.kalibr_camera, c.width, c.height, c.focal_px),
+                        geometry::Extrinsics::from_options(o.extrinsics), c.rate_hz, c.camera_id};
 
   std::unique_ptr<sim::Renderer> renderer;
   if (o.render) {

@@ -5,6 +5,7 @@
 #include "wingman/follower_ctrl/world_frame.hpp"
 
 #include <wingman/common/time_sanity.hpp>
+#include <wingman/geometry/message_eigen.hpp>
 
 #include <tuple>
 
@@ -35,8 +36,8 @@ std::vector<TargetState> usable_targets(const wingman::targets_t& msg, int64_t m
     if (t.predicted_utime > 0 && !common::is_fresh(msg.utime, t.predicted_utime, max_age_us, max_age_us)) continue;
     TargetState s;
     s.track_id = t.track_id;
-    s.p_target_in_world = Eigen::Vector3d(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);
-    s.v_target_in_world = Eigen::Vector3d(t.v_target_in_world[0], t.v_target_in_world[1], t.v_target_in_world[2]);
+    s.p_target_in_world = geometry::to_vector3(t.p_target_in_world);
+    s.v_target_in_world = geometry::to_vector3(t.v_target_in_world);
     if (ned) {
       s.p_target_in_world = swap_ned_enu(s.p_target_in_world);
       s.v_target_in_world = swap_ned_enu(s.v_target_in_world);

@@ -2,6 +2,8 @@
 // Own state in ENU/FLU, NED <-> ENU conversions and angle helpers.
 #include "wingman/follower_ctrl/world_frame.hpp"
 
+#include <wingman/geometry/message_eigen.hpp>
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -21,12 +23,9 @@ OwnState own_state_from_message(const wingman::own_pose_t& m) {
   OwnState s;
   s.utime = m.utime;
   s.frame = m.frame;
-  const Eigen::Vector3d p(m.p_body_in_world[0], m.p_body_in_world[1], m.p_body_in_world[2]);
-  const Eigen::Vector3d v(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
-  const Eigen::Matrix3d R =
-      Eigen::Quaterniond(m.q_body_to_world[0], m.q_body_to_world[1], m.q_body_to_world[2], m.q_body_to_world[3])
-          .normalized()
-          .toRotationMatrix();
+  const Eigen::Vector3d p = geometry::to_vector3(m.p_body_in_world);
+  const Eigen::Vector3d v = geometry::to_vector3(m.v_body_in_world);
+  const Eigen::Matrix3d R = geometry::to_quaternion(m.q_body_to_world).normalized().toRotationMatrix();
   if (m.frame == wingman::own_pose_t::FRAME_NED) {
     s.p_body_in_world = swap_ned_enu(p);
     s.v_body_in_world = swap_ned_enu(v);

@@ -117,9 +117,9 @@ std::vector<double> intrinsics_from_k(const std::string& path, const std::string
   return {k[0], k[4], k[2], k[5]};
 }
 
-CameraModel make_camera(const std::string& path, const std::string& key, int width, int height,
-                        const std::vector<double>& f, Distortion distortion, std::vector<double> coefficients,
-                        std::string name) {
+CameraModel checked_camera(const std::string& path, const std::string& key, int width, int height,
+                           const std::vector<double>& f, Distortion distortion, std::vector<double> coefficients,
+                           std::string name) {
   try {
     return CameraModel(width, height, f[0], f[1], f[2], f[3], distortion, std::move(coefficients), std::move(name));
   } catch (const std::invalid_argument& e) {
@@ -149,7 +149,7 @@ CameraModel read_ros(const std::string& path, const YAML::Node& root) {
   if (root["camera_name"]) name = to_string(path, "camera_name", root["camera_name"]);
   if (width <= 0 || height <= 0)
     fail(path, "image_width", fmt::format("expected a size > 0, got {}x{}", width, height));
-  return make_camera(path, "distortion_coefficients.data", width, height, f, distortion, std::move(d), name);
+  return checked_camera(path, "distortion_coefficients.data", width, height, f, distortion, std::move(d), name);
 }
 
 CameraModel read_kalibr(const std::string& path, const YAML::Node& root, const std::string& camera) {
@@ -193,8 +193,8 @@ CameraModel read_kalibr(const std::string& path, const YAML::Node& root, const s
     expect_count(path, camera + ".distortion_coeffs", d, 4,
                  distortion == Distortion::kRadTan ? "k1, k2, r1, r2" : "k1, k2, k3, k4");
   }
-  return make_camera(path, camera + ".distortion_coeffs", static_cast<int>(res[0]), static_cast<int>(res[1]), f,
-                     distortion, std::move(d), camera);
+  return checked_camera(path, camera + ".distortion_coeffs", static_cast<int>(res[0]), static_cast<int>(res[1]), f,
+                        distortion, std::move(d), camera);
 }
 
 // --- OpenCV FileStorage (YAML) ---
@@ -304,7 +304,7 @@ CameraModel read_opencv(const std::string& path, const std::string& text) {
   } else {
     fail(path, d_key, fmt::format("expected 4, 5, 8, 12 or 14 coefficients, got {}", d.size()));
   }
-  return make_camera(path, d_key, width, height, f, distortion, std::move(d), "");
+  return checked_camera(path, d_key, width, height, f, distortion, std::move(d), "");
 }
 
 }  // namespace
@@ -329,6 +329,13 @@ CameraModel load_calibration(const std::string& path, const std::string& kalibr_
   const YAML::Node root = parse_yaml(path, text);
   if (format == CalibrationFormat::kRosCameraInfo) return read_ros(path, root);
   return read_kalibr(path, root, kalibr_camera);
+}
+
+CameraModel make_camera(const std::string& calibration, const std::string& kalibr_camera, int width, int height,
+                        double focal_px) {
+  if (!calibration.empty()) return load_calibration(calibration, kalibr_camera);
+  // Principal point at the image centre, in the calibration convention (pixel centres at integers).
+  return CameraModel::pinhole(width, height, focal_px, focal_px, 0.5 * width - 0.5, 0.5 * height - 0.5);
 }
 
 }  // namespace wingman::geometry

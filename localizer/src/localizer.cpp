@@ -6,24 +6,11 @@
 
 #include <fmt/format.h>
 #include <wingman/common/detection_class.hpp>
+#include <wingman/geometry/message_eigen.hpp>
 
 #include <stdexcept>
 
 namespace wingman::localizer {
-namespace {
-
-template <class M>
-void copy3(const M& v, double (&out)[3]) {
-  for (int i = 0; i < 3; ++i) out[i] = v(i);
-}
-
-void copy33(const Eigen::Matrix3d& m, double (&out)[9]) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out[3 * r + c] = m(r, c);
-}
-
-}  // namespace
-
 std::string NonDroneCounts::summary() const {
   if (total == 0) return "";
   std::string by_class_text;
@@ -49,17 +36,12 @@ Localizer::Localizer(const LocalizerOptions& options, geometry::CameraModel came
 void Localizer::on_own_pose(const wingman::own_pose_t& m) {
   PoseSample s;
   s.utime = m.utime;
-  s.p_body_in_world = Eigen::Vector3d(m.p_body_in_world[0], m.p_body_in_world[1], m.p_body_in_world[2]);
-  s.q_body_to_world =
-      Eigen::Quaterniond(m.q_body_to_world[0], m.q_body_to_world[1], m.q_body_to_world[2], m.q_body_to_world[3])
-          .normalized();
-  s.v_body_in_world = Eigen::Vector3d(m.v_body_in_world[0], m.v_body_in_world[1], m.v_body_in_world[2]);
+  s.p_body_in_world = geometry::to_vector3(m.p_body_in_world);
+  s.q_body_to_world = geometry::to_quaternion(m.q_body_to_world).normalized();
+  s.v_body_in_world = geometry::to_vector3(m.v_body_in_world);
   if (m.has_covariance && options_.pose.use_covariance) {
-    const double* c = m.cov_p_body_in_world;    // upper triangle row by row: xx xy xz yy yz zz
-    s.cov_p_body_in_world << c[0], c[1], c[2],  //
-        c[1], c[3], c[4],                       //
-        c[2], c[4], c[5];
-    s.var_rpy_body = Eigen::Vector3d(m.var_rpy_body[0], m.var_rpy_body[1], m.var_rpy_body[2]);
+    s.cov_p_body_in_world = geometry::from_upper_triangle(m.cov_p_body_in_world);
+    s.var_rpy_body = geometry::to_vector3(m.var_rpy_body);
   }
   if (m.frame == wingman::own_pose_t::FRAME_NED) s = pose_ned_frd_to_enu_flu(s);  // world ENU, body FLU inside
   const common::TimeAdmission admission = clock_.admit(own_pose_input_, m.utime);
@@ -154,11 +136,11 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     wingman::target_t m{};
     m.track_id = t.track_id;
     m.camera_id = t.camera_id;
-    copy3(t.p_target_in_cam, m.p_target_in_cam);
-    copy3(t.p_target_in_world, m.p_target_in_world);
-    copy3(t.v_target_in_world, m.v_target_in_world);
-    copy33(t.cov_p, m.position_covariance);
-    copy33(t.cov_v, m.velocity_covariance);
+    geometry::to_array(t.p_target_in_cam, m.p_target_in_cam);
+    geometry::to_array(t.p_target_in_world, m.p_target_in_world);
+    geometry::to_array(t.v_target_in_world, m.v_target_in_world);
+    geometry::to_array(t.cov_p, m.position_covariance);
+    geometry::to_array(t.cov_v, m.velocity_covariance);
     m.world_valid = true;
     m.range = t.range;
     m.radius_m = t.size_scale * options_.sphere.radius_m;
@@ -216,8 +198,8 @@ wingman::targets_t Localizer::camera_frame_targets(const wingman::detections_t& 
     wingman::target_t t{};
     t.track_id = 0;  // untracked: tracks live in the world frame
     t.camera_id = d.camera_id;
-    copy3(m.p_target_in_cam, t.p_target_in_cam);
-    copy33(m.cov_p_in_cam, t.position_covariance);
+    geometry::to_array(m.p_target_in_cam, t.p_target_in_cam);
+    geometry::to_array(m.cov_p_in_cam, t.position_covariance);
     t.world_valid = false;
     t.range = m.range_valid ? m.range : 0.0;
     t.confidence = static_cast<float>(m.confidence);

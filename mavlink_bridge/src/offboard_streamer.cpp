@@ -2,6 +2,7 @@
 // The setpoint stream's states, conversion to NED and clamps.
 #include "wingman/mavlink_bridge/offboard_streamer.hpp"
 
+#include <wingman/geometry/message_eigen.hpp>
 #include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 #include <wingman/own_pose_t.hpp>
@@ -189,7 +190,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
   SetPositionTargetLocalNed t;
   t.coordinate_frame = mavlink::kMavFrameLocalNed;
   if (sp.mode == wingman::setpoint_t::MODE_POSITION) {
-    Eigen::Vector3d p(sp.position[0], sp.position[1], sp.position[2]);
+    Eigen::Vector3d p = geometry::to_vector3(sp.position);
     if (enu) p = geometry::swap_ned_enu(p);
     const double up = std::clamp(-p.z(), o_.min_altitude_m, o_.max_altitude_m);
     if (up != -p.z())
@@ -205,7 +206,7 @@ SetPositionTargetLocalNed OffboardStreamer::follower_target(int64_t mono_us) {
     last_follower_utime_ = -1;
     return t;
   }
-  Eigen::Vector3d v(sp.velocity[0], sp.velocity[1], sp.velocity[2]);
+  Eigen::Vector3d v = geometry::to_vector3(sp.velocity);
   if (enu) v = geometry::swap_ned_enu(v);
   // Speeds.
   const double h = std::hypot(v.x(), v.y());

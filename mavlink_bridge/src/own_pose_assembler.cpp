@@ -2,6 +2,7 @@
 // Poses from the autopilot's attitude, position and odometry messages.
 #include "wingman/mavlink_bridge/own_pose_assembler.hpp"
 
+#include <wingman/geometry/message_eigen.hpp>
 #include <wingman/geometry/ned_enu.hpp>
 #include <wingman/mavlink/enums.hpp>
 
@@ -129,21 +130,15 @@ wingman::own_pose_t own_pose_message(const NedPose& pose, int64_t utime, bool en
   const Eigen::Vector3d p = enu ? geometry::swap_ned_enu(pose.p_body_in_ned) : pose.p_body_in_ned;
   const Eigen::Vector3d v = enu ? geometry::swap_ned_enu(pose.v_body_in_ned) : pose.v_body_in_ned;
   const Eigen::Quaterniond q = enu ? geometry::swap_ned_frd_enu_flu(pose.q_frd_to_ned) : pose.q_frd_to_ned.normalized();
-  for (int i = 0; i < 3; ++i) {
-    m.p_body_in_world[i] = p[i];
-    m.v_body_in_world[i] = v[i];
-  }
-  m.q_body_to_world[0] = q.w();
-  m.q_body_to_world[1] = q.x();
-  m.q_body_to_world[2] = q.y();
-  m.q_body_to_world[3] = q.z();
+  geometry::to_array(p, m.p_body_in_world);
+  geometry::to_array(v, m.v_body_in_world);
+  geometry::to_array(q, m.q_body_to_world);
   if (pose.has_covariance) {
     // Roll, pitch, yaw variances are the same for an FRD and an FLU body (the axes differ by sign only).
     const Eigen::Matrix3d C = enu ? geometry::swap_ned_enu_covariance(pose.cov_p_in_ned) : pose.cov_p_in_ned;
     m.has_covariance = true;
-    const double upper[6] = {C(0, 0), C(0, 1), C(0, 2), C(1, 1), C(1, 2), C(2, 2)};
-    for (int i = 0; i < 6; ++i) m.cov_p_body_in_world[i] = upper[i];
-    for (int i = 0; i < 3; ++i) m.var_rpy_body[i] = pose.var_rpy_frd[i];
+    geometry::to_upper_triangle(C, m.cov_p_body_in_world);
+    geometry::to_array(pose.var_rpy_frd, m.var_rpy_body);
   }
   return m;
 }

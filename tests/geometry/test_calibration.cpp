@@ -180,6 +180,30 @@ TEST(Calibration, ReadsKalibrCamchainByCameraName) {
   EXPECT_EQ(c1.name(), "cam1");
 }
 
+TEST(MakeCamera, WithoutCalibrationIsTheCentredIdealPinhole) {
+  const CameraModel c = make_camera("", "cam0", 1280, 720, 640.0);
+  EXPECT_EQ(c.width(), 1280);
+  EXPECT_EQ(c.height(), 720);
+  EXPECT_EQ(c.fx(), 640.0);
+  EXPECT_EQ(c.fy(), 640.0);
+  EXPECT_EQ(c.cx(), 639.5);  // pixel centres at integers: the image spans [-0.5, 1279.5]
+  EXPECT_EQ(c.cy(), 359.5);
+  EXPECT_EQ(c.distortion(), Distortion::kNone);
+  const CameraModel odd = make_camera("", "cam0", 641, 481, 300.0);
+  EXPECT_EQ(odd.cx(), 320.0);
+  EXPECT_EQ(odd.cy(), 240.0);
+  EXPECT_THROW(make_camera("", "cam0", 0, 720, 640.0), std::invalid_argument);
+}
+
+TEST(MakeCamera, WithCalibrationReadsItAndIgnoresThePinholeKeys) {
+  TempDir dir;
+  const std::string path = write(dir, "camchain.yaml", kKalibr);
+  const CameraModel c1 = make_camera(path, "cam1", 1, 1, 1.0);
+  EXPECT_EQ(c1.describe(), load_calibration(path, "cam1").describe());
+  EXPECT_EQ(c1.name(), "cam1");
+  EXPECT_THROW(make_camera(path, "cam7", 1280, 720, 640.0), CalibrationError);
+}
+
 TEST(Calibration, ErrorsNameTheFileTheKeyAndWhatWasExpected) {
   TempDir dir;
   auto ros_with = [&](const std::string& name, const std::string& from, const std::string& to) {

@@ -3,6 +3,7 @@
 #include "eval_metrics.hpp"
 
 #include <wingman/detections_t.hpp>
+#include <wingman/geometry/message_eigen.hpp>
 
 #include <algorithm>
 #include <array>
@@ -258,7 +259,7 @@ void localization_metrics(const EvalLog& log, const EvalOptions& o, EvalResult* 
   TrackIds ids;
   const TruthTrack* follower = log.truth.count(o.follower_id) ? &log.truth.at(o.follower_id) : nullptr;
   for (const auto& [u, message, t] : log.estimates) {
-    const Eigen::Vector3d p_est(t.p_target_in_world[0], t.p_target_in_world[1], t.p_target_in_world[2]);
+    const Eigen::Vector3d p_est = geometry::to_vector3(t.p_target_in_world);
     const Match m = nearest_vehicle(log.truth, o, u, p_est);
     const double t_s = seconds_since(t0, u);
     Eigen::Vector3d p_f;

@@ -7,6 +7,7 @@
 #include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detections_t.hpp>
+#include <wingman/geometry/message_eigen.hpp>
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
 #include <wingman/targets_t.hpp>
@@ -45,7 +46,7 @@ void add_truth(const wingman::ground_truth_t& g, int64_t timestamp, EvalLog* log
     TruthTrack& t = log->truth[v.vehicle_id];
     if (!t.utime.empty() && g.utime <= t.utime.back()) continue;  // keep times strictly increasing
     t.utime.push_back(g.utime);
-    t.p.emplace_back(v.p_body_in_world[0], v.p_body_in_world[1], v.p_body_in_world[2]);
+    t.p.push_back(geometry::to_vector3(v.p_body_in_world));
   }
   log->truth_boxes_at[g.utime] = g.boxes;
   log->truth_event_at.emplace(g.utime, timestamp);

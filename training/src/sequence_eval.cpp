@@ -14,6 +14,7 @@
 #include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
 #include <wingman/detector/sized_detector.hpp>
+#include <wingman/geometry/message_eigen.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
 
 #include <fmt/format.h>
@@ -236,7 +237,7 @@ void ClipTracker::add_frame(int frame_index, const std::vector<detector::Box>& b
     }
     rec.last_frame = frame_index;
     if (t.source_utime != utime) continue;  // coasting: no detection this frame
-    const Eigen::Vector3d p(t.p_target_in_cam[0], t.p_target_in_cam[1], t.p_target_in_cam[2]);
+    const Eigen::Vector3d p = geometry::to_vector3(t.p_target_in_cam);
     size_t best = drone.size();
     double best_d = std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < drone.size(); ++i) {

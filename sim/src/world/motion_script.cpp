@@ -6,6 +6,7 @@
 #include "wingman/sim/multirotor.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/geometry/angles.hpp>
 
 #include <fmt/format.h>
 
@@ -261,7 +262,7 @@ std::unique_ptr<MotionScript> make_motion_script(const MotionSpec& spec, const E
                                                  double yaw_initial_rad, const FrameClock& clock) {
   const auto problems = validate_motion(spec, p_initial_in_world);
   if (!problems.empty()) throw std::invalid_argument(problems.front());
-  const double yaw = wrap_angle(yaw_initial_rad);
+  const double yaw = geometry::wrap_pi(yaw_initial_rad);
   switch (spec.type) {
     case MotionSpec::Type::kHover:
       return std::make_unique<HoverScript>(p_initial_in_world, yaw);

@@ -4,6 +4,7 @@
 #include "wingman/sim/multirotor.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/geometry/angles.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -48,12 +49,6 @@ std::vector<std::string> MultirotorLimits::validate(const std::string& prefix) c
   return p;
 }
 
-double wrap_angle(double rad) {
-  double a = std::remainder(rad, 2.0 * M_PI);  // [-pi, pi]
-  if (a <= -M_PI) a += 2.0 * M_PI;
-  return a;
-}
-
 Eigen::Quaterniond attitude_from_acceleration(const Eigen::Vector3d& a_in_world, double yaw_rad) {
   Eigen::Vector3d thrust = a_in_world + Eigen::Vector3d(0, 0, kGravity);
   thrust.z() = std::max(thrust.z(), 0.1 * kGravity);
@@ -95,7 +90,7 @@ void Multirotor::set_command(const VehicleCommand& command) {
 void Multirotor::teleport(const Eigen::Vector3d& p_in_world, double yaw_rad) {
   state_ = MultirotorState{};
   state_.p_body_in_world = p_in_world;
-  state_.yaw_rad = wrap_angle(yaw_rad);
+  state_.yaw_rad = geometry::wrap_pi(yaw_rad);
   state_.q_body_to_world = attitude_from_acceleration(Eigen::Vector3d::Zero(), state_.yaw_rad);
   command_ = VehicleCommand{};
   command_.mode = VehicleCommand::Mode::kPosition;
@@ -123,7 +118,7 @@ void Multirotor::step(double h) {
   } else {  // kPosition (holds are resolved to positions by set_command)
     v_cmd = command_.v_ref_in_world + tau * command_.a_ref_in_world +
             L.position_gain * (command_.p_ref_in_world - state_.p_body_in_world);
-    yaw_rate_cmd = L.yaw_gain * wrap_angle(command_.yaw_ref_rad - state_.yaw_rad);
+    yaw_rate_cmd = L.yaw_gain * geometry::wrap_pi(command_.yaw_ref_rad - state_.yaw_rad);
   }
   v_cmd = clamp_xy_z(v_cmd, L.max_speed_xy, L.max_speed_z);
 
@@ -138,7 +133,7 @@ void Multirotor::step(double h) {
   state_.a_body_in_world = a;
 
   const double max_rate = L.max_yaw_rate_deg * kDegToRad;
-  state_.yaw_rad = wrap_angle(state_.yaw_rad + std::clamp(yaw_rate_cmd, -max_rate, max_rate) * h);
+  state_.yaw_rad = geometry::wrap_pi(state_.yaw_rad + std::clamp(yaw_rate_cmd, -max_rate, max_rate) * h);
 
   const Eigen::Quaterniond q_old = state_.q_body_to_world;
   state_.q_body_to_world = attitude_from_acceleration(a, state_.yaw_rad);

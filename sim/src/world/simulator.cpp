@@ -7,6 +7,7 @@
 #include "wingman/sim/vehicle_command.hpp"
 
 #include <wingman/common/message_validation.hpp>
+#include <wingman/geometry/message_eigen.hpp>
 
 #include <fmt/format.h>
 
@@ -19,16 +20,6 @@ namespace {
 
 /// Propeller speed in hover, rad/s (about 5700 rpm, an F450 with 10" props); it scales with sqrt(thrust / hover).
 constexpr double kHoverPropRate = 600.0;
-
-void copy3(const Eigen::Vector3d& v, double (&out)[3]) {
-  for (int i = 0; i < 3; ++i) out[i] = v[i];
-}
-void copy_q(const Eigen::Quaterniond& q, double (&out)[4]) {
-  out[0] = q.w();
-  out[1] = q.x();
-  out[2] = q.y();
-  out[3] = q.z();
-}
 
 }  // namespace
 
@@ -197,9 +188,9 @@ SimFrame Simulator::step() {
   f.own_reported = own_pose_error_ ? own_pose_error_->reported(own, f.utime) : own;
   f.own_pose.utime = f.utime;
   f.own_pose.frame = wingman::own_pose_t::FRAME_ENU;
-  copy3(f.own_reported.p_body_in_world, f.own_pose.p_body_in_world);
-  copy_q(f.own_reported.q_body_to_world, f.own_pose.q_body_to_world);
-  copy3(f.own_reported.v_body_in_world, f.own_pose.v_body_in_world);
+  geometry::to_array(f.own_reported.p_body_in_world, f.own_pose.p_body_in_world);
+  geometry::to_array(f.own_reported.q_body_to_world, f.own_pose.q_body_to_world);
+  geometry::to_array(f.own_reported.v_body_in_world, f.own_pose.v_body_in_world);
   if (own_pose_error_ && own_pose_error_->options().report_covariance) {
     const double var_p = std::pow(own_pose_error_->options().position_std_m, 2);
     const double var_a = std::pow(own_pose_error_->options().attitude_std_rad, 2);
@@ -222,10 +213,10 @@ SimFrame Simulator::step() {
     wingman::vehicle_truth_t t{};
     t.vehicle_id = v->spec.id;
     t.name = v->spec.name;
-    copy3(s.p_body_in_world, t.p_body_in_world);
-    copy_q(s.q_body_to_world, t.q_body_to_world);
-    copy3(s.v_body_in_world, t.v_body_in_world);
-    copy3(s.w_body_in_body, t.w_body_in_body);
+    geometry::to_array(s.p_body_in_world, t.p_body_in_world);
+    geometry::to_array(s.q_body_to_world, t.q_body_to_world);
+    geometry::to_array(s.v_body_in_world, t.v_body_in_world);
+    geometry::to_array(s.w_body_in_body, t.w_body_in_body);
     t.bounding_radius = v->model.bounding_radius();
     f.truth.vehicles.push_back(t);
     if (v.get() == camera_vehicle_) continue;

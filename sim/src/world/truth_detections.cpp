@@ -4,6 +4,7 @@
 
 #include "trapezoid.hpp"
 
+#include <wingman/geometry/message_eigen.hpp>
 #include <wingman/geometry/sphere_projection.hpp>
 
 #include <algorithm>
@@ -18,7 +19,7 @@ bool sphere_box(const wingman::ground_truth_t& truth, int32_t vehicle_id, const 
                 const Eigen::Isometry3d& T_cam_to_world, geometry::PixelBox* box) {
   for (const auto& v : truth.vehicles) {
     if (v.vehicle_id != vehicle_id) continue;
-    const Eigen::Vector3d p_in_world(v.p_body_in_world[0], v.p_body_in_world[1], v.p_body_in_world[2]);
+    const Eigen::Vector3d p_in_world = geometry::to_vector3(v.p_body_in_world);
     const geometry::SphereImageBox s =
         geometry::project_sphere(camera, T_cam_to_world.inverse() * p_in_world, v.bounding_radius);
     if (!s.valid) return false;

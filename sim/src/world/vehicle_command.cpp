@@ -2,6 +2,7 @@
 // setpoint_t (ENU or NED) to VehicleCommand (ENU).
 #include "wingman/sim/vehicle_command.hpp"
 
+#include <wingman/geometry/message_eigen.hpp>
 #include <wingman/geometry/ned_enu.hpp>
 #include <wingman/own_pose_t.hpp>
 
@@ -13,7 +14,7 @@ namespace wingman::sim {
 namespace {
 
 Eigen::Vector3d to_enu(const double (&v)[3], bool ned) {
-  const Eigen::Vector3d p(v[0], v[1], v[2]);
+  const Eigen::Vector3d p = geometry::to_vector3(v);
   return ned ? geometry::swap_ned_enu(p) : p;
 }
 

@@ -2,6 +2,7 @@
 // The follower's own state in Wingman's ENU world / FLU body frames, and the NED <-> ENU conversions.
 #pragma once
 
+#include <wingman/geometry/angles.hpp>
 #include <wingman/geometry/ned_enu.hpp>
 #include <wingman/own_pose_t.hpp>
 
@@ -35,7 +36,8 @@ struct OwnState {
 /// quaternion, known frame).
 OwnState own_state_from_message(const wingman::own_pose_t& pose);
 
-// The NED <-> ENU conversions and angle wrapping live in geometry/ (ned_enu.hpp), shared with wingman-mavlink.
+// The NED <-> ENU conversions (ned_enu.hpp) and the angle wrap (angles.hpp) live in geometry/, shared with
+// wingman-mavlink and the simulator.
 using geometry::swap_ned_enu;
 using geometry::swap_ned_enu_yaw;
 using geometry::wrap_pi;

@@ -3,6 +3,8 @@
 // with an FLU body: docs/localization.md).
 #pragma once
 
+#include "wingman/geometry/angles.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -23,14 +25,8 @@ inline Eigen::Matrix3d swap_ned_enu_covariance(const Eigen::Matrix3d& C) {
   return S * C * S.transpose();
 }
 
-/// Angle wrapped into (-pi, pi].
-inline double wrap_pi(double angle_rad) {
-  const double a = std::remainder(angle_rad, 2.0 * M_PI);  // [-pi, pi]
-  return a <= -M_PI ? a + 2.0 * M_PI : a;
-}
-
 /// Heading in NED (from north, clockwise) of an ENU heading (from east, counter-clockwise), and back:
-/// yaw_ned = pi/2 - yaw_enu, wrapped. Its own inverse. A yaw *rate* changes sign only.
+/// yaw_ned = pi/2 - yaw_enu, wrapped (wrap_pi, angles.hpp). Its own inverse. A yaw *rate* changes sign only.
 inline double swap_ned_enu_yaw(double yaw_rad) { return wrap_pi(0.5 * M_PI - yaw_rad); }
 
 /// A body-to-world rotation between the conventions: R_flu_to_enu = R_ned_to_enu R_frd_to_ned R_flu_to_frd from an

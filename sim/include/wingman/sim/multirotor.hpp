@@ -74,9 +74,6 @@ struct MultirotorState {
 /// Precondition: a_z > -g (not in free fall); a_z is clamped to -0.9 g otherwise.
 Eigen::Quaterniond attitude_from_acceleration(const Eigen::Vector3d& a_in_world, double yaw_rad);
 
-/// Wraps an angle to (-pi, pi].
-double wrap_angle(double rad);
-
 /// One multirotor with its autopilot, integrated deterministically.
 ///
 /// Before any command it holds its initial position and heading (hover). Commands take effect from the next
