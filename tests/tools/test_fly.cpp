@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `wingman fly`'s plan: the processes and command lines a flight runs, and the option errors (nothing is started).
 #include <gtest/gtest.h>
+#include <wingman/common/config.hpp>
 #include <wingman/tools/fly.hpp>
 
 #include "../support/test_support.hpp"
@@ -174,16 +175,19 @@ TEST(FlyPlan, TheOwnPoseErrorBecomesTheSimulatorsKeys) {
 TEST(FlyPlan, BadOptionsAreOneClearErrorBeforeAnythingStarts) {
   FlyOptions o = options_for_tests();
   o.detections = "radar";
-  EXPECT_NE(error_of(o).find("--detections 'radar': expected cnn or truth"), std::string::npos) << error_of(o);
+  EXPECT_NE(error_of(o).find("flight.detections = 'radar': must be cnn or truth"), std::string::npos) << error_of(o);
   o = options_for_tests();
   o.render = "off";
-  EXPECT_NE(error_of(o).find("--detections cnn needs images"), std::string::npos);
+  EXPECT_NE(error_of(o).find("flight.render = 'off': cnn detections need images"), std::string::npos) << error_of(o);
   o = options_for_tests();
   o.scenario = "no_such_flight";
   EXPECT_NE(error_of(o).find("no scenario 'no_such_flight' (looked for "), std::string::npos) << error_of(o);
   o = options_for_tests();
   o.localizer_config = "/nonexistent/localizer.yaml";
-  EXPECT_NE(error_of(o).find("--localizer-config /nonexistent/localizer.yaml: cannot read it"), std::string::npos);
+  EXPECT_NE(
+      error_of(o).find("processes.localizer_config (--localizer-config) /nonexistent/localizer.yaml: cannot read it"),
+      std::string::npos)
+      << error_of(o);
   TempDir empty_bin;
   o = options_for_tests();
   o.bin_dir = empty_bin.path();
@@ -193,7 +197,37 @@ TEST(FlyPlan, BadOptionsAreOneClearErrorBeforeAnythingStarts) {
   EXPECT_NE(error_of(o).find("has no " + empty_bin.file("other.cfg") + " beside it"), std::string::npos) << error_of(o);
   o = options_for_tests();
   o.duration_s = -1.0;
-  EXPECT_NE(error_of(o).find("--duration -1"), std::string::npos);
+  EXPECT_NE(error_of(o).find("flight.duration_s = -1"), std::string::npos) << error_of(o);
+}
+
+TEST(FlyOptions, AFlightIsDataReadWithTheOneLoaderEveryBadKeyAtOnce) {
+  TempDir dir;
+  std::ofstream(dir.file("flight.yaml"))
+      << "flight:\n  scenario: follow_1d\n  duration_s: 12\nwindows:\n  enabled: true\n";
+  common::ConfigSources sources;
+  sources.files = {dir.file("flight.yaml")};
+  sources.sets = {"flight.duration_s=30", "autopilot.kind=mavlink"};
+  const FlyOptions o = common::load_options<FlyOptions>(sources);
+  EXPECT_EQ(o.scenario, "follow_1d");
+  EXPECT_EQ(o.duration_s, 30.0);  // --set over the file
+  EXPECT_TRUE(o.windows);
+  EXPECT_EQ(o.autopilot, "mavlink");
+  EXPECT_EQ(o.detections, "cnn");  // the default
+  // Printed and read back: the same flight.
+  const std::string printed = common::print_options(o);
+  const FlyOptions again = common::load_options_from_string<FlyOptions>(printed, "printed.yaml");
+  EXPECT_EQ(common::print_options(again), printed);
+
+  std::ofstream(dir.file("bad.yaml")) << "flight:\n  duraton_s: 3\n  detections: radar\nwindow:\n  enabled: yes\n";
+  try {
+    common::load_options<FlyOptions>(common::ConfigSources{{dir.file("bad.yaml")}, {}});
+    FAIL() << "expected a ConfigError";
+  } catch (const common::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad.yaml:2: flight.duraton_s: unknown key"), std::string::npos) << what;
+    EXPECT_NE(what.find("bad.yaml:5: window.enabled: unknown key"), std::string::npos) << what;
+    EXPECT_NE(what.find("flight.detections = 'radar': must be cnn or truth"), std::string::npos) << what;
+  }
 }
 
 TEST(FlyPlan, WithoutABusItSaysWhereToRunIt) {

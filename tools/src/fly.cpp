@@ -6,6 +6,7 @@
 #include "wingman/tools/report.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/config.hpp>
 #include <wingman/sim/scenario.hpp>
 
 #include <chrono>
@@ -49,8 +50,8 @@ std::vector<std::string> own_pose_sets(const std::string& spec) {
   }
   if (parts.size() < 2 || parts.size() > 3 || parts[0].empty() || parts[1].empty() ||
       (parts.size() == 3 && parts[2].empty())) {
-    throw std::invalid_argument(
-        fmt::format("--own-pose-error '{}': expected M,RAD or M,RAD,TAU (e.g. 0.3,0.01)", spec));
+    throw std::invalid_argument(fmt::format(
+        "flight.own_pose_error (--own-pose-error) = '{}': expected M,RAD or M,RAD,TAU (e.g. 0.3,0.01)", spec));
   }
   return {"--set", "own_pose.position_std_m=" + parts[0],
           "--set", "own_pose.attitude_std_rad=" + parts[1],
@@ -65,30 +66,31 @@ void append(std::vector<std::string>& to, const std::vector<std::string>& more) 
 
 std::vector<std::string> FlyOptions::validate() const {
   std::vector<std::string> p;
-  auto one_of = [&](const char* flag, const std::string& value, std::initializer_list<const char*> allowed) {
+  auto one_of = [&](const char* key, const std::string& value, std::initializer_list<const char*> allowed) {
     std::string list;
     for (const char* a : allowed) {
       if (value == a) return;
       list += (list.empty() ? "" : " or ") + std::string(a);
     }
-    p.push_back(fmt::format("{} '{}': expected {}", flag, value, list));
+    p.push_back(common::problem(key, value, "must be " + list));
   };
-  one_of("--detections", detections, {"cnn", "truth"});
-  one_of("--render", render, {"auto", "on", "off"});
-  one_of("--truth-box", truth_box, {"sphere", "silhouette"});
-  one_of("--autopilot", autopilot, {"lcm", "mavlink"});
-  one_of("--firmware", firmware, {"px4", "ardupilot"});
+  one_of("flight.detections", detections, {"cnn", "truth"});
+  one_of("flight.render", render, {"auto", "on", "off"});
+  one_of("flight.truth_box", truth_box, {"sphere", "silhouette"});
+  one_of("autopilot.kind", autopilot, {"lcm", "mavlink"});
+  one_of("autopilot.firmware", firmware, {"px4", "ardupilot"});
   if (!(duration_s >= 0.0))
-    p.push_back(fmt::format("--duration {}: expected seconds >= 0 (0: the scenario's)", duration_s));
-  if (scenario.empty()) p.push_back("--scenario '': expected a scenario name or file");
-  if (detections == "cnn" && render == "off") p.push_back("--detections cnn needs images: drop --no-render");
+    p.push_back(common::problem("flight.duration_s", duration_s, "must be >= 0 seconds (0: the scenario's)"));
+  if (scenario.empty()) p.push_back(common::problem("flight.scenario", scenario, "must name a scenario or a file"));
+  if (detections == "cnn" && render == "off")
+    p.push_back(common::problem("flight.render", render, "cnn detections need images: on or auto"));
   return p;
 }
 
 FlightPlan plan_flight(const FlyOptions& o) {
   if (const auto problems = o.validate(); !problems.empty()) {
     std::string all;
-    for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
+    for (const auto& line : problems) all += (all.empty() ? "" : "; ") + line;
     throw std::invalid_argument(all);
   }
   FlightPlan plan;
@@ -123,9 +125,9 @@ FlightPlan plan_flight(const FlyOptions& o) {
     const fs::path f = fs::path(o.config_dir) / "flights" / fmt::format("{}.{}.yaml", plan.name, process_name);
     return readable_file(f.string()) ? absolute(f.string()) : "";
   };
-  std::string localizer_config = given(o.localizer_config, "--localizer-config");
-  std::string follower_config = given(o.follower_config, "--follower-config");
-  const std::string render_config = given(o.render_config, "--render-config");
+  std::string localizer_config = given(o.localizer_config, "processes.localizer_config (--localizer-config)");
+  std::string follower_config = given(o.follower_config, "processes.follower_config (--follower-config)");
+  const std::string render_config = given(o.render_config, "processes.render_config (--render-config)");
   if (o.localizer_config.empty()) localizer_config = flight_file("localizer");
   if (o.follower_config.empty()) follower_config = flight_file("follower_ctrl");
 
@@ -143,8 +145,8 @@ FlightPlan plan_flight(const FlyOptions& o) {
     model_cfg = stem + ".cfg";
     if (!readable_file(model_cfg))
       throw std::invalid_argument(
-          fmt::format("--model-weights (WINGMAN_MODEL_WEIGHTS) {} has no {} beside it: give "
-                      "--model-cfg (WINGMAN_MODEL_CFG)",
+          fmt::format("detector.model_weights (--model-weights, WINGMAN_MODEL_WEIGHTS) {} has no {} beside it: "
+                      "give detector.model_cfg (--model-cfg, WINGMAN_MODEL_CFG)",
                       o.model_weights, model_cfg));
   }
   if (model_cfg.empty()) model_cfg = "builtin:wingman-small";

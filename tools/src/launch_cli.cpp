@@ -10,9 +10,30 @@
 #include "wingman/tools/fly.hpp"
 #endif
 
+#include <wingman/common/config.hpp>
+
+#include <initializer_list>
+#include <string>
+#include <tuple>
+#include <vector>
+
 #include <CLI/CLI.hpp>
 
 namespace wingman::tools {
+
+namespace {
+
+/// `text` as a double-quoted YAML scalar (backslashes and quotes escaped), so any path or text is read back as is.
+[[maybe_unused]] std::string yaml_quoted(const std::string& text) {
+  std::string q = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+}  // namespace
 
 struct LaunchVerbs::State {
   CLI::App* demo = nullptr;
@@ -21,8 +42,16 @@ struct LaunchVerbs::State {
   LoadOptions load_options;
 #ifdef WINGMAN_WITH_SIM
   CLI::App* fly = nullptr;
-  FlyOptions options;
-  bool render = false, no_render = false;
+  FlyOptions options;  // what the flags say (only the flags given count)
+  bool render = false, no_render = false, print_config = false;
+  common::ConfigSources sources;  // --config FILE..., --set KEY=VALUE...
+  /// Each flag with its key; `quote`: its value is text (a YAML string), else a number or a switch.
+  struct Keyed {
+    CLI::Option* option;
+    std::string key;
+    bool quote;
+  };
+  std::vector<Keyed> keyed;
 #endif
 };
 
@@ -131,6 +160,41 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   f->add_option("--config-dir", o.config_dir, "The checkout's config folder (scenarios, flights, MAVLink bridge)");
   f->add_option("--bin-dir", o.bin_dir, "The executables (empty: the folder of this wingman)");
   f->add_option("--lcm-url", o.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+  // A flight as data: the one loader's layers (defaults, --config files, --set), and the flags given over them.
+  f->add_option("--config", s_->sources.files,
+                "A flight file (FlyOptions' keys, as --print-config shows them; repeatable, a later file wins); the "
+                "flags given on the command line win over it")
+      ->allow_extra_args(false)
+      ->type_name("FILE");
+  f->add_option("--set", s_->sources.sets, "KEY=VALUE over the --config files (repeatable), e.g. flight.duration_s=30")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  f->add_flag("--print-config", s_->print_config, "Print the effective flight (files, --set and flags) and exit");
+  for (const auto& [flag, key, quote] : std::initializer_list<std::tuple<const char*, const char*, bool>>{
+           {"--scenario", "flight.scenario", true},
+           {"--out", "flight.out", true},
+           {"--duration", "flight.duration_s", false},
+           {"--detections", "flight.detections", true},
+           {"--record-images", "flight.record_images", false},
+           {"--truth-box", "flight.truth_box", true},
+           {"--zoom-in", "detector.zoom_in", false},
+           {"--flip-fusion", "detector.flip_fusion", false},
+           {"--coarse-pass", "detector.coarse_pass", false},
+           {"--windows", "windows.enabled", false},
+           {"--localizer-config", "processes.localizer_config", true},
+           {"--follower-config", "processes.follower_config", true},
+           {"--render-config", "processes.render_config", true},
+           {"--autopilot", "autopilot.kind", true},
+           {"--firmware", "autopilot.firmware", true},
+           {"--own-pose-error", "flight.own_pose_error", true},
+           {"--model-cfg", "detector.model_cfg", true},
+           {"--model-weights", "detector.model_weights", true},
+           {"--config-dir", "run.config_dir", true},
+           {"--bin-dir", "run.bin_dir", true},
+           {"--lcm-url", "run.lcm_url", true},
+       }) {
+    s_->keyed.push_back({f->get_option(flag), key, quote});
+  }
 #endif
 }
 
@@ -144,10 +208,21 @@ int LaunchVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
 #ifdef WINGMAN_WITH_SIM
   if (!*s_->fly) return -1;
   return run_verb("wingman fly", err, [&] {
-    FlyOptions o = s_->options;
     if (s_->render && s_->no_render) throw std::invalid_argument("--render and --no-render: give one");
-    if (s_->render) o.render = "on";
-    if (s_->no_render) o.render = "off";
+    // The flags given become the last --set layer: they win, and every value goes through the one loader.
+    common::ConfigSources sources = s_->sources;
+    for (const auto& k : s_->keyed) {
+      if (k.option->count() == 0) continue;
+      const std::string value = k.option->get_expected_min() == 0 ? "true" : k.option->as<std::string>();
+      sources.sets.push_back(k.key + "=" + (k.quote ? yaml_quoted(value) : value));
+    }
+    if (s_->render) sources.sets.push_back("flight.render=on");
+    if (s_->no_render) sources.sets.push_back("flight.render=off");
+    const FlyOptions o = common::load_options<FlyOptions>(sources);
+    if (s_->print_config) {
+      out << common::print_options(o, "wingman fly: the effective flight (from " + sources.describe() + ")");
+      return 0;
+    }
     return fly(plan_flight(o), out, err);
   });
 #else

@@ -13,8 +13,9 @@
 
 namespace wingman::tools {
 
-/// What `wingman fly` flies. Relative paths are taken from the working directory (tools/fly.sh runs it from the
-/// checkout's root).
+/// What `wingman fly` flies: a flight as data. Read from layered files and `--set` (the one loader in common, keys
+/// below) with the command line's flags over them; `wingman fly --print-config` shows the result. Relative paths are
+/// taken from the working directory (tools/fly.sh runs it from the checkout's root).
 struct FlyOptions {
   std::string scenario = "formation_2d";  ///< a file, else the name of `config_dir`/scenarios/NAME.yaml
   std::string out;                        ///< output folder ("" = build/flights/NAME)
@@ -23,23 +24,50 @@ struct FlyOptions {
   std::string render = "auto";            ///< auto (render with cnn, not with truth), on or off
   bool record_images = false;             ///< also record IMAGE_* (2.7 MB per 1280x720 frame)
   std::string truth_box = "sphere";       ///< ground-truth boxes: sphere (the localizer's model) or silhouette
+  std::string own_pose_error;             ///< "M,RAD[,TAU]": the own pose's drifting error ("" = none)
+  std::string autopilot = "lcm";          ///< lcm (the simulator takes SETPOINT) or mavlink (through wingman-mavlink)
+  std::string firmware = "px4";           ///< with mavlink: px4 or ardupilot
   bool zoom_in = false;                   ///< detector: re-detect each box in a full-resolution crop
   bool flip_fusion = false;               ///< detector: also the mirrored frame, boxes fused
   bool coarse_pass = false;               ///< detector: also half the network input, large boxes fused
+  std::string model_cfg;                  ///< the detector's network ("" = builtin, or beside model_weights)
+  std::string model_weights;              ///< its weights ("" = builtin:wingman-small)
   bool windows = false;                   ///< tracker-driven windows (localizer publishes, detector searches)
   std::string localizer_config;           ///< "" = config_dir/flights/NAME.localizer.yaml if any, else the defaults
   std::string follower_config;            ///< "" = config_dir/flights/NAME.follower_ctrl.yaml if any, else the defaults
   std::string render_config;              ///< the simulator's render.* keys from this file ("" = its defaults)
-  std::string autopilot = "lcm";          ///< lcm (the simulator takes SETPOINT) or mavlink (through wingman-mavlink)
-  std::string firmware = "px4";           ///< with mavlink: px4 or ardupilot
-  std::string own_pose_error;             ///< "M,RAD[,TAU]": the own pose's drifting error ("" = none)
-  std::string model_cfg;              ///< the detector's network ("" = builtin:wingman-small, or beside model_weights)
-  std::string model_weights;          ///< its weights ("" = builtin:wingman-small)
-  std::string config_dir = "config";  ///< the checkout's config/ (scenarios, flights, mavlink_bridge.sim.yaml)
-  std::string bin_dir;                ///< the executables ("" = the folder of the running wingman)
-  std::string lcm_url;                ///< the bus ("" = $WINGMAN_LCM_URL, set by tools/netns_run.sh)
+  std::string config_dir = "config";      ///< the checkout's config/ (scenarios, flights, mavlink_bridge.sim.yaml)
+  std::string bin_dir;                    ///< the executables ("" = the folder of the running wingman)
+  std::string lcm_url;                    ///< the bus ("" = $WINGMAN_LCM_URL, set by tools/netns_run.sh)
 
-  /// Every problem with the values alone, one line each ("--detections 'x': expected cnn or truth").
+  template <class V>
+  void visit(V& v) {
+    v("flight.scenario", scenario, "config/scenarios/NAME.yaml (under run.config_dir) or a scenario file");
+    v("flight.out", out, "output folder; \"\" = build/flights/NAME");
+    v("flight.duration_s", duration_s, "simulated seconds to fly; 0 = the scenario's own length");
+    v("flight.detections", detections, "cnn (the detector's model in rendered images) or truth (ground truth)");
+    v("flight.render", render, "auto (with cnn), on or off");
+    v("flight.record_images", record_images, "also record the camera images (2.7 MB a 1280x720 frame)");
+    v("flight.truth_box", truth_box, "ground-truth boxes: sphere (the localizer's model) or silhouette");
+    v("flight.own_pose_error", own_pose_error, "M,RAD[,TAU]: the reported pose's drifting error; \"\" = exact");
+    v("autopilot.kind", autopilot, "lcm (SETPOINT/OWN_POSE) or mavlink (the simulator as a MAVLink vehicle)");
+    v("autopilot.firmware", firmware, "with mavlink: px4 or ardupilot");
+    v("detector.zoom_in", zoom_in, "re-detect each box in a full-resolution crop");
+    v("detector.flip_fusion", flip_fusion, "also detect in the mirrored frame and fuse");
+    v("detector.coarse_pass", coarse_pass, "also detect at half the network input (close drones)");
+    v("detector.model_cfg", model_cfg, "the network; \"\" = beside model_weights, or the built-in shipped model");
+    v("detector.model_weights", model_weights, "the weights; \"\" = the built-in shipped model");
+    v("windows.enabled", windows, "tracker-driven windows (localizer publishes, detector searches)");
+    v("processes.localizer_config", localizer_config,
+      "\"\" = config/flights/NAME.localizer.yaml if any, else the localizer's defaults");
+    v("processes.follower_config", follower_config,
+      "\"\" = config/flights/NAME.follower_ctrl.yaml if any, else the follower's defaults");
+    v("processes.render_config", render_config, "the simulator's render.* keys from this file; \"\" = its defaults");
+    v("run.config_dir", config_dir, "the checkout's config folder (scenarios, flights, MAVLink bridge)");
+    v("run.bin_dir", bin_dir, "the executables; \"\" = the folder of this wingman");
+    v("run.lcm_url", lcm_url, "the LCM bus; \"\" = $WINGMAN_LCM_URL (tools/netns_run.sh sets it)");
+  }
+  /// Every problem with the values alone, one line each ("flight.detections = 'x': must be cnn or truth").
   std::vector<std::string> validate() const;
 };
 

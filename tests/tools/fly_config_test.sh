@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# `wingman fly --config FILE --set KEY=VALUE` with flags: a flight as data through the one loader, the flags given
+# winning over the files and --set, every bad key at once (exit 2). Nothing flies (--print-config).
+# Usage: fly_config_test.sh WINGMAN
+set -euo pipefail
+wingman="$1"
+fail() { echo "fly_config_test: FAIL: $*" >&2; exit 1; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+printf 'flight:\n  scenario: follow_1d\n  duration_s: 12\nautopilot:\n  kind: mavlink\n' > "$tmp/flight.yaml"
+out=$("$wingman" fly --config "$tmp/flight.yaml" --set flight.duration_s=20 --duration 5 --windows \
+      --out "$tmp/dir with \"quote\"" --print-config)
+grep -q '^  scenario: "follow_1d"$' <<<"$out" || fail "the file's scenario: $out"
+grep -q '^  duration_s: 5.0$' <<<"$out" || fail "--duration over --set over the file: $out"
+grep -q '^  kind: "mavlink"$' <<<"$out" || fail "the file's autopilot: $out"
+grep -q '^  enabled: true$' <<<"$out" || fail "--windows: $out"
+grep -Fq "out: \"$tmp/dir with \\\"quote\\\"\"" <<<"$out" || fail "a path with a space and quotes read back as given: $out"
+# The effective flight, printed, is a flight file that gives the same flight.
+"$wingman" fly --config "$tmp/flight.yaml" --duration 5 --print-config > "$tmp/printed.yaml"
+"$wingman" fly --config "$tmp/printed.yaml" --print-config | tail -n +2 > "$tmp/again.yaml"
+diff <(tail -n +2 "$tmp/printed.yaml") "$tmp/again.yaml" || fail "a printed flight read back differs"
+# Every bad key at once, naming the file and line; exit 2.
+printf 'flight:\n  duraton_s: 3\n  detections: radar\n' > "$tmp/bad.yaml"
+rc=0
+err=$("$wingman" fly --config "$tmp/bad.yaml" --set windows.enabeld=true --print-config 2>&1) || rc=$?
+[ "$rc" = 2 ] || fail "a bad flight file: exit $rc, expected 2 ($err)"
+for want in "bad.yaml:2: flight.duraton_s: unknown key" "--set windows.enabeld: unknown key" \
+            "flight.detections = 'radar': must be cnn or truth"; do
+  grep -Fq -e "$want" <<<"$err" || fail "missing '$want' in: $err"
+done
+echo "fly_config_test: ok"
