@@ -100,15 +100,15 @@ static_sweep() {
   local scn; scn=$(scenario_variant "$out/scenario" static_sweep "vehicles.camera.motion.frames_per_step=$fps")
   # The bounding sphere's own radius (the default quad's) and ratio 1 (no box relation), so that the sweep measures
   # the boxes' raw range scale.
-  printf 'target: {radius_m: 0.348, box_relation: sphere}\n' > "$out/sphere.localizer.yaml"
-  fly "$out/single" --scenario "$scn" --localizer-config "$out/sphere.localizer.yaml"
-  fly "$out/zoom" --scenario "$scn" --zoom-in --localizer-config "$out/sphere.localizer.yaml"
+  local sphere=(--localizer-set target.radius_m=0.348 --localizer-set target.box_relation=sphere)
+  fly "$out/single" --scenario "$scn" "${sphere[@]}"
+  fly "$out/zoom" --scenario "$scn" --zoom-in "${sphere[@]}"
   # The same sweep with the drone turned 90 degrees, seen from behind as a follower sees its leader (single pass): the
   # boxes' width, and so the range scale, depends on the view (models/wingman-small.boxes.yaml tabulates it by the
   # box's aspect).
   local behind; behind=$(scenario_variant "$out/scenario-behind" static_sweep "vehicles.camera.motion.frames_per_step=$fps" \
     "vehicles.target.initial.yaw_deg=90")
-  fly "$out/behind" --scenario "$behind" --localizer-config "$out/sphere.localizer.yaml"
+  fly "$out/behind" --scenario "$behind" "${sphere[@]}"
   py static_sweep "$out" "$out/single/eval.json" "$out/zoom/eval.json" "$out/behind/eval.json"
 }
 
@@ -128,12 +128,11 @@ distance() {
   local out="$out_root/distance" dur=10; $quick && dur=4
   rm -rf "$out"; mkdir -p "$out"
   # Unfiltered: the newest measurement of the track (a sliding window of one); filtered: the thesis's window of 5.
-  printf 'tracker: {mode: sliding_window, window_size: 1}\n' > "$out/raw.localizer.yaml"
-  printf 'tracker: {mode: sliding_window, window_size: 5}\n' > "$out/window5.localizer.yaml"
-  fly "$out/single" --scenario fast_target --duration "$dur" --localizer-config "$out/raw.localizer.yaml"
-  fly "$out/zoom" --scenario fast_target --duration "$dur" --zoom-in --localizer-config "$out/raw.localizer.yaml"
-  fly "$out/zoom_window5" --scenario fast_target --duration "$dur" --zoom-in \
-    --localizer-config "$out/window5.localizer.yaml"
+  local raw=(--localizer-set tracker.mode=sliding_window --localizer-set tracker.window_size=1)
+  local window5=(--localizer-set tracker.mode=sliding_window --localizer-set tracker.window_size=5)
+  fly "$out/single" --scenario fast_target --duration "$dur" "${raw[@]}"
+  fly "$out/zoom" --scenario fast_target --duration "$dur" --zoom-in "${raw[@]}"
+  fly "$out/zoom_window5" --scenario fast_target --duration "$dur" --zoom-in "${window5[@]}"
   fly "$out/zoom_kalman" --scenario fast_target --duration "$dur" --zoom-in
   py distance "$out" "$out/single/eval.json" "$out/zoom/eval.json" "$out/zoom_window5/eval.json" \
     "$out/zoom_kalman/eval.json"

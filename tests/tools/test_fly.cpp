@@ -157,6 +157,26 @@ TEST(FlyPlan, AFlightsOwnConfigurationIsUsedAndEvalMeasuresAgainstIt) {
   EXPECT_EQ(plan_flight(o).eval_target.follower.files.at(0), fs::weakly_canonical(dir.file("f.yaml")).string());
 }
 
+TEST(FlyPlan, EachProcessesSetsFollowItsConfigurationAndEvalMeasuresAgainstTheFollowers) {
+  FlyOptions o = options_for_tests();
+  o.scenario = "follow_1d";  // with config/flights/follow_1d.follower_ctrl.yaml
+  o.localizer_sets = {"tracker.window_size=1"};
+  o.follower_sets = {"formation.offset_m=[0, -5, 0]"};
+  o.detector_sets = {"detection.p_thresh=0.3"};
+  const FlightPlan plan = plan_flight(o);
+  EXPECT_EQ(value_of(plan.pipeline[1].argv, "--set", "tracker."), "tracker.window_size=1");
+  const auto& follower = plan.pipeline[2].argv;
+  ASSERT_EQ(value_of(follower, "--set", "formation."), "formation.offset_m=[0, -5, 0]");
+  // After the flight's file: a --set wins over it.
+  EXPECT_LT(std::find(follower.begin(), follower.end(), "--config") - follower.begin(),
+            std::find(follower.begin(), follower.end(), "formation.offset_m=[0, -5, 0]") - follower.begin());
+  EXPECT_EQ(plan.eval_target.follower.sets, o.follower_sets);
+  // The detector's own sets come after the flight's (model, passes), so they win.
+  const auto& det = plan.pipeline[0].argv;
+  EXPECT_LT(std::find(det.begin(), det.end(), "windows.enabled=false") - det.begin(),
+            std::find(det.begin(), det.end(), "detection.p_thresh=0.3") - det.begin());
+}
+
 TEST(FlyPlan, TheOwnPoseErrorBecomesTheSimulatorsKeys) {
   FlyOptions o = options_for_tests();
   o.own_pose_error = "0.3,0.01";

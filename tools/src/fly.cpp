@@ -223,13 +223,16 @@ FlightPlan plan_flight(const FlyOptions& o) {
   } else {
     append(detector.argv, {"--set", "model.weights=\"\""});
   }
+  for (const auto& kv : o.detector_sets) append(detector.argv, {"--set", kv});
   append(detector.argv, {"--log-level", "warn"});
   launcher::ProcessSpec localizer = process("wingman-localizer", {exe("wingman-localizer"), "--lcm-url", url});
   if (!localizer_config.empty()) append(localizer.argv, {"--config", localizer_config});
   if (o.windows) append(localizer.argv, {"--set", "windows.publish=true"});
+  for (const auto& kv : o.localizer_sets) append(localizer.argv, {"--set", kv});
   append(localizer.argv, {"--log-level", "warn"});
   launcher::ProcessSpec follower = process("wingman-follower-ctrl", {exe("wingman-follower-ctrl"), "--lcm-url", url});
   if (!follower_config.empty()) append(follower.argv, {"--config", follower_config});
+  for (const auto& kv : o.follower_sets) append(follower.argv, {"--set", kv});
   append(follower.argv, {"--log-level", "warn"});
   plan.pipeline = {detector, localizer, follower};
   if (mavlink) {
@@ -255,6 +258,7 @@ FlightPlan plan_flight(const FlyOptions& o) {
   plan.eval.title = "Wingman flight: " + plan.name;
   plan.eval_target.scenario = plan.scenario_file;
   if (!follower_config.empty()) plan.eval_target.follower.files = {follower_config};
+  plan.eval_target.follower.sets = o.follower_sets;
   return plan;
 }
 

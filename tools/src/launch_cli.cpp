@@ -160,6 +160,16 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   f->add_option("--config-dir", o.config_dir, "The checkout's config folder (scenarios, flights, MAVLink bridge)");
   f->add_option("--bin-dir", o.bin_dir, "The executables (empty: the folder of this wingman)");
   f->add_option("--lcm-url", o.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+  f->add_option("--localizer-set", o.localizer_sets, "KEY=VALUE over the localizer's configuration (repeatable)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  f->add_option("--follower-set", o.follower_sets,
+                "KEY=VALUE over the follower's configuration (repeatable; the formation error follows it)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  f->add_option("--detector-set", o.detector_sets, "KEY=VALUE over the detector's configuration (repeatable)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
   // A flight as data: the one loader's layers (defaults, --config files, --set), and the flags given over them.
   f->add_option("--config", s_->sources.files,
                 "A flight file (FlyOptions' keys, as --print-config shows them; repeatable, a later file wins); the "
@@ -189,6 +199,9 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
            {"--own-pose-error", "flight.own_pose_error", true},
            {"--model-cfg", "detector.model_cfg", true},
            {"--model-weights", "detector.model_weights", true},
+           {"--localizer-set", "processes.localizer_set", true},
+           {"--follower-set", "processes.follower_set", true},
+           {"--detector-set", "processes.detector_set", true},
            {"--config-dir", "run.config_dir", true},
            {"--bin-dir", "run.bin_dir", true},
            {"--lcm-url", "run.lcm_url", true},
@@ -213,6 +226,13 @@ int LaunchVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     common::ConfigSources sources = s_->sources;
     for (const auto& k : s_->keyed) {
       if (k.option->count() == 0) continue;
+      if (k.option->get_expected_max() > 1) {  // a list: a YAML flow sequence of quoted items
+        std::string list;
+        for (const auto& item : k.option->as<std::vector<std::string>>())
+          list += (list.empty() ? "" : ", ") + yaml_quoted(item);
+        sources.sets.push_back(k.key + "=[" + list + "]");
+        continue;
+      }
       const std::string value = k.option->get_expected_min() == 0 ? "true" : k.option->as<std::string>();
       sources.sets.push_back(k.key + "=" + (k.quote ? yaml_quoted(value) : value));
     }

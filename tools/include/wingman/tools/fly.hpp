@@ -36,9 +36,12 @@ struct FlyOptions {
   std::string localizer_config;           ///< "" = config_dir/flights/NAME.localizer.yaml if any, else the defaults
   std::string follower_config;            ///< "" = config_dir/flights/NAME.follower_ctrl.yaml if any, else the defaults
   std::string render_config;              ///< the simulator's render.* keys from this file ("" = its defaults)
-  std::string config_dir = "config";      ///< the checkout's config/ (scenarios, flights, mavlink_bridge.sim.yaml)
-  std::string bin_dir;                    ///< the executables ("" = the folder of the running wingman)
-  std::string lcm_url;                    ///< the bus ("" = $WINGMAN_LCM_URL, set by tools/netns_run.sh)
+  std::vector<std::string> localizer_sets;  ///< KEY=VALUE over the localizer's configuration (its --set)
+  std::vector<std::string> follower_sets;   ///< KEY=VALUE over the follower's (its --set; eval measures against it)
+  std::vector<std::string> detector_sets;   ///< KEY=VALUE over the detector's (its --set, after the flight's own)
+  std::string config_dir = "config";        ///< the checkout's config/ (scenarios, flights, mavlink_bridge.sim.yaml)
+  std::string bin_dir;                      ///< the executables ("" = the folder of the running wingman)
+  std::string lcm_url;                      ///< the bus ("" = $WINGMAN_LCM_URL, set by tools/netns_run.sh)
 
   template <class V>
   void visit(V& v) {
@@ -63,6 +66,10 @@ struct FlyOptions {
     v("processes.follower_config", follower_config,
       "\"\" = config/flights/NAME.follower_ctrl.yaml if any, else the follower's defaults");
     v("processes.render_config", render_config, "the simulator's render.* keys from this file; \"\" = its defaults");
+    v("processes.localizer_set", localizer_sets, "KEY=VALUE over the localizer's configuration (its --set)");
+    v("processes.follower_set", follower_sets,
+      "KEY=VALUE over the follower's configuration (its --set; the formation error follows it)");
+    v("processes.detector_set", detector_sets, "KEY=VALUE over the detector's configuration (its --set)");
     v("run.config_dir", config_dir, "the checkout's config folder (scenarios, flights, MAVLink bridge)");
     v("run.bin_dir", bin_dir, "the executables; \"\" = the folder of this wingman");
     v("run.lcm_url", lcm_url, "the LCM bus; \"\" = $WINGMAN_LCM_URL (tools/netns_run.sh sets it)");
