@@ -33,7 +33,7 @@ VehicleCommand command_from_setpoint(const wingman::setpoint_t& sp) {
     case wingman::setpoint_t::MODE_POSITION:
       c.mode = VehicleCommand::Mode::kPosition;
       c.p_ref_in_world = to_enu(sp.position, ned);
-      c.yaw_ref_rad = ned ? M_PI / 2 - sp.yaw : sp.yaw;
+      c.yaw_ref_rad = ned ? geometry::swap_ned_enu_yaw(sp.yaw) : sp.yaw;
       break;
     case wingman::setpoint_t::MODE_VELOCITY:
       c.mode = VehicleCommand::Mode::kVelocity;
