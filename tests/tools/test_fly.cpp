@@ -171,6 +171,11 @@ TEST(FlyPlan, EachProcessesSetsFollowItsConfigurationAndEvalMeasuresAgainstTheFo
   EXPECT_LT(std::find(follower.begin(), follower.end(), "--config") - follower.begin(),
             std::find(follower.begin(), follower.end(), "formation.offset_m=[0, -5, 0]") - follower.begin());
   EXPECT_EQ(plan.eval_target.follower.sets, o.follower_sets);
+  EXPECT_TRUE(plan.eval.has_formation);  // pid_1d: the leader's start moved to the follower's line
+  EXPECT_EQ(plan.eval.formation_offset_in_world, Eigen::Vector3d(0, -8, 0));
+  // A follower key that its loader refuses fails the plan, before anything flies.
+  o.follower_sets = {"formation.offset_mm=[0, -5, 0]"};
+  EXPECT_NE(error_of(o).find("formation.offset_mm"), std::string::npos) << error_of(o);
   // The detector's own sets come after the flight's (model, passes), so they win.
   const auto& det = plan.pipeline[0].argv;
   EXPECT_LT(std::find(det.begin(), det.end(), "windows.enabled=false") - det.begin(),

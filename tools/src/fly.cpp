@@ -259,6 +259,10 @@ FlightPlan plan_flight(const FlyOptions& o) {
   plan.eval_target.scenario = plan.scenario_file;
   if (!follower_config.empty()) plan.eval_target.follower.files = {follower_config};
   plan.eval_target.follower.sets = o.follower_sets;
+  // What the formation error is measured against, known before the flight (a bad follower key fails here).
+  plan.eval.formation_offset_in_world =
+      formation_offset_for(plan.eval_target, plan.eval.follower_id, plan.eval.leader_id);
+  plan.eval.has_formation = true;
   return plan;
 }
 
@@ -281,8 +285,10 @@ int fly(const FlightPlan& plan, std::ostream& out, std::ostream& err) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t sim = group.start(plan.sim);
 
-  // The flight: until the simulator ends. A pipeline process that ends first (or a stop signal) ends the flight.
+  // The flight: until the simulator ends. A pipeline process or the logger that ends first (or a stop signal) ends
+  // the flight.
   std::vector<size_t> watched = pipeline;
+  watched.push_back(logger);
   watched.push_back(sim);
   const std::optional<size_t> ended = group.wait_any(watched, [&] { return signals.requested(); });
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -310,8 +316,6 @@ int fly(const FlightPlan& plan, std::ostream& out, std::ostream& err) {
   out << "\nfly: " << plan.name << " flown in " << static_cast<int>(wall_s)
       << " s of wall-clock time; errors against ground truth:" << std::endl;
   EvalOptions eval = plan.eval;
-  eval.formation_offset_in_world = formation_offset_for(plan.eval_target, eval.follower_id, eval.leader_id);
-  eval.has_formation = true;
   eval.progress = &err;
   const EvalResult result = evaluate_log(eval);
   write_html_report(result, eval, eval.report_path);

@@ -89,7 +89,7 @@ struct FlightPlan {
   std::vector<launcher::ProcessSpec> pipeline;  ///< detector, localizer, follower [, wingman-mavlink], in start order
   launcher::ProcessSpec sim_print_config;       ///< the simulator's effective configuration into out_dir/sim.yaml
   launcher::ProcessSpec sim;                    ///< the flight itself; it ends the flight
-  EvalOptions eval;                             ///< how the log is scored afterwards
+  EvalOptions eval;                             ///< how the log is scored (formation offset from eval_target)
   FlightTargetSources eval_target;              ///< the follower configuration and scenario eval measures against
 };
 
@@ -98,10 +98,11 @@ struct FlightPlan {
 /// or file and what was expected. Reads files; starts nothing.
 FlightPlan plan_flight(const FlyOptions& o);
 
-/// Flies `plan`: starts the logger, the pipeline and the simulator, waits for the simulator (a pipeline process that
-/// ends first fails the flight, named), stops the pipeline and then the logger, and scores the log (`wingman eval`'s
-/// table on `out`, its HTML report, JSON and CSV in out_dir). SIGINT/SIGTERM stop the flight cleanly. Returns the exit
-/// code: 0, the simulator's code when it failed, 1 when a pipeline process ended early, 130 when interrupted.
+/// Flies `plan`: starts the logger, the pipeline and the simulator, waits for the simulator (a pipeline process or the
+/// logger that ends first fails the flight, named), stops the pipeline and then the logger, and scores the log
+/// (`wingman eval`'s table on `out`, its HTML report, JSON and CSV in out_dir). SIGINT/SIGTERM stop the flight cleanly.
+/// Returns the exit code: 0, the simulator's code when it failed, 1 when a pipeline process ended early, 130 when
+/// interrupted.
 int fly(const FlightPlan& plan, std::ostream& out, std::ostream& err);
 
 }  // namespace wingman::tools
