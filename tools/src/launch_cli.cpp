@@ -13,6 +13,7 @@
 #include <wingman/common/config.hpp>
 
 #include <initializer_list>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -207,6 +208,15 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
            {"--lcm-url", "run.lcm_url", true},
        }) {
     s_->keyed.push_back({f->get_option(flag), key, quote});
+  }
+  // Every flag of the flight has its key (a flag without one would be parsed and then ignored).
+  for (const CLI::Option* opt : f->get_options()) {
+    const std::string name = opt->get_name();
+    bool known = name == "--help" || name == "--config" || name == "--set" || name == "--print-config" ||
+                 name == "--render" || name == "--no-render";
+    for (const auto& k : s_->keyed) known = known || k.option == opt;
+    if (!known)
+      throw std::logic_error("wingman fly: the flag " + name + " has no flight key (tools/src/launch_cli.cpp)");
   }
 #endif
 }
