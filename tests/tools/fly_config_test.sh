@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # `wingman fly --config FILE --set KEY=VALUE` with flags: a flight as data through the one loader, the flags given
-# winning over the files and --set, every bad key at once (exit 2). Nothing flies (--print-config).
+# winning over the files and --set, every bad key at once (exit 2). Nothing flies (--print-config). The same layers for
+# `wingman load` and `wingman demo-camera`.
 # Usage: fly_config_test.sh WINGMAN
 set -euo pipefail
 wingman="$1"
@@ -28,4 +29,15 @@ for want in "bad.yaml:2: flight.duraton_s: unknown key" "--set windows.enabeld: 
             "flight.detections = 'radar': must be cnn or truth"; do
   grep -Fq -e "$want" <<<"$err" || fail "missing '$want' in: $err"
 done
+# The other launching verbs take the same layers.
+printf 'load:\n  cameras: 2\n  mode: replay\n' > "$tmp/load.yaml"
+out=$("$wingman" load --config "$tmp/load.yaml" --replay-frames 3 --print-config)
+grep -q '^  cameras: 2$' <<<"$out" && grep -q '^  mode: "replay"$' <<<"$out" && grep -q '^  replay_frames: 3$' <<<"$out" ||
+  fail "wingman load's layers: $out"
+rc=0
+err=$("$wingman" load --set load.camera=2 --cameras 9 --print-config 2>&1) || rc=$?
+[ "$rc" = 2 ] || fail "wingman load with a bad key and a bad flag: exit $rc ($err)"
+printf 'demo:\n  video: clip.avi\n' > "$tmp/demo.yaml"
+out=$("$wingman" demo-camera --config "$tmp/demo.yaml" --print-config)
+grep -q '^  video: "clip.avi"$' <<<"$out" || fail "wingman demo-camera's layers: $out"
 echo "fly_config_test: ok"

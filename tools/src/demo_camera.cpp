@@ -8,6 +8,7 @@
 #include "wingman/tools/log_info.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/config.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -28,10 +29,11 @@ const char* kDetectionsChannel = "DETECTIONS_CAM0";
 
 std::vector<std::string> DemoCameraOptions::validate() const {
   std::vector<std::string> p;
-  if (video.empty()) p.push_back("video: expected a video file");
-  if (!(start_timeout_s > 0.0)) p.push_back(fmt::format("--start-timeout {}: expected seconds > 0", start_timeout_s));
+  if (video.empty()) p.push_back(common::problem("demo.video", video, "must name the video to play (VIDEO)"));
+  if (!(start_timeout_s > 0.0))
+    p.push_back(common::problem("demo.start_timeout_s", start_timeout_s, "must be > 0 seconds (--start-timeout)"));
   if (!(settle_timeout_s > 0.0))
-    p.push_back(fmt::format("--settle-timeout {}: expected seconds > 0", settle_timeout_s));
+    p.push_back(common::problem("demo.settle_timeout_s", settle_timeout_s, "must be > 0 seconds (--settle-timeout)"));
   return p;
 }
 

@@ -4,6 +4,7 @@
 #include "wingman/tools/launch_cli.hpp"
 
 #include "run_verb.hpp"
+#include "verb_layers.hpp"
 #include "wingman/tools/demo_camera.hpp"
 #include "wingman/tools/load.hpp"
 #ifdef WINGMAN_WITH_SIM
@@ -22,37 +23,18 @@
 
 namespace wingman::tools {
 
-namespace {
-
-/// `text` as a double-quoted YAML scalar (backslashes and quotes escaped), so any path or text is read back as is.
-[[maybe_unused]] std::string yaml_quoted(const std::string& text) {
-  std::string q = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') q += '\\';
-    q += c;
-  }
-  return q + "\"";
-}
-
-}  // namespace
-
 struct LaunchVerbs::State {
   CLI::App* demo = nullptr;
-  DemoCameraOptions demo_options;
+  DemoCameraOptions demo_options;  // what the flags say (only the flags given count: VerbLayers)
+  std::unique_ptr<VerbLayers> demo_layers;
   CLI::App* load = nullptr;
   LoadOptions load_options;
+  std::unique_ptr<VerbLayers> load_layers;
 #ifdef WINGMAN_WITH_SIM
   CLI::App* fly = nullptr;
-  FlyOptions options;  // what the flags say (only the flags given count)
-  bool render = false, no_render = false, print_config = false;
-  common::ConfigSources sources;  // --config FILE..., --set KEY=VALUE...
-  /// Each flag with its key; `quote`: its value is text (a YAML string), else a number or a switch.
-  struct Keyed {
-    CLI::Option* option;
-    std::string key;
-    bool quote;
-  };
-  std::vector<Keyed> keyed;
+  FlyOptions options;
+  bool render = false, no_render = false;
+  std::unique_ptr<VerbLayers> fly_layers;
 #endif
 };
 
@@ -63,7 +45,7 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       "Play a video through wingman-camera-driver into the running pipeline (detector, localizer, follower: their "
       "built-in defaults) on the LCM bus, record the bus and show what arrived. Run it in a private network namespace "
       "(tools/demo_camera.sh does)");
-  s_->demo->add_option("video", d.video, "The clip to play once at its own rate")->required();
+  s_->demo->add_option("video", d.video, "The clip to play once at its own rate (or demo.video)");
   s_->demo->add_option("--out", d.out, "Output folder: demo.lcmlog, last_frame.png");
   s_->demo->add_option("--start-timeout", d.start_timeout_s,
                        "Seconds to wait for every pipeline process's first heartbeat");
@@ -71,6 +53,18 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                        "Seconds to wait after the clip for the detector to account for every frame");
   s_->demo->add_option("--bin-dir", d.bin_dir, "The executables (empty: the folder of this wingman)");
   s_->demo->add_option("--lcm-url", d.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+  s_->demo_layers = std::make_unique<VerbLayers>(s_->demo);
+  for (const auto& [flag, key, quote] : std::initializer_list<std::tuple<const char*, const char*, bool>>{
+           {"video", "demo.video", true},
+           {"--out", "demo.out", true},
+           {"--start-timeout", "demo.start_timeout_s", false},
+           {"--settle-timeout", "demo.settle_timeout_s", false},
+           {"--bin-dir", "run.bin_dir", true},
+           {"--lcm-url", "run.lcm_url", true},
+       }) {
+    s_->demo_layers->key(flag, key, quote);
+  }
+  s_->demo_layers->check_every_flag({});
   LoadOptions& l = s_->load_options;
   auto* ld = s_->load = app.add_subcommand(
       "load",
@@ -105,6 +99,26 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   ld->add_option("--summary-script", l.summary_script, "The figures and checks (Python, the generated LCM types)");
   ld->add_option("--bin-dir", l.bin_dir, "The executables (empty: the folder of this wingman)");
   ld->add_option("--lcm-url", l.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+  s_->load_layers = std::make_unique<VerbLayers>(ld);
+  for (const auto& [flag, key, quote] : std::initializer_list<std::tuple<const char*, const char*, bool>>{
+           {"--mode", "load.mode", true},
+           {"--duration", "load.duration_s", false},
+           {"--out", "load.out", true},
+           {"--cameras", "load.cameras", false},
+           {"--soak", "load.soak", false},
+           {"--warmup", "load.warmup_s", false},
+           {"--sample-period", "load.sample_period_s", false},
+           {"--replay-frames", "load.replay_frames", false},
+           {"--max-p99-s", "checks.max_p99_s", false},
+           {"--max-rss-growth-pct", "checks.max_rss_growth_pct", false},
+           {"--report-only", "checks.report_only", false},
+           {"--summary-script", "run.summary_script", true},
+           {"--bin-dir", "run.bin_dir", true},
+           {"--lcm-url", "run.lcm_url", true},
+       }) {
+    s_->load_layers->key(flag, key, quote);
+  }
+  s_->load_layers->check_every_flag({});
 #ifdef WINGMAN_WITH_SIM
   FlyOptions& o = s_->options;
   auto* f = s_->fly = app.add_subcommand(
@@ -172,15 +186,7 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
   // A flight as data: the one loader's layers (defaults, --config files, --set), and the flags given over them.
-  f->add_option("--config", s_->sources.files,
-                "A flight file (FlyOptions' keys, as --print-config shows them; repeatable, a later file wins); the "
-                "flags given on the command line win over it")
-      ->allow_extra_args(false)
-      ->type_name("FILE");
-  f->add_option("--set", s_->sources.sets, "KEY=VALUE over the --config files (repeatable), e.g. flight.duration_s=30")
-      ->allow_extra_args(false)
-      ->type_name("KEY=VALUE");
-  f->add_flag("--print-config", s_->print_config, "Print the effective flight (files, --set and flags) and exit");
+  s_->fly_layers = std::make_unique<VerbLayers>(f);
   for (const auto& [flag, key, quote] : std::initializer_list<std::tuple<const char*, const char*, bool>>{
            {"--scenario", "flight.scenario", true},
            {"--out", "flight.out", true},
@@ -207,17 +213,9 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
            {"--bin-dir", "run.bin_dir", true},
            {"--lcm-url", "run.lcm_url", true},
        }) {
-    s_->keyed.push_back({f->get_option(flag), key, quote});
+    s_->fly_layers->key(flag, key, quote);
   }
-  // Every flag of the flight has its key (a flag without one would be parsed and then ignored).
-  for (const CLI::Option* opt : f->get_options()) {
-    const std::string name = opt->get_name();
-    bool known = name == "--help" || name == "--config" || name == "--set" || name == "--print-config" ||
-                 name == "--render" || name == "--no-render";
-    for (const auto& k : s_->keyed) known = known || k.option == opt;
-    if (!known)
-      throw std::logic_error("wingman fly: the flag " + name + " has no flight key (tools/src/launch_cli.cpp)");
-  }
+  s_->fly_layers->check_every_flag({"--render", "--no-render"});  // flight.render, from both
 #endif
 }
 
@@ -225,34 +223,30 @@ LaunchVerbs::~LaunchVerbs() = default;
 
 int LaunchVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   if (*s_->demo) {
-    return run_verb("wingman demo-camera", err, [&] { return run_demo_camera(s_->demo_options, out, err); });
+    return run_verb("wingman demo-camera", err, [&] {
+      bool printed = false;
+      const auto o = s_->demo_layers->load<DemoCameraOptions>(out, &printed);
+      return printed ? 0 : run_demo_camera(o, out, err);
+    });
   }
-  if (*s_->load) return run_verb("wingman load", err, [&] { return run_load(s_->load_options, out, err); });
+  if (*s_->load) {
+    return run_verb("wingman load", err, [&] {
+      bool printed = false;
+      const auto o = s_->load_layers->load<LoadOptions>(out, &printed);
+      return printed ? 0 : run_load(o, out, err);
+    });
+  }
 #ifdef WINGMAN_WITH_SIM
   if (!*s_->fly) return -1;
   return run_verb("wingman fly", err, [&] {
     if (s_->render && s_->no_render) throw std::invalid_argument("--render and --no-render: give one");
-    // The flags given become the last --set layer: they win, and every value goes through the one loader.
-    common::ConfigSources sources = s_->sources;
-    for (const auto& k : s_->keyed) {
-      if (k.option->count() == 0) continue;
-      if (k.option->get_expected_max() > 1) {  // a list: a YAML flow sequence of quoted items
-        std::string list;
-        for (const auto& item : k.option->as<std::vector<std::string>>())
-          list += (list.empty() ? "" : ", ") + yaml_quoted(item);
-        sources.sets.push_back(k.key + "=[" + list + "]");
-        continue;
-      }
-      const std::string value = k.option->get_expected_min() == 0 ? "true" : k.option->as<std::string>();
-      sources.sets.push_back(k.key + "=" + (k.quote ? yaml_quoted(value) : value));
-    }
-    if (s_->render) sources.sets.push_back("flight.render=on");
-    if (s_->no_render) sources.sets.push_back("flight.render=off");
-    const FlyOptions o = common::load_options<FlyOptions>(sources);
-    if (s_->print_config) {
-      out << common::print_options(o, "wingman fly: the effective flight (from " + sources.describe() + ")");
-      return 0;
-    }
+    // The flags given become the last --set layer (they win); every value goes through the one loader.
+    std::vector<std::string> render;
+    if (s_->render) render.push_back("flight.render=on");
+    if (s_->no_render) render.push_back("flight.render=off");
+    bool printed = false;
+    const FlyOptions o = s_->fly_layers->load<FlyOptions>(out, &printed, render);
+    if (printed) return 0;
     return fly(plan_flight(o), out, err);
   });
 #else

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 #include <unistd.h>
+#include <wingman/common/config.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -109,21 +110,21 @@ double LoadOptions::effective_warmup_s() const {
 }
 
 std::vector<std::string> LoadOptions::validate() const {
+  using common::problem;
   std::vector<std::string> p;
-  if (mode != "realtime" && mode != "replay")
-    p.push_back(fmt::format("--mode '{}': expected realtime or replay", mode));
-  if (soak && mode == "replay") p.push_back("--soak runs in realtime mode; drop --mode replay");
-  if (cameras < 1 || cameras > 4) p.push_back(fmt::format("--cameras {}: expected 1..4", cameras));
-  if (!(duration_s >= 0.0)) p.push_back(fmt::format("--duration {}: expected seconds", duration_s));
-  if (!(warmup_s >= 0.0)) p.push_back(fmt::format("--warmup {}: expected seconds", warmup_s));
-  if (!(sample_period_s > 0.0)) p.push_back(fmt::format("--sample-period {}: expected seconds > 0", sample_period_s));
-  if (replay_frames < 1) p.push_back(fmt::format("--replay-frames {}: expected a positive integer", replay_frames));
-  if (!(max_p99_s > 0.0)) p.push_back(fmt::format("--max-p99-s {}: expected seconds > 0", max_p99_s));
+  if (mode != "realtime" && mode != "replay") p.push_back(problem("load.mode", mode, "must be realtime or replay"));
+  if (soak && mode == "replay") p.push_back(problem("load.soak", "true", "runs in realtime mode; drop --mode replay"));
+  if (cameras < 1 || cameras > 4) p.push_back(problem("load.cameras", cameras, "must be 1..4"));
+  if (!(duration_s >= 0.0)) p.push_back(problem("load.duration_s", duration_s, "must be >= 0 seconds"));
+  if (!(warmup_s >= 0.0)) p.push_back(problem("load.warmup_s", warmup_s, "must be >= 0 seconds"));
+  if (!(sample_period_s > 0.0)) p.push_back(problem("load.sample_period_s", sample_period_s, "must be > 0 seconds"));
+  if (replay_frames < 1) p.push_back(problem("load.replay_frames", replay_frames, "must be at least 1"));
+  if (!(max_p99_s > 0.0)) p.push_back(problem("checks.max_p99_s", max_p99_s, "must be > 0 seconds"));
   if (!(max_rss_growth_pct >= 0.0))
-    p.push_back(fmt::format("--max-rss-growth-pct {}: expected a percentage >= 0", max_rss_growth_pct));
+    p.push_back(problem("checks.max_rss_growth_pct", max_rss_growth_pct, "must be a percentage >= 0"));
   if (soak && effective_duration_s() < effective_warmup_s() + 20.0) {
-    p.push_back(fmt::format("--duration {}: a soak needs at least the warm-up ({} s) plus 20 s", effective_duration_s(),
-                            effective_warmup_s()));
+    p.push_back(problem("load.duration_s", effective_duration_s(),
+                        fmt::format("a soak needs at least the warm-up ({} s) plus 20 s", effective_warmup_s())));
   }
   return p;
 }

@@ -20,6 +20,15 @@ struct DemoCameraOptions {
   /// Wall seconds after the clip for the detector to account for every frame.
   double settle_timeout_s = 60.0;
 
+  template <class V>
+  void visit(V& v) {
+    v("demo.video", video, "the clip the camera driver plays once at its own rate");
+    v("demo.out", out, "output folder: demo.lcmlog, last_frame.png");
+    v("demo.start_timeout_s", start_timeout_s, "wall seconds for every pipeline process's first heartbeat");
+    v("demo.settle_timeout_s", settle_timeout_s, "wall seconds after the clip for the detector to settle");
+    v("run.bin_dir", bin_dir, "the executables; \"\" = the folder of this wingman");
+    v("run.lcm_url", lcm_url, "the bus; \"\" = $WINGMAN_LCM_URL (tools/netns_run.sh sets it)");
+  }
   /// Every problem with the values, one line each.
   std::vector<std::string> validate() const;
 };

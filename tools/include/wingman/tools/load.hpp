@@ -28,7 +28,24 @@ struct LoadOptions {
   std::string bin_dir;                                   ///< the executables ("" = the folder of the running wingman)
   std::string lcm_url;  ///< realtime's bus ("" = $WINGMAN_LCM_URL, set by tools/netns_run.sh)
 
-  /// Every problem with the values, one line each ("--cameras 5: expected 1..4").
+  template <class V>
+  void visit(V& v) {
+    v("load.mode", mode, "realtime (cameras paced at 30 fps) or replay (detectors file to file)");
+    v("load.duration_s", duration_s, "realtime: seconds the cameras play; 0 = 30, or 600 with soak");
+    v("load.out", out, "output folder; \"\" = build/load/MODE (build/load/soak with soak)");
+    v("load.cameras", cameras, "camera chains, 1..4");
+    v("load.soak", soak, "realtime, plus the RSS growth check and the latency trend");
+    v("load.warmup_s", warmup_s, "soak: seconds before RSS is the reference; 0 = 30 up to 180-s runs, else 60");
+    v("load.sample_period_s", sample_period_s, "seconds between RSS/CPU samples from /proc");
+    v("load.replay_frames", replay_frames, "replay: frames per camera");
+    v("checks.max_p99_s", max_p99_s, "realtime: bound on the end-to-end p99, seconds");
+    v("checks.max_rss_growth_pct", max_rss_growth_pct, "soak: bound on RSS growth after the warm-up, percent");
+    v("checks.report_only", report_only, "speed and memory bounds reported, not checked (frame accounting still is)");
+    v("run.summary_script", summary_script, "the figures and checks (Python, the generated LCM types)");
+    v("run.bin_dir", bin_dir, "the executables; \"\" = the folder of this wingman");
+    v("run.lcm_url", lcm_url, "realtime's bus; \"\" = $WINGMAN_LCM_URL (tools/netns_run.sh sets it)");
+  }
+  /// Every problem with the values, one line each ("load.cameras = 5: must be 1..4").
   std::vector<std::string> validate() const;
   /// duration_s and warmup_s with their defaults applied.
   double effective_duration_s() const;
