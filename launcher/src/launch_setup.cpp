@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
@@ -18,6 +19,29 @@ ProcessSpec process(std::string name, std::vector<std::string> argv) {
   spec.name = std::move(name);
   spec.argv = std::move(argv);
   return spec;
+}
+
+int run_in_foreground(const ProcessSpec& spec) {
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  struct sigaction old_int {};
+  struct sigaction old_quit {};
+  ::sigaction(SIGINT, &ignore, &old_int);
+  ::sigaction(SIGQUIT, &ignore, &old_quit);
+  const auto restore = [&] {
+    ::sigaction(SIGINT, &old_int, nullptr);
+    ::sigaction(SIGQUIT, &old_quit, nullptr);
+  };
+  try {
+    ProcessGroup group;
+    const int rc = group.run(spec);
+    restore();
+    return rc;
+  } catch (...) {
+    restore();
+    throw;
+  }
 }
 
 std::string executable_dir() {

@@ -24,17 +24,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// The argument as a shell would need it: bare when it holds only safe characters, else in single quotes.
-std::string shell_word(const std::string& word) {
-  const bool safe = !word.empty() && word.find_first_not_of(
-                                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                         "0123456789_-+=/.,:@%") == std::string::npos;
-  if (safe) return word;
-  std::string quoted = "'";
-  for (const char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
 /// Creates (truncates) `path` so that a failure names the file, before the child opens it again.
 void check_output_file(const std::string& path, const std::string& program, const char* stream) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -73,6 +62,16 @@ extern "C" void on_stop_signal(int sig) { g_stop_signal.store(sig); }
 
 }  // namespace
 
+std::string shell_word(const std::string& word) {
+  const bool safe = !word.empty() && word.find_first_not_of(
+                                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                         "0123456789_-+=/.,:@%") == std::string::npos;
+  if (safe) return word;
+  std::string quoted = "'";
+  for (const char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
 std::string ProcessSpec::command_line() const {
   std::string line;
   for (const auto& a : argv) line += (line.empty() ? "" : " ") + shell_word(a);
@@ -97,7 +96,7 @@ size_t ProcessGroup::start(const ProcessSpec& spec) {
   sigset_t none, defaults;
   sigemptyset(&none);
   sigemptyset(&defaults);
-  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGCHLD}) sigaddset(&defaults, sig);
+  for (const int sig : {SIGINT, SIGQUIT, SIGTERM, SIGHUP, SIGPIPE, SIGCHLD}) sigaddset(&defaults, sig);
   posix_spawnattr_setsigmask(&setup.attr_, &none);
   posix_spawnattr_setsigdefault(&setup.attr_, &defaults);
   posix_spawnattr_setflags(&setup.attr_, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
@@ -106,7 +105,9 @@ size_t ProcessGroup::start(const ProcessSpec& spec) {
     posix_spawn_file_actions_addopen(&setup.actions_, STDOUT_FILENO, spec.stdout_path.c_str(),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
   }
-  if (!spec.stderr_path.empty()) {
+  if (spec.stderr_to_stdout) {
+    posix_spawn_file_actions_adddup2(&setup.actions_, STDOUT_FILENO, STDERR_FILENO);
+  } else if (!spec.stderr_path.empty()) {
     check_output_file(spec.stderr_path, program, "stderr");
     posix_spawn_file_actions_addopen(&setup.actions_, STDERR_FILENO, spec.stderr_path.c_str(),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);

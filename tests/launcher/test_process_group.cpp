@@ -2,6 +2,7 @@
 // ProcessGroup and StopSignals with real children: /bin/sh scripts and sleep.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <wingman/launcher/launch_setup.hpp>
 #include <wingman/launcher/process_group.hpp>
 
 #include "../support/test_support.hpp"
@@ -63,6 +64,31 @@ TEST(ProcessGroup, GivesTheChildItsEnvironmentWithTheSpecsEntriesOver) {
   ProcessGroup group;
   ASSERT_EQ(group.run(spec), 0);
   EXPECT_EQ(read_file(dir.file("o.txt")), "kept new a=b\n");
+}
+
+TEST(ProcessGroup, StderrCanFollowStdoutIntoOneFileInOrder) {
+  TempDir dir;
+  ProcessSpec spec = sh("echo one; echo two >&2; echo three");
+  spec.stdout_path = dir.file("both.txt");
+  spec.stderr_to_stdout = true;
+  ProcessGroup group;
+  ASSERT_EQ(group.run(spec), 0);
+  EXPECT_EQ(read_file(dir.file("both.txt")), "one\ntwo\nthree\n");
+}
+
+TEST(RunInForeground, TheChildGetsCtrlCAndThisProcessOnlyItsExit) {
+  struct sigaction before {};
+  ::sigaction(SIGINT, nullptr, &before);
+  // The child sends SIGINT to its parent (this test), then waits to be interrupted itself: the parent ignores it
+  // while the child runs, so the test survives; the child ends on its own SIGINT.
+  EXPECT_EQ(run_in_foreground(sh("kill -INT $PPID; kill -INT $$; sleep 5")), 128 + SIGINT);
+  struct sigaction after {};
+  ::sigaction(SIGINT, nullptr, &after);
+  EXPECT_EQ(after.sa_handler, before.sa_handler);  // restored
+  EXPECT_EQ(run_in_foreground(sh("exit 7")), 7);
+  ProcessSpec missing;
+  missing.argv = {"/nonexistent/program"};
+  EXPECT_THROW(run_in_foreground(missing), std::runtime_error);
 }
 
 TEST(ProcessGroup, AProgramThatCannotStartIsAnErrorNamingIt) {

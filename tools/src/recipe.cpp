@@ -3,6 +3,8 @@
 // processes of the other `wingman` verbs.
 #include "wingman/tools/recipe.hpp"
 
+#include "wingman/launcher/launch_setup.hpp"
+
 #include <wingman/common/config.hpp>
 #include <wingman/common/yaml_mapping_reader.hpp>
 
@@ -10,18 +12,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <csignal>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <set>
 #include <stdexcept>
-
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace wingman::tools {
 
@@ -313,14 +308,7 @@ Recipe load_recipe(const std::string& path, const std::vector<std::string>& over
 namespace {
 
 /// A word as a POSIX shell reads it back.
-std::string quote(const std::string& w) {
-  if (!w.empty() && w.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=/.,:@%") ==
-                        std::string::npos)
-    return w;
-  std::string q = "'";
-  for (const char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using launcher::shell_word;
 
 std::string num(double v) { return fmt::format("{}", v); }
 
@@ -389,9 +377,9 @@ class Runner {
   /// Prints and (unless dry-run) runs a command; throws when it fails.
   void run(const Command& c) {
     std::string line;
-    for (const auto& [k, v] : c.env) line += k + "=" + quote(v) + " ";
-    for (size_t i = 0; i < c.argv.size(); ++i) line += (i ? " " : "") + quote(c.argv[i]);
-    if (!c.output.empty()) line += " > " + quote(c.output) + " 2>&1";
+    for (const auto& [k, v] : c.env) line += k + "=" + shell_word(v) + " ";
+    for (size_t i = 0; i < c.argv.size(); ++i) line += (i ? " " : "") + shell_word(c.argv[i]);
+    if (!c.output.empty()) line += " > " + shell_word(c.output) + " 2>&1";
     note(line);
     if (o_.dry_run) return;
     const int rc = exec(c, true);
@@ -401,55 +389,30 @@ class Runner {
                                            c.output.empty() ? "" : " (log: " + c.output + ")"));
   }
 
+  /// Runs `c` to its end as system() does (launcher::run_in_foreground: Ctrl-C reaches the child, the trainer saves
+  /// its checkpoint and stops, and this process then reports its exit). A program that cannot start: 127.
   static int exec(const Command& c, bool report) {
     std::cout.flush();
-    // As system() does: Ctrl-C reaches the child (the trainer saves its checkpoint and stops), and this process
-    // waits for it and then reports its exit instead of leaving it behind.
-    struct sigaction ignore {};
-    struct sigaction old_int {};
-    struct sigaction old_quit {};
-    ignore.sa_handler = SIG_IGN;
-    sigaction(SIGINT, &ignore, &old_int);
-    sigaction(SIGQUIT, &ignore, &old_quit);
-    const pid_t pid = fork();
-    if (pid < 0) {
-      sigaction(SIGINT, &old_int, nullptr);
-      sigaction(SIGQUIT, &old_quit, nullptr);
-      throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
+    launcher::ProcessSpec spec;
+    spec.argv = c.argv;
+    for (const auto& [k, v] : c.env) spec.env.push_back(k + "=" + v);
+    spec.stdout_path = c.output;
+    spec.stderr_to_stdout = !c.output.empty();
+    try {
+      return launcher::run_in_foreground(spec);
+    } catch (const std::runtime_error& e) {
+      if (report) std::cerr << "train-recipe: " << e.what() << std::endl;
+      return 127;
     }
-    if (pid == 0) {
-      sigaction(SIGINT, &old_int, nullptr);
-      sigaction(SIGQUIT, &old_quit, nullptr);
-      for (const auto& [k, v] : c.env) setenv(k.c_str(), v.c_str(), 1);
-      if (!c.output.empty()) {
-        const int fd = open(c.output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd < 0) _exit(126);
-        dup2(fd, 1);
-        dup2(fd, 2);
-        close(fd);
-      }
-      std::vector<char*> argv;
-      for (const std::string& a : c.argv) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      execvp(argv[0], argv.data());
-      if (report) fprintf(stderr, "train-recipe: cannot run %s: %s\n", argv[0], std::strerror(errno));
-      _exit(127);
-    }
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    sigaction(SIGINT, &old_int, nullptr);
-    sigaction(SIGQUIT, &old_quit, nullptr);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
   void remove_all(const fs::path& p) {
     if (!fs::exists(p)) return;
-    note("rm -rf " + quote(p.string()));
+    note("rm -rf " + shell_word(p.string()));
     if (!o_.dry_run) fs::remove_all(p);
   }
   void touch(const fs::path& p) {
-    note("touch " + quote(p.string()));
+    note("touch " + shell_word(p.string()));
     if (!o_.dry_run) std::ofstream(p).flush();
   }
 
@@ -488,7 +451,7 @@ class Runner {
       const std::string name = fmt::format("train_flight_{:02d}", k);
       if (fs::exists(logs / (name + ".done"))) continue;
       remove_all(logs / name);
-      note(fmt::format("rm -f {0}/images/*/{1}_* {0}/labels/*/{1}_*", quote(dir.string()), name));
+      note(fmt::format("rm -f {0}/images/*/{1}_* {0}/labels/*/{1}_*", shell_word(dir.string()), name));
       if (!o_.dry_run)
         for (const char* sub : {"images", "labels"}) {
           std::error_code ec;
@@ -504,14 +467,14 @@ class Runner {
            {{"WINGMAN_BIN_DIR", o_.bin}},
            (logs / (name + ".log")).string()});
       const fs::path log = flight / (name + ".lcmlog");
-      note(fmt::format("mv {} {}", quote((flight / "flight.lcmlog").string()), quote(log.string())));
+      note(fmt::format("mv {} {}", shell_word((flight / "flight.lcmlog").string()), shell_word(log.string())));
       if (!o_.dry_run) fs::rename(flight / "flight.lcmlog", log);
       const bool val = std::find(d.val.begin(), d.val.end(), k) != d.val.end();
       run({{wingman_, "dataset", "from-log", log.string(), "--out", dir.string(), "--split", val ? "val" : "train",
             "--every", std::to_string(d.every)},
            {},
            ""});
-      note("rm -f " + quote(log.string()));
+      note("rm -f " + shell_word(log.string()));
       if (!o_.dry_run) fs::remove(log);
       touch(logs / (name + ".done"));
     }
@@ -521,7 +484,7 @@ class Runner {
   /// DATA/<mix>.yaml, a data.yaml for `wingman train --data` (written every run, as the datasets are).
   void write_mix(const RecipeMix& x) {
     const fs::path file = fs::path(o_.data) / (x.name + ".yaml");
-    note(fmt::format("write {} (train: {}; val: {})", quote(file.string()), fmt::join(x.train, ", "), x.val));
+    note(fmt::format("write {} (train: {}; val: {})", shell_word(file.string()), fmt::join(x.train, ", "), x.val));
     if (o_.dry_run) return;
     std::vector<std::string> train;
     for (const std::string& d : x.train) train.push_back(d + "/images/train");

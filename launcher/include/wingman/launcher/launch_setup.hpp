@@ -12,6 +12,11 @@ namespace wingman::launcher {
 /// A ProcessSpec named `name` running `argv` (output inherited, no extra environment).
 ProcessSpec process(std::string name, std::vector<std::string> argv);
 
+/// Runs `spec` to its end as system() does: while it runs, this process ignores SIGINT and SIGQUIT (the child gets
+/// them, at their defaults: Ctrl-C stops the child, and then this process reports its exit). Returns the exit code
+/// (128 + signal when killed). Throws std::runtime_error naming the program when it cannot be started.
+int run_in_foreground(const ProcessSpec& spec);
+
 /// The folder of the running executable (the build's or the installation's bin/), from /proc/self/exe. Throws
 /// std::runtime_error when it cannot be read.
 std::string executable_dir();

@@ -19,6 +19,7 @@ struct ProcessSpec {
   std::vector<std::string> argv;  ///< argv[0]: a path, or a name looked up on PATH; not empty
   std::string stdout_path;        ///< the child's stdout goes to this file (truncated); "" = the launcher's stdout
   std::string stderr_path;        ///< the same for stderr
+  bool stderr_to_stdout = false;  ///< stderr goes where stdout goes (stderr_path unused), as a shell's 2>&1
   std::vector<std::string> env;   ///< KEY=VALUE set for the child over the launcher's environment
 
   /// "name" or argv[0].
@@ -93,6 +94,10 @@ class StopSignals {
   bool requested() const;
   int signal() const;
 };
+
+/// `word` as a shell needs it: bare when it holds only safe characters, else in single quotes (for messages and
+/// command lines a person may copy).
+std::string shell_word(const std::string& word);
 
 /// Exit code as a shell reports it, from a waitpid() status: the exit status, or 128 + the signal.
 int exit_code_from_status(int status);
