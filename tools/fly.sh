@@ -10,11 +10,4 @@
 #   the options of `wingman fly` (tools/fly.sh --help lists them with their defaults); relative paths are taken from
 #   the checkout's root. WINGMAN_BIN_DIR: the executables (default build/bin). WINGMAN_MODEL_CFG and
 #   WINGMAN_MODEL_WEIGHTS: another detector model (wingman fly's --model-cfg and --model-weights).
-set -euo pipefail
-cd "$(dirname "$0")/.."
-bin="${WINGMAN_BIN_DIR:-$(pwd)/build/bin}"
-[ -x "$bin/wingman" ] || { echo "fly: $bin/wingman is missing: build first (tools/build.sh)" >&2; exit 2; }
-for a in "$@"; do
-  case "$a" in -h|--help) exec "$bin/wingman" fly --help ;; esac
-done
-exec tools/netns_run.sh "$bin/wingman" fly --bin-dir "$bin" "$@"
+exec "$(dirname "$0")/netns_verb.sh" fly "$@"

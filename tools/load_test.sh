@@ -12,11 +12,4 @@
 #                           [--max-rss-growth-pct P] [--report-only]
 #   the options of `wingman load` (tools/load_test.sh --help lists them with their defaults and what each mode
 #   checks); relative paths are taken from the checkout's root. Environment: WINGMAN_BIN_DIR (default build/bin).
-set -euo pipefail
-cd "$(dirname "$0")/.."
-bin="${WINGMAN_BIN_DIR:-$(pwd)/build/bin}"
-[ -x "$bin/wingman" ] || { echo "load_test: $bin/wingman is missing: build first (tools/build.sh)" >&2; exit 2; }
-for a in "$@"; do
-  case "$a" in -h|--help) exec "$bin/wingman" load --help ;; esac
-done
-exec tools/netns_run.sh "$bin/wingman" load --bin-dir "$bin" "$@"
+exec "$(dirname "$0")/netns_verb.sh" load "$@"

@@ -8,6 +8,7 @@
 #include "wingman/tools/demo_camera.hpp"
 #include "wingman/tools/load.hpp"
 #ifdef WINGMAN_WITH_SIM
+#include "wingman/tools/experiment.hpp"
 #include "wingman/tools/fly.hpp"
 #endif
 
@@ -35,6 +36,10 @@ struct LaunchVerbs::State {
   FlyOptions options;
   bool render = false, no_render = false;
   std::unique_ptr<VerbLayers> fly_layers;
+  CLI::App* experiment = nullptr;
+  ExperimentOptions experiment_options;
+  bool list_experiments = false;
+  std::unique_ptr<VerbLayers> experiment_layers;
 #endif
 };
 
@@ -216,6 +221,50 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
     s_->fly_layers->key(flag, key, quote);
   }
   s_->fly_layers->check_every_flag({"--render", "--no-render"});  // flight.render, from both
+
+  ExperimentOptions& x = s_->experiment_options;
+  auto* e = s_->experiment = app.add_subcommand(
+      "experiment",
+      "Run experiments as their files say (config/experiments/NAME.yaml: the flights, their scenarios and settings, "
+      "the table over them): each flight through `wingman fly`, then tools/experiment_summary.py's table "
+      "(results.md, results.json) in OUT/NAME. Run it in a private network namespace (tools/experiment.sh does)");
+  e->add_option("names", x.names, "Experiments in order: NAME (config/experiments/NAME.yaml) or an experiment file")
+      ->type_name("NAME|FILE");
+  e->add_flag("--list", s_->list_experiments, "List the experiments (config/experiments) with their titles and exit");
+  e->add_flag("--quick", x.quick, "Short flights and sparse sweeps (each file's quick: parts): a check, not results");
+  e->add_option("--out", x.out, "Output root (empty: build/experiments, or build/experiments-truth with truth)");
+  e->add_option("--detections", x.detections,
+                "cnn: the shipped model on rendered images; truth: boxes from the simulator's ground truth (no "
+                "rendering), for the experiments whose files allow it")
+      ->check(CLI::IsMember({"cnn", "truth"}));
+  e->add_option("--duration", x.duration_s,
+                "Fly only the first S seconds of every flight, sweeps included (0: their own length)");
+  e->add_option("--meshes", x.meshes,
+                "The four shared airframes (empty: $WINGMAN_SHARED_MESHES, else ../shared/meshes; absent: the flights "
+                "that need them are skipped, their stand-ins fly)");
+  e->add_flag("--dry-run", x.dry_run,
+              "Write the scenarios and plan every flight (all of wingman fly's checks), print the plans, fly nothing");
+  e->add_option("--summary-script", x.summary_script, "The tables (Python, run with python3)");
+  e->add_option("--config-dir", x.config_dir, "The checkout's config folder (experiments, scenarios, flights)");
+  e->add_option("--bin-dir", x.bin_dir, "The executables (empty: the folder of this wingman)");
+  e->add_option("--lcm-url", x.lcm_url, "The LCM bus (empty: $WINGMAN_LCM_URL, set by tools/netns_run.sh)");
+  s_->experiment_layers = std::make_unique<VerbLayers>(e);
+  for (const auto& [flag, key, quote] : std::initializer_list<std::tuple<const char*, const char*, bool>>{
+           {"names", "experiment.names", true},
+           {"--quick", "experiment.quick", false},
+           {"--out", "experiment.out", true},
+           {"--detections", "experiment.detections", true},
+           {"--duration", "experiment.duration_s", false},
+           {"--meshes", "experiment.meshes", true},
+           {"--dry-run", "experiment.dry_run", false},
+           {"--summary-script", "run.summary_script", true},
+           {"--config-dir", "run.config_dir", true},
+           {"--bin-dir", "run.bin_dir", true},
+           {"--lcm-url", "run.lcm_url", true},
+       }) {
+    s_->experiment_layers->key(flag, key, quote);
+  }
+  s_->experiment_layers->check_every_flag({"--list"});
 #endif
 }
 
@@ -237,6 +286,17 @@ int LaunchVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     });
   }
 #ifdef WINGMAN_WITH_SIM
+  if (*s_->experiment) {
+    return run_verb("wingman experiment", err, [&] {
+      if (s_->list_experiments) {
+        list_experiments(s_->experiment_options.config_dir, out);
+        return 0;
+      }
+      bool printed = false;
+      const auto o = s_->experiment_layers->load<ExperimentOptions>(out, &printed);
+      return printed ? 0 : run_experiments(o, out, err);
+    });
+  }
   if (!*s_->fly) return -1;
   return run_verb("wingman fly", err, [&] {
     if (s_->render && s_->no_render) throw std::invalid_argument("--render and --no-render: give one");
