@@ -12,8 +12,7 @@ namespace {
 using namespace wingman;
 
 int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
-  const localizer::CameraOptions& c = o.camera;
-  localizer::Localizer loc(o, geometry::make_camera(c.calibration, c.kalibr_camera, c.width, c.height, c.focal_px));
+  localizer::Localizer loc(o, geometry::make_camera(o.camera));
   rt.status().declare_output(o.output_channel);
   if (o.windows.publish) rt.status().declare_output(o.windows.channel);
   // A time resync (one input re-anchored the clock) is worth a log line each time.

@@ -192,9 +192,8 @@ std::string mavlink_detail(MavlinkSide& mav, int64_t own_pose_timeouts, int64_t 
 int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scenario) {
   common::StatusTracker& status = rt.status();
   // The localizer's camera from the same keys (geometry::make_camera): their defaults agree.
-  const sim::SimCameraOptions& c = o.camera;
-  sim::SimCamera camera{geometry::make_camera(c.calibration, c.kalibr_camera, c.width, c.height, c.focal_px),
-                        geometry::Extrinsics::from_options(o.extrinsics), c.rate_hz, c.camera_id};
+  sim::SimCamera camera{geometry::make_camera(o.camera), geometry::Extrinsics::from_options(o.extrinsics),
+                        o.camera.rate_hz, o.camera.camera_id};
 
   std::unique_ptr<sim::Renderer> renderer;
   if (o.render) {

@@ -331,11 +331,10 @@ CameraModel load_calibration(const std::string& path, const std::string& kalibr_
   return read_kalibr(path, root, kalibr_camera);
 }
 
-CameraModel make_camera(const std::string& calibration, const std::string& kalibr_camera, int width, int height,
-                        double focal_px) {
-  if (!calibration.empty()) return load_calibration(calibration, kalibr_camera);
+CameraModel make_camera(const CameraModelOptions& o) {
+  if (!o.calibration.empty()) return load_calibration(o.calibration, o.kalibr_camera);
   // Principal point at the image centre, in the calibration convention (pixel centres at integers).
-  return CameraModel::pinhole(width, height, focal_px, focal_px, 0.5 * width - 0.5, 0.5 * height - 0.5);
+  return CameraModel::pinhole(o.width, o.height, o.focal_px, o.focal_px, 0.5 * o.width - 0.5, 0.5 * o.height - 0.5);
 }
 
 }  // namespace wingman::geometry

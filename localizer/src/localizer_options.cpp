@@ -6,17 +6,6 @@
 
 namespace wingman::localizer {
 
-std::vector<std::string> CameraOptions::validate() const {
-  using common::problem;
-  std::vector<std::string> p;
-  if (camera_id < 0) p.push_back(problem("camera.camera_id", camera_id, "must be >= 0"));
-  if (width < 1 || width > 16384) p.push_back(problem("camera.width", width, "must be in 1..16384"));
-  if (height < 1 || height > 16384) p.push_back(problem("camera.height", height, "must be in 1..16384"));
-  if (!(focal_px > 0)) p.push_back(problem("camera.focal_px", focal_px, "must be > 0"));
-  if (kalibr_camera.empty()) p.push_back(problem("camera.kalibr_camera", kalibr_camera, "must not be empty"));
-  return p;
-}
-
 std::vector<std::string> LocalizerOptions::validate() const {
   using common::problem;
   std::vector<std::string> p;

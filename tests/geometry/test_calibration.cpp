@@ -180,8 +180,20 @@ TEST(Calibration, ReadsKalibrCamchainByCameraName) {
   EXPECT_EQ(c1.name(), "cam1");
 }
 
+/// camera.* keys with `calibration` or, when it is "", the ideal pinhole of the other arguments.
+CameraModelOptions camera_keys(const std::string& calibration, const std::string& kalibr_camera, int width, int height,
+                               double focal_px) {
+  CameraModelOptions o;
+  o.calibration = calibration;
+  o.kalibr_camera = kalibr_camera;
+  o.width = width;
+  o.height = height;
+  o.focal_px = focal_px;
+  return o;
+}
+
 TEST(MakeCamera, WithoutCalibrationIsTheCentredIdealPinhole) {
-  const CameraModel c = make_camera("", "cam0", 1280, 720, 640.0);
+  const CameraModel c = make_camera(camera_keys("", "cam0", 1280, 720, 640.0));
   EXPECT_EQ(c.width(), 1280);
   EXPECT_EQ(c.height(), 720);
   EXPECT_EQ(c.fx(), 640.0);
@@ -189,19 +201,20 @@ TEST(MakeCamera, WithoutCalibrationIsTheCentredIdealPinhole) {
   EXPECT_EQ(c.cx(), 639.5);  // pixel centres at integers: the image spans [-0.5, 1279.5]
   EXPECT_EQ(c.cy(), 359.5);
   EXPECT_EQ(c.distortion(), Distortion::kNone);
-  const CameraModel odd = make_camera("", "cam0", 641, 481, 300.0);
+  EXPECT_EQ(make_camera(CameraModelOptions{}).describe(), c.describe()) << "the defaults are this camera";
+  const CameraModel odd = make_camera(camera_keys("", "cam0", 641, 481, 300.0));
   EXPECT_EQ(odd.cx(), 320.0);
   EXPECT_EQ(odd.cy(), 240.0);
-  EXPECT_THROW(make_camera("", "cam0", 0, 720, 640.0), std::invalid_argument);
+  EXPECT_THROW(make_camera(camera_keys("", "cam0", 0, 720, 640.0)), std::invalid_argument);
 }
 
 TEST(MakeCamera, WithCalibrationReadsItAndIgnoresThePinholeKeys) {
   TempDir dir;
   const std::string path = write(dir, "camchain.yaml", kKalibr);
-  const CameraModel c1 = make_camera(path, "cam1", 1, 1, 1.0);
+  const CameraModel c1 = make_camera(camera_keys(path, "cam1", 1, 1, 1.0));
   EXPECT_EQ(c1.describe(), load_calibration(path, "cam1").describe());
   EXPECT_EQ(c1.name(), "cam1");
-  EXPECT_THROW(make_camera(path, "cam7", 1280, 720, 640.0), CalibrationError);
+  EXPECT_THROW(make_camera(camera_keys(path, "cam7", 1280, 720, 640.0)), CalibrationError);
 }
 
 TEST(Calibration, ErrorsNameTheFileTheKeyAndWhatWasExpected) {

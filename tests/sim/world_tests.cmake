@@ -6,6 +6,11 @@ wingman_add_test(test_sim_world
   SOURCES test_multirotor.cpp test_scenario.cpp test_simulator.cpp
   LIBS wingman::sim_world wingman::test_support)
 
+# The camera.* keys the simulator shares with the localizer (geometry::CameraModelOptions): read alike.
+wingman_add_test(test_sim_camera_options
+  SOURCES test_sim_camera_options.cpp
+  LIBS wingman::sim_world wingman::localizer wingman::geometry wingman::common)
+
 # The simulated autopilot's MAVLink rules (autopilot: mavlink): PX4 OFFBOARD, ArduPilot GUIDED, TIMESYNC, telemetry.
 wingman_add_test(test_sim_mavlink_vehicle
   SOURCES test_mavlink_vehicle.cpp

@@ -3,6 +3,7 @@
 #include "wingman/sim/sim_options.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/common/message_validation.hpp>
 
 #include <cmath>
 #include <set>
@@ -12,13 +13,9 @@ namespace wingman::sim {
 using common::problem;
 
 std::vector<std::string> SimCameraOptions::validate() const {
-  std::vector<std::string> p;
-  if (camera_id < 0) p.push_back(problem("camera.camera_id", camera_id, "must be >= 0"));
-  if (width < 1 || width > 8192) p.push_back(problem("camera.width", width, "must be in 1..8192"));
-  if (height < 1 || height > 8192) p.push_back(problem("camera.height", height, "must be in 1..8192"));
-  if (!(focal_px > 0) || !std::isfinite(focal_px)) p.push_back(problem("camera.focal_px", focal_px, "must be > 0"));
+  const common::ImageLimits published;  // what every subscriber of the images accepts
+  std::vector<std::string> p = CameraModelOptions::validate(published.max_width, published.max_height);
   if (!(rate_hz > 0 && rate_hz <= 1000)) p.push_back(problem("camera.rate_hz", rate_hz, "must be in (0, 1000]"));
-  if (kalibr_camera.empty()) p.push_back(problem("camera.kalibr_camera", kalibr_camera, "must not be empty"));
   return p;
 }
 

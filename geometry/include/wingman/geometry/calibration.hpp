@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wingman/geometry/camera_model.hpp"
+#include "wingman/geometry/camera_model_options.hpp"
 
 #include <stdexcept>
 #include <string>
@@ -42,13 +43,13 @@ const char* calibration_format_name(CalibrationFormat format);
 CameraModel load_calibration(const std::string& path, const std::string& kalibr_camera = "cam0");
 
 /// The camera of a process's camera.* keys (wingman-localizer and wingman-sim, whose defaults are the same camera):
-/// the calibration file `calibration` read by load_calibration() (camera `kalibr_camera` of a Kalibr camchain), or,
-/// when `calibration` is "", the ideal pinhole camera of `width` x `height` pixels with fx = fy = `focal_px` and the
+/// the calibration file `o.calibration` read by load_calibration() (camera `o.kalibr_camera` of a Kalibr camchain),
+/// or, when it is "", the ideal pinhole camera of `o.width` x `o.height` pixels with fx = fy = `o.focal_px` and the
 /// principal point at the image centre in the calibration convention (pixel centres at integers: cx = width / 2 -
-/// 0.5, cy = height / 2 - 0.5). width, height and focal_px are unused with a calibration file. Throws
-/// CalibrationError for a file that cannot be used, std::invalid_argument for a pinhole CameraModel rejects.
-CameraModel make_camera(const std::string& calibration, const std::string& kalibr_camera, int width, int height,
-                        double focal_px);
+/// 0.5, cy = height / 2 - 0.5). width, height and focal_px are unused with a calibration file; camera_id is not part
+/// of the model. Throws CalibrationError for a file that cannot be used, std::invalid_argument for a pinhole
+/// CameraModel rejects.
+CameraModel make_camera(const CameraModelOptions& o);
 
 /// The format load_calibration() would read `path` as. Throws CalibrationError if it is none of them.
 CalibrationFormat detect_calibration_format(const std::string& path);

@@ -2,6 +2,7 @@
 // Options of wingman-localizer (config/localizer.yaml).
 #pragma once
 
+#include <wingman/geometry/camera_model_options.hpp>
 #include <wingman/geometry/extrinsics.hpp>
 #include "wingman/localizer/pose_buffer.hpp"
 #include "wingman/localizer/sphere_localizer.hpp"
@@ -15,33 +16,20 @@
 
 namespace wingman::localizer {
 
-/// The camera the detections come from.
-struct CameraOptions {
-  /// Calibration file (ROS camera_info, OpenCV FileStorage or Kalibr camchain YAML); "" = an ideal
-  /// pinhole camera from the width, height and focal length below.
-  std::string calibration;
-  std::string kalibr_camera = "cam0";  ///< camera of a Kalibr camchain file
-  int camera_id = 0;                   ///< detections_t.camera_id this localizer accepts
-  int width = 1280;                    ///< built-in pinhole: image width, pixels
-  int height = 720;                    ///< built-in pinhole: image height, pixels
-  double focal_px = 640.0;             ///< built-in pinhole: fx = fy, pixels (principal point at the centre)
+/// The camera the detections come from: the camera.* keys every camera-building process shares
+/// (geometry::CameraModelOptions; camera.camera_id is the one camera this localizer accepts) and the localizer's own.
+struct CameraOptions : geometry::CameraModelOptions {
   /// Rescale the calibration to the detections' image size when they differ (intrinsics scaled
   /// by the width and height ratios). Off: a size mismatch drops the message, naming both sizes.
   bool scale_to_image = false;
 
   template <class V>
   void visit(V& v) {
-    v("camera.calibration", calibration,
-      "calibration YAML (ROS camera_info, OpenCV, Kalibr); \"\" = ideal pinhole below");
-    v("camera.kalibr_camera", kalibr_camera, "which camera of a Kalibr camchain file");
-    v("camera.camera_id", camera_id, "detections_t.camera_id accepted; others are dropped and counted");
-    v("camera.width", width, "ideal pinhole only: image width, pixels");
-    v("camera.height", height, "ideal pinhole only: image height, pixels");
-    v("camera.focal_px", focal_px, "ideal pinhole only: focal length fx = fy, pixels");
+    geometry::CameraModelOptions::visit(v);
     v("camera.scale_to_image", scale_to_image,
       "rescale intrinsics to the detections' image size (false: a size mismatch is an error)");
   }
-  std::vector<std::string> validate() const;
+  // validate(): the shared keys' (scale_to_image has no rule).
 };
 
 /// Options of the localizer process.

@@ -7,6 +7,7 @@
 #include "wingman/sim/render_options.hpp"
 
 #include <wingman/camera_driver/preview.hpp>
+#include <wingman/geometry/camera_model_options.hpp>
 #include <wingman/geometry/extrinsics.hpp>
 
 #include <cstdint>
@@ -15,30 +16,19 @@
 
 namespace wingman::sim {
 
-/// The simulated onboard camera. The defaults equal the localizer's built-in camera (config/localizer.yaml), so
-/// the pipeline works on embedded defaults.
-struct SimCameraOptions {
-  /// Calibration file (ROS camera_info, OpenCV FileStorage or Kalibr camchain YAML); "" = an ideal pinhole camera
-  /// from width, height and focal_px (principal point at the image centre), like the localizer's.
-  std::string calibration;
-  std::string kalibr_camera = "cam0";  ///< camera of a Kalibr camchain file
-  int camera_id = 0;                   ///< image_t / detections_t / truth_box_t camera_id
-  int width = 1280;                    ///< ideal pinhole: image width, pixels
-  int height = 720;                    ///< ideal pinhole: image height, pixels
-  double focal_px = 640.0;             ///< ideal pinhole: fx = fy, pixels
-  double rate_hz = 30.0;               ///< frames per simulated second, > 0
+/// The simulated onboard camera: the camera.* keys every camera-building process shares (geometry::CameraModelOptions,
+/// whose defaults are the localizer's built-in camera, so the pipeline works on embedded defaults; camera.camera_id
+/// is the id the simulator publishes with) and the frame rate.
+struct SimCameraOptions : geometry::CameraModelOptions {
+  double rate_hz = 30.0;  ///< frames per simulated second, in (0, 1000]
 
   template <class V>
   void visit(V& v) {
-    v("camera.calibration", calibration,
-      "calibration YAML (ROS camera_info, OpenCV, Kalibr); \"\" = ideal pinhole below (the localizer's default)");
-    v("camera.kalibr_camera", kalibr_camera, "which camera of a Kalibr camchain file");
-    v("camera.camera_id", camera_id, "camera_id of the published images, detections and truth boxes");
-    v("camera.width", width, "ideal pinhole only: image width, pixels");
-    v("camera.height", height, "ideal pinhole only: image height, pixels");
-    v("camera.focal_px", focal_px, "ideal pinhole only: focal length fx = fy, pixels");
+    geometry::CameraModelOptions::visit(v);
     v("camera.rate_hz", rate_hz, "frames per simulated second");
   }
+  /// The shared keys' problems, with width and height bounded by the largest image_t a subscriber accepts
+  /// (common::ImageLimits), and rate_hz's.
   std::vector<std::string> validate() const;
 };
 
