@@ -12,6 +12,7 @@
 #include <wingman/common/progress.hpp>
 #include <wingman/common/runtime.hpp>
 #include <wingman/geometry/calibration.hpp>
+#include <wingman/launcher/bus_watch.hpp>
 #include <wingman/mavlink/parser.hpp>
 #include <wingman/mavlink_bridge/link.hpp>
 #include <wingman/mavlink_bridge/link_reader.hpp>
@@ -25,7 +26,6 @@
 #include <cstdlib>
 #include <functional>
 #include <iostream>
-#include <map>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -41,32 +41,21 @@ int remaining_ms(Clock::time_point deadline, int cap_ms) {
   return static_cast<int>(std::clamp<int64_t>(left, 0, cap_ms));
 }
 
-/// Waits until every instance of `names` has published a heartbeat (bounded by timeout_s of wall clock).
+/// Waits until every process instance of `names` (status_t.process, on its STATUS_<NAME> channel) has published a
+/// heartbeat on the input bus, bounded by timeout_s of wall clock: the launchers' launcher::BusWatch, the runtime
+/// spinning between its spins (our heartbeat, signals, inputs). Throws naming those not seen.
 void wait_for_processes(common::Runtime& rt, const std::vector<std::string>& names, double timeout_s) {
   if (names.empty()) return;
-  // The subscriptions outlive this function (heartbeats keep coming): they share the map.
-  auto seen_ptr = std::make_shared<std::map<std::string, bool>>();
-  auto& seen = *seen_ptr;
-  for (const auto& name : names) {
-    seen[name] = false;
-    rt.subscribe<status_t>(common::status_channel(name),
-                           [seen_ptr, name](const status_t&) { (*seen_ptr)[name] = true; });
-  }
+  if (rt.input_is_file())
+    throw std::runtime_error("sync.wait_for: heartbeats are heard on a bus, not read from a file:// input");
+  const common::RuntimeOptions& ro = rt.options();
+  launcher::BusWatch watch(ro.lcm_in.empty() ? ro.lcm_url : ro.lcm_in);
   spdlog::info("waiting up to {} s for the status of: {}", timeout_s, fmt::join(names, ", "));
-  const auto deadline =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-  auto missing = [&] {
-    std::vector<std::string> m;
-    for (const auto& [name, ok] : seen) {
-      if (!ok) m.push_back(name + " (" + common::status_channel(name) + ")");
-    }
-    return m;
-  };
-  while (!missing().empty() && Clock::now() < deadline && !rt.stop_requested()) {
-    if (!rt.spin_once(remaining_ms(deadline, 100)) && !rt.stop_requested()) break;  // end of a file input
-  }
+  const std::vector<std::string> missing = watch.wait_for_status(names, timeout_s, [&] { return !rt.spin_once(0); });
   if (rt.stop_requested()) return;
-  if (const auto m = missing(); !m.empty()) {
+  if (!missing.empty()) {
+    std::vector<std::string> m;
+    for (const auto& name : missing) m.push_back(name + " (" + common::status_channel(name) + ")");
     throw std::runtime_error(
         fmt::format("sync.wait_for: no status heartbeat within {} s from {}", timeout_s, fmt::join(m, ", ")));
   }

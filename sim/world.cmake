@@ -20,5 +20,7 @@ target_link_libraries(wingman_sim_world
 wingman_warnings(wingman_sim_world)
 
 add_executable(wingman-sim main.cpp)
-target_link_libraries(wingman-sim PRIVATE wingman::sim_world wingman::mavlink_bridge wingman::common spdlog::spdlog fmt::fmt)
+# launcher: BusWatch for sync.wait_for (the launchers' wait for heartbeats).
+target_link_libraries(wingman-sim PRIVATE wingman::sim_world wingman::mavlink_bridge wingman::common wingman::launcher
+                                          spdlog::spdlog fmt::fmt)
 wingman_warnings(wingman-sim)

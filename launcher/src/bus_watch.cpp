@@ -3,6 +3,7 @@
 #include "wingman/launcher/bus_watch.hpp"
 
 #include <fmt/format.h>
+#include <wingman/common/message_validation.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -11,17 +12,25 @@
 namespace wingman::launcher {
 
 BusWatch::BusWatch(const std::string& lcm_url, const std::string& count_channels)
-    : lcm_(std::make_unique<lcm::LCM>(lcm_url)) {
+    : owned_lcm_(std::make_unique<lcm::LCM>(lcm_url)), lcm_(owned_lcm_.get()) {
   if (!lcm_->good()) throw std::runtime_error(fmt::format("cannot open the LCM bus '{}'", lcm_url));
-  lcm_->subscribe("STATUS_.*", &BusWatch::on_status, this);
-  if (!count_channels.empty()) lcm_->subscribe(count_channels, &BusWatch::on_counted, this);
+  subscribe(count_channels);
 }
 
-BusWatch::~BusWatch() = default;
+BusWatch::BusWatch(lcm::LCM& lcm, const std::string& count_channels) : lcm_(&lcm) { subscribe(count_channels); }
+
+BusWatch::~BusWatch() {
+  for (lcm::Subscription* s : subscriptions_) lcm_->unsubscribe(s);
+}
+
+void BusWatch::subscribe(const std::string& count_channels) {
+  subscriptions_.push_back(lcm_->subscribe("STATUS_.*", &BusWatch::on_status, this));
+  if (!count_channels.empty()) subscriptions_.push_back(lcm_->subscribe(count_channels, &BusWatch::on_counted, this));
+}
 
 void BusWatch::on_status(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
   status_t s;
-  if (s.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) {
+  if (s.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0 || !common::validate_message(s).empty()) {
     ++bad_messages_;
     return;
   }

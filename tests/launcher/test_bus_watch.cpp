@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// BusWatch on a real LCM bus (udpm on loopback in a private network namespace): heartbeats, counts, bad messages.
+// BusWatch on a real LCM bus (udpm on loopback in a private network namespace): heartbeats, counts, bad messages,
+// listening on the caller's LCM.
 #include <gtest/gtest.h>
 #include <wingman/launcher/bus_watch.hpp>
 
@@ -74,6 +75,65 @@ TEST(BusWatch, WaitingForHeartbeatsReturnsWhoIsMissing) {
   int asked = 0;
   missing = watch.wait_for_status({"follower_ctrl"}, 60.0, [&] { return ++asked > 1; });
   EXPECT_EQ(missing, std::vector<std::string>{"follower_ctrl"});
+}
+
+TEST(BusWatch, AHeartbeatThatFailsValidationIsCountedAndIgnored) {
+  const std::string url = wingman::testing::netns_lcm_url();
+  BusWatch watch(url);
+  lcm::LCM pub(url);
+  ASSERT_TRUE(pub.good());
+  status_t bad = heartbeat("detector", 1);
+  bad.state = 9;  // decodes, but no status_t state
+  ASSERT_TRUE(watch.spin_until(
+      [&] {
+        pub.publish("STATUS_DETECTOR", &bad);
+        return watch.bad_messages() >= 1;
+      },
+      10.0));
+  EXPECT_EQ(watch.status("detector"), nullptr);
+}
+
+TEST(BusWatch, OnTheCallersLcmItsSpinsServeBothAndItUnsubscribesWhenDestroyed) {
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM lcm(url);
+  lcm::LCM pub(url);
+  ASSERT_TRUE(lcm.good() && pub.good());
+  struct Counter {
+    int64_t n = 0;
+    void on(const lcm::ReceiveBuffer*, const std::string&) { ++n; }
+  } other;
+  lcm.subscribe("OTHER", &Counter::on, &other);
+  const std::vector<uint8_t> bytes(10, 1);
+  const status_t hb = heartbeat("localizer", 0);
+  {
+    BusWatch watch(lcm, "IMAGE_CAM0");
+    std::vector<std::string> missing{"localizer"};
+    for (int i = 0; i < 50 && (!missing.empty() || other.n == 0 || watch.count("IMAGE_CAM0") == 0); ++i) {
+      pub.publish("STATUS_LOCALIZER", &hb);
+      pub.publish("OTHER", bytes.data(), static_cast<unsigned>(bytes.size()));
+      pub.publish("IMAGE_CAM0", bytes.data(), static_cast<unsigned>(bytes.size()));
+      missing = watch.wait_for_status({"localizer"}, 0.2);
+    }
+    EXPECT_TRUE(missing.empty());
+    EXPECT_GT(other.n, 0) << "the caller's subscription is handled by the watch's spins";
+    EXPECT_GT(watch.count("IMAGE_CAM0"), 0);
+    // The caller's own handle calls serve the watch too.
+    const int64_t before = watch.count("IMAGE_CAM0");
+    for (int i = 0; i < 50 && watch.count("IMAGE_CAM0") == before; ++i) {
+      pub.publish("IMAGE_CAM0", bytes.data(), static_cast<unsigned>(bytes.size()));
+      lcm.handleTimeout(100);
+    }
+    EXPECT_GT(watch.count("IMAGE_CAM0"), before);
+  }
+  // The watch is gone: the caller's LCM goes on without calling it (ASan would see a use after free).
+  const int64_t before = other.n;
+  for (int i = 0; i < 50 && other.n == before; ++i) {
+    pub.publish("STATUS_LOCALIZER", &hb);
+    pub.publish("IMAGE_CAM0", bytes.data(), static_cast<unsigned>(bytes.size()));
+    pub.publish("OTHER", bytes.data(), static_cast<unsigned>(bytes.size()));
+    lcm.handleTimeout(100);
+  }
+  EXPECT_GT(other.n, before);
 }
 
 TEST(BusWatch, AnUrlThatCannotBeOpenedIsAnErrorNamingIt) {

@@ -5,7 +5,7 @@
 #include "log_progress.hpp"
 
 #include <wingman/common/lcm_log_reader.hpp>
-#include <wingman/common/message_validation.hpp>
+#include <wingman/launcher/bus_watch.hpp>
 #include <wingman/status_t.hpp>
 
 #include <fmt/format.h>
@@ -29,22 +29,13 @@ bool is_status_channel(const std::string& channel) { return channel.rfind("STATU
 /// LCM's udpm provider publishes one LCM_SELF_TEST message when a process starts; it is not pipeline traffic.
 bool is_lcm_internal(const std::string& channel) { return channel == "LCM_SELF_TEST"; }
 
-/// Everything the player learns from the bus.
+/// What the player counts and records from the bus (the stages' heartbeats: a launcher::BusWatch on the same LCM).
 class BusObserver {
  public:
   explicit BusObserver(lcm::LogFile* record) : record_(record) {}
 
   void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    if (is_status_channel(channel)) {
-      wingman::status_t s;
-      if (s.decode(rbuf->data, 0, rbuf->data_size) < 0 || !common::validate_message(s).empty()) {
-        ++bad_status_;
-        return;
-      }
-      statuses_[s.process] = s;
-      return;
-    }
-    if (is_lcm_internal(channel)) return;
+    if (is_status_channel(channel) || is_lcm_internal(channel)) return;
     ++bus_counts_[channel];
     if (record_ != nullptr) {
       lcm::LogEvent ev;
@@ -58,11 +49,9 @@ class BusObserver {
     }
   }
 
-  std::map<std::string, int64_t> bus_counts_;          ///< messages seen per channel since start
-  std::map<std::string, wingman::status_t> statuses_;  ///< newest status per process instance
+  std::map<std::string, int64_t> bus_counts_;  ///< messages seen per channel since start
   int64_t current_event_utime_ = 0;
   int64_t recorded_ = 0;
-  int64_t bad_status_ = 0;
 
  private:
   lcm::LogFile* record_;
@@ -71,10 +60,12 @@ class BusObserver {
 /// Input counts of a stage at the start, so messages it handled before the replay do not count.
 using Baseline = std::map<std::string, std::map<std::string, int64_t>>;
 
-/// "" when every stage has handled every message on its input channels, else what is missing.
-std::string unsettled(const BusObserver& bus, const std::vector<std::string>& stages, const Baseline& baseline) {
+/// "" when every stage has handled every message on its input channels, else what is missing. Every stage has
+/// reported (`watch` holds its newest status).
+std::string unsettled(const BusObserver& bus, const launcher::BusWatch& watch, const std::vector<std::string>& stages,
+                      const Baseline& baseline) {
   for (const auto& name : stages) {
-    const auto& s = bus.statuses_.at(name);
+    const auto& s = *watch.status(name);
     for (const auto& c : s.channels) {
       if (c.direction != wingman::channel_stats_t::DIRECTION_IN) continue;
       // Heartbeats are wall-clock liveness, never played nor counted (a follower watches STATUS_LOCALIZER): a
@@ -137,29 +128,23 @@ ReplaySummary run_replay(const ReplayOptions& options) {
 
   BusObserver bus(record.get());
   lcm.subscribe(".*", &BusObserver::on_message, &bus);
+  launcher::BusWatch watch(lcm);  // the stages' heartbeats, handled by the same spins as everything else
   const bool lockstep = !options.stages.empty();
 
   // Lockstep: wait until every stage reports, and remember where its counters start.
   Baseline baseline;
   std::set<std::string> stage_outputs;
   if (lockstep) {
-    const auto deadline = t_start + std::chrono::duration<double>(options.start_timeout_s);
-    for (;;) {
-      std::string missing;
-      for (const auto& name : options.stages) {
-        if (!bus.statuses_.count(name)) missing += (missing.empty() ? "" : ", ") + name;
-      }
-      if (missing.empty()) break;
-      if (Clock::now() > deadline) {
-        summary.error = fmt::format("no status from {} within {} s (started with --lockstep on this LCM URL?)", missing,
-                                    options.start_timeout_s);
-        summary.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
-        return summary;
-      }
-      lcm.handleTimeout(20);
+    const double waited_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+    const auto missing = watch.wait_for_status(options.stages, options.start_timeout_s - waited_s);
+    if (!missing.empty()) {
+      summary.error = fmt::format("no status from {} within {} s (started with --lockstep on this LCM URL?)",
+                                  fmt::join(missing, ", "), options.start_timeout_s);
+      summary.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+      return summary;
     }
     for (const auto& name : options.stages) {
-      for (const auto& c : bus.statuses_.at(name).channels) {
+      for (const auto& c : watch.status(name)->channels) {
         if (c.direction == wingman::channel_stats_t::DIRECTION_IN)
           baseline[name][c.channel] = c.count;
         else if (!is_status_channel(c.channel))
@@ -208,7 +193,7 @@ ReplaySummary run_replay(const ReplayOptions& options) {
     std::string why;
     for (;;) {
       why = bus.bus_counts_[ev->channel] < expected ? "own message not seen on the bus"
-                                                    : unsettled(bus, options.stages, baseline);
+                                                    : unsettled(bus, watch, options.stages, baseline);
       if (why.empty()) break;
       if (Clock::now() > deadline) {
         summary.error = fmt::format("event {} (channel {}): not settled within {} s: {}", summary.events_played,
@@ -226,7 +211,8 @@ ReplaySummary run_replay(const ReplayOptions& options) {
     const auto until = Clock::now() + std::chrono::milliseconds(300);
     while (Clock::now() < until) lcm.handleTimeout(20);
   }
-  if (bus.bad_status_ > 0) spdlog::warn("{} status messages could not be decoded and were ignored", bus.bad_status_);
+  if (watch.bad_messages() > 0)
+    spdlog::warn("{} status messages could not be decoded and were ignored", watch.bad_messages());
   summary.ok = true;
   summary.messages_recorded = bus.recorded_;
   summary.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();

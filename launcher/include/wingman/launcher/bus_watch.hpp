@@ -15,13 +15,18 @@
 namespace wingman::launcher {
 
 /// Listens to a bus: every STATUS_* heartbeat (the newest per process instance, status_t.process) and the message
-/// count of the channels matching `count_channels`. A heartbeat that does not decode is counted in bad_messages() and
-/// otherwise ignored. Wall-clock waits only (starting processes); nothing read here is a message time. Not thread-safe.
+/// count of the channels matching `count_channels`. A heartbeat that does not decode or fails common::validate_message
+/// is counted in bad_messages() and otherwise ignored. Wall-clock waits only (starting processes); nothing read here
+/// is a message time. Not thread-safe. The one way a program waits for processes' heartbeats: the launchers (`wingman
+/// fly`, `demo-camera`, `load`), `wingman replay --wait-for` and wingman-sim's sync.wait_for.
 class BusWatch {
  public:
   /// Opens `lcm_url` (a udpm URL in a private network namespace). `count_channels`: a regular expression of channels to
   /// count ("" = none). Throws std::runtime_error naming the URL when LCM cannot open it.
   explicit BusWatch(const std::string& lcm_url, const std::string& count_channels = "");
+  /// Listens on the caller's `lcm` instead, which must outlive the watch: its other subscriptions are handled by the
+  /// same spins (and the watch's by the caller's handle calls). The watch unsubscribes when destroyed.
+  explicit BusWatch(lcm::LCM& lcm, const std::string& count_channels = "");
   ~BusWatch();
   BusWatch(const BusWatch&) = delete;
   BusWatch& operator=(const BusWatch&) = delete;
@@ -44,8 +49,11 @@ class BusWatch {
  private:
   void on_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_counted(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void subscribe(const std::string& count_channels);
 
-  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<lcm::LCM> owned_lcm_;  ///< the URL constructor's; null when listening on the caller's
+  lcm::LCM* lcm_ = nullptr;
+  std::vector<lcm::Subscription*> subscriptions_;
   std::map<std::string, status_t> statuses_;
   std::map<std::string, int64_t> counts_;
   int64_t bad_messages_ = 0;
