@@ -8,7 +8,8 @@
 # /etc/opt/wingman/wingman for /opt/wingman) and equal the shipped config/*.yaml, that the recorder's recordings
 # folder was created, and that supervisord parses the installed file without a log folder of its own (a missing
 # one would stop supervisord, and everything else it runs, from starting: checked on a copy that names one). The
-# stopped-process listener must be installed where its command names it and answer supervisord's protocol.
+# stopped-process listener must be installed where its command names it and answer supervisord's protocol. The
+# installed `wingman train` runs the wingman-train installed beside it.
 # Usage: tests/reliability/install_layout_test.sh SRC_DIR BUILD_DIR
 set -euo pipefail
 src=$(cd "$1" && pwd) build=$(cd "$2" && pwd)
@@ -40,6 +41,14 @@ check_prefix() {  # check_prefix PREFIX CONFDIR
     cmp -s "$src/config/$cfg.yaml" "$dest$confdir/$cfg.yaml" ||
       fail "$prefix: $confdir/$cfg.yaml is not the shipped config/$cfg.yaml"
   done
+  # `wingman train` starts the wingman-train installed beside wingman (tools/src/forwarded_verbs.cpp).
+  local train_help
+  if [ ! -x "$dest$prefix/bin/wingman-train" ]; then
+    fail "$prefix: bin/wingman-train (what \`wingman train\` starts) is not installed"
+  elif ! train_help=$("$dest$prefix/bin/wingman" train --help 2>&1) ||
+    ! grep -q -- '--cfg TEXT REQUIRED' <<<"$train_help"; then
+    fail "$prefix: the installed wingman train --help: $train_help"
+  fi
   if [ "$prefix" != /usr/local ] && grep -hE '^(command|ExecStart|directory|WorkingDirectory)=.*/usr/local' "$conf" "$share"/systemd/*; then
     fail "$prefix: a /usr/local path left in the rendered files (above)"
   fi

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // `wingman`: the tools CLI. Verbs: replay (deterministic log player), spy, loginfo, make-video, localize, predict,
 // bench detector, eval (flight errors against ground truth), report (its HTML page), dataset synth, scenario random
-// (out-of-sample flights), train / val / import-halmstad (training).
+// (out-of-sample flights), train / val / import-halmstad (training; `train` runs in wingman-train).
 #include "wingman/tools/bench.hpp"
 #include "wingman/tools/eval.hpp"
 #include "wingman/tools/eval_target.hpp"
+#include "wingman/tools/forwarded_verbs.hpp"
 #include "wingman/tools/launch_cli.hpp"
 #include "wingman/tools/localize.hpp"
 #include "wingman/tools/log_info.hpp"
@@ -21,6 +22,8 @@
 #include "wingman/tools/scenario_random.hpp"
 #endif
 
+#include "tidy_defaults.hpp"
+
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
@@ -29,24 +32,6 @@
 #include <iostream>
 #include <string>
 #include <tuple>
-
-namespace {
-
-/// Every option's help shows its default, the value of the variable it is bound to (always_capture_default), but
-/// not a required option's (it has none) nor an empty list's ("[]": not given; the description says what that does).
-/// A default with a space is quoted, so that it does not run into the description.
-void tidy_defaults(CLI::App& app) {
-  for (CLI::Option* o : app.get_options()) {
-    const std::string d = o->get_default_str();
-    if (o->get_required() || d == "[]")
-      o->default_str("");
-    else if (d.find(' ') != std::string::npos)
-      o->default_str('"' + d + '"');
-  }
-  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) tidy_defaults(*sub);
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace wingman::tools;
@@ -241,9 +226,10 @@ int main(int argc, char** argv) {
   bd->add_option("--seed", bench_detector.seed, "Seed of the random weights");
   bd->add_flag("--json", bench_detector.json, "Print one JSON object instead of the table");
 
-  TrainingVerbs training(app);  // train, val, import-halmstad
-  LaunchVerbs launching(app);   // fly (with the simulator), demo-camera
-  ModelVerbs model_verbs(app);  // model widen-classes
+  ForwardedVerbs forwarded(app);  // train: runs in wingman-train (libtorch), so that wingman starts without it
+  TrainingVerbs training(app);    // val, import-halmstad
+  LaunchVerbs launching(app);     // fly (with the simulator), demo-camera
+  ModelVerbs model_verbs(app);    // model widen-classes
 #ifdef WINGMAN_WITH_SIM
   DatasetVerbs dataset(app);    // dataset synth
   ScenarioVerbs scenario(app);  // scenario random
@@ -261,6 +247,7 @@ int main(int argc, char** argv) {
     }
     return app.exit(e);
   }
+  if (const int rc = forwarded.run_if_chosen(argc, argv, std::cerr); rc >= 0) return rc;  // returns on failure only
   auto logger = spdlog::stderr_color_st("wingman");
   logger->set_pattern("%Y-%m-%dT%H:%M:%S.%e [%n] %^%l%$: %v");
   spdlog::set_default_logger(logger);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The training verbs of `wingman`: train (libtorch, WINGMAN_WITH_TRAINING), val and import-halmstad (always).
+// The training verbs of `wingman` that need no libtorch: val and import-halmstad (`train` runs in wingman-train).
 #pragma once
 
 #include <memory>
@@ -11,8 +11,8 @@ class App;
 
 namespace wingman::tools {
 
-/// Adds `train`, `val` and `import-halmstad` to the CLI and runs the one chosen. `train` without a libtorch build
-/// answers with how to get one.
+/// Adds `val` and `import-halmstad` to the CLI and runs the one chosen. `train` is wingman-train's (train_verb.hpp),
+/// which `wingman train` hands over to (forwarded_verbs.hpp).
 class TrainingVerbs {
  public:
   /// Registers the subcommands and their options on `app`.
