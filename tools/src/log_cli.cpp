@@ -1,23 +1,70 @@
 // SPDX-License-Identifier: MIT
-// The log verbs' command lines: `wingman replay`, `spy`, `make-video` and `loginfo`.
+// The log verbs' command lines: `wingman replay` (its options as data: --config, --set, --print-config), `spy`,
+// `make-video` and `loginfo`.
 #include "wingman/tools/log_cli.hpp"
 
+#include "verb_layers.hpp"
 #include "wingman/tools/log_info.hpp"
 #include "wingman/tools/make_video.hpp"
 #include "wingman/tools/replay.hpp"
 #include "wingman/tools/spy.hpp"
 
+#include <wingman/common/config.hpp>
+
 #include <exception>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 namespace wingman::tools {
 
+namespace {
+
+/// `wingman replay`'s options as keys.
+struct ReplayVerbOptions {
+  ReplayOptions replay;
+  bool quiet = false;  ///< no progress on stderr
+
+  template <class V>
+  void visit(V& v) {
+    v("input.log", replay.input_log, "the LCM log to play");
+    v("input.channels", replay.channels, "regular expression of channels to play; \"\" = all but STATUS_*");
+    v("input.exclude", replay.exclude, "regular expression of channels not to play (e.g. the stages' own outputs)");
+    v("input.max_events", replay.max_events, "play at most this many events; 0 = all");
+    v("input.skip_corrupt", replay.skip_corrupt,
+      "skip and count corrupt log events; false = stop at the first, naming its byte offset");
+    v("bus.lcm_url", replay.lcm_url, "LCM URL to publish on and listen to; \"\" = LCM_DEFAULT_URL");
+    v("lockstep.wait_for", replay.stages,
+      "process instance names (as in their status) to run in lockstep with; each must run with --lockstep");
+    v("lockstep.start_timeout_s", replay.start_timeout_s, "seconds to wait for every lockstep process to report");
+    v("lockstep.step_timeout_s", replay.step_timeout_s, "seconds to wait for the pipeline to settle after a message");
+    v("playback.speed", replay.speed, "without lockstep: 1 = real time, 0 = as fast as possible");
+    v("output.record", replay.record_log, "write every message seen on the bus (but status) to this LCM log");
+    v("output.quiet", quiet, "no progress on stderr");
+  }
+  /// ReplayOptions::validate()'s rules, every problem named by its key.
+  std::vector<std::string> validate() const {
+    using common::problem;
+    std::vector<std::string> p;
+    if (replay.input_log.empty()) p.emplace_back("input.log: give the log to play (LOG, or the key)");
+    if (replay.speed < 0) p.push_back(problem("playback.speed", replay.speed, "must be >= 0"));
+    if (replay.start_timeout_s <= 0)
+      p.push_back(problem("lockstep.start_timeout_s", replay.start_timeout_s, "must be > 0 seconds"));
+    if (replay.step_timeout_s <= 0)
+      p.push_back(problem("lockstep.step_timeout_s", replay.step_timeout_s, "must be > 0 seconds"));
+    if (replay.max_events < 0)
+      p.push_back(problem("input.max_events", static_cast<double>(replay.max_events), "must be >= 0"));
+    return p;
+  }
+};
+
+}  // namespace
+
 struct LogVerbs::State {
   CLI::App* replay = nullptr;
-  ReplayOptions replay_options;
-  bool replay_quiet = false;
+  ReplayVerbOptions replay_flags;  // what the flags say; replay runs with what its layers load
+  std::unique_ptr<VerbLayers> replay_layers;
   CLI::App* spy = nullptr;
   SpyOptions spy_options;
   CLI::App* video = nullptr;
@@ -28,10 +75,10 @@ struct LogVerbs::State {
 };
 
 LogVerbs::LogVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
-  ReplayOptions& replay = s_->replay_options;
+  ReplayOptions& replay = s_->replay_flags.replay;
   auto* r = s_->replay = app.add_subcommand(
       "replay", "Play an LCM log into the pipeline; with --wait-for, in lockstep with the named processes");
-  r->add_option("log", replay.input_log, "Input LCM log file")->required();
+  r->add_option("log", replay.input_log, "Input LCM log file");
   r->add_option("--lcm-url", replay.lcm_url, "LCM URL to publish on and listen to (empty: LCM_DEFAULT_URL)");
   r->add_option("--wait-for", replay.stages,
                 "Process instance names (as in their status) to run in lockstep with; each must run with --lockstep")
@@ -45,9 +92,24 @@ LogVerbs::LogVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   r->add_option("--step-timeout", replay.step_timeout_s,
                 "Seconds to wait for the pipeline to settle after each message");
   r->add_option("--max-events", replay.max_events, "Play at most this many events (0 = all)");
-  r->add_flag("--quiet", s_->replay_quiet, "No progress on stderr");
+  r->add_flag("--quiet", s_->replay_flags.quiet, "No progress on stderr");
   r->add_flag("--skip-corrupt", replay.skip_corrupt,
               "Skip and count corrupt log events (without it: stop at the first with an error naming its byte offset)");
+  s_->replay_layers = std::make_unique<VerbLayers>(r);
+  s_->replay_layers->keys({
+      {"log", "input.log", true},
+      {"--lcm-url", "bus.lcm_url", true},
+      {"--wait-for", "lockstep.wait_for", true},
+      {"--channels", "input.channels", true},
+      {"--exclude", "input.exclude", true},
+      {"--record", "output.record", true},
+      {"--speed", "playback.speed", false},
+      {"--start-timeout", "lockstep.start_timeout_s", false},
+      {"--step-timeout", "lockstep.step_timeout_s", false},
+      {"--max-events", "input.max_events", false},
+      {"--quiet", "output.quiet", false},
+      {"--skip-corrupt", "input.skip_corrupt", false},
+  });
 
   SpyOptions& spy = s_->spy_options;
   auto* s = s_->spy = app.add_subcommand("spy", "Start lcm-spy with the Wingman message types");
@@ -80,9 +142,11 @@ int LogVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   if (!*s_->replay && !*s_->spy && !*s_->video && !*s_->info) return -1;
   try {
     if (*s_->replay) {
-      ReplayOptions& o = s_->replay_options;
-      if (!s_->replay_quiet) o.progress = &err;
-      const ReplaySummary summary = run_replay(o);
+      int rc = -1;
+      auto o = s_->replay_layers->load_or_exit<ReplayVerbOptions>(out, err, &rc);
+      if (!o) return rc;
+      if (!o->quiet) o->replay.progress = &err;
+      const ReplaySummary summary = run_replay(o->replay);
       err << summary.one_line() << std::endl;
       return summary.ok ? 0 : 1;
     }

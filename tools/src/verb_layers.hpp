@@ -3,12 +3,17 @@
 // given on the command line as the last --set layer (they win), and --print-config.
 #pragma once
 
+#include "run_verb.hpp"
+
 #include <CLI/CLI.hpp>
 #include <wingman/common/config.hpp>
 
+#include <initializer_list>
+#include <optional>
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace wingman::tools {
@@ -38,6 +43,13 @@ class VerbLayers {
     keyed_.push_back({option, key, quote});
   }
 
+  /// key() for each (flag, key, quote), then check_every_flag(except).
+  void keys(std::initializer_list<std::tuple<const char*, const char*, bool>> keyed,
+            const std::vector<std::string>& except = {}) {
+    for (const auto& [flag, k, quote] : keyed) key(flag, k, quote);
+    check_every_flag(except);
+  }
+
   /// Throws std::logic_error naming a flag of the verb without a key (it would be parsed and ignored), but `except`.
   void check_every_flag(std::vector<std::string> except) const {
     except.insert(except.end(), {"--help", "--config", "--set", "--print-config"});
@@ -47,7 +59,7 @@ class VerbLayers {
       for (const auto& k : keyed_) known = known || k.option == opt;
       if (!known) {
         throw std::logic_error("wingman " + verb_->get_name() + ": the option " + opt->get_name() +
-                               " has no key (tools/src/launch_cli.cpp)");
+                               " has no key (VerbLayers::key)");
       }
     }
   }
@@ -79,10 +91,32 @@ class VerbLayers {
     Options options = common::load_options<Options>(s);
     *printed = print_config_;
     if (print_config_) {
-      out << common::print_options(
-          options, "wingman " + verb_->get_name() + ": the effective options (from " + s.describe() + ")");
+      out << common::print_options(options, command() + ": the effective options (from " + s.describe() + ")");
     }
     return options;
+  }
+
+  /// load() for a verb that runs with the options it returns: nullopt and `*rc` 0 after --print-config, or 2 after a
+  /// bad option (one line "wingman VERB: error: ..." on `err`, every bad key in it).
+  template <class Options>
+  std::optional<Options> load_or_exit(std::ostream& out, std::ostream& err, int* rc,
+                                      const std::vector<std::string>& extra = {}) const {
+    std::optional<Options> options;
+    *rc = run_verb(command(), err, [&] {
+      bool printed = false;
+      options = load<Options>(out, &printed, extra);
+      return printed ? 0 : -1;
+    });
+    if (*rc >= 0) return std::nullopt;
+    return options;
+  }
+
+  /// "wingman VERB" (with its parent verb: "wingman bench detector").
+  std::string command() const {
+    std::string c = verb_->get_name();
+    for (const CLI::App* p = verb_->get_parent(); p != nullptr; p = p->get_parent())
+      c = (p->get_parent() == nullptr ? std::string("wingman") : p->get_name()) + " " + c;
+    return c;
   }
 
   /// `text` as a double-quoted YAML scalar (backslashes and quotes escaped), read back as is.
