@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Every verb with its options as data takes `--config FILE` (repeatable), `--set KEY=VALUE` and `--print-config`
-# through common's one loader (issue #32): for each, the printed options read back as a file print the same, a flag
+# Every verb with its options as data (replay, localize, predict, eval, report, bench detector, import-halmstad,
+# scenario random and sweep here; fly, load and demo-camera in fly_config_test.sh) takes `--config FILE` (repeatable),
+# `--set KEY=VALUE` and `--print-config` through common's one loader (issue #32): for each, the printed options read back as a file print the same, a flag
 # wins over a file and over --set, a --set over a file, and bad keys are all named at once (exit 2). Nothing runs:
 # every call ends at --print-config or at the bad key.
 # Usage: verb_config_test.sh WINGMAN
@@ -15,19 +16,19 @@ fail() {
   failures=$((failures + 1))
 }
 
-# layers "VERB WORDS" "INPUT ARGS" SECTION.NAME --FLAG FILE_VALUE FLAG_VALUE SET_VALUE: the key's printed value after
-# each layering (values as --print-config prints them).
+# layers "VERB WORDS" "INPUT ARGS" SECTION.NAME --FLAG FILE_VALUE FLAG_VALUE SET_VALUE [text]: the key's printed value
+# after each layering (numbers as --print-config prints them; with `text`, the values are printed quoted).
 layers() {
-  local verb="$1" inputs="$2" key="$3" flag="$4" in_file="$5" in_flag="$6" in_set="$7"
+  local verb="$1" inputs="$2" key="$3" flag="$4" in_file="$5" in_flag="$6" in_set="$7" q=""
+  [ "${8:-}" != text ] || q='"'
   local section=${key%%.*} name=${key#*.} out rc err
-  local -a cmd words
+  local -a cmd
   read -r -a cmd <<<"$verb $inputs"
-  read -r -a words <<<"$verb"
   local before=$failures
   printf '%s:\n  %s: %s\n' "$section" "$name" "$in_file" >"$tmp/file.yaml"
   value() { sed -n "/^$section:/,/^\$/s/^  $name: //p" <<<"$1"; }
   expect() {  # WHAT WANT ARGS...
-    local what="$1" want="$2"
+    local what="$1" want="$q$2$q"
     shift 2
     if ! out=$("$wingman" "${cmd[@]}" "$@" --print-config 2>&1); then
       fail "wingman $verb: $what: exit non-zero: $out"
@@ -39,10 +40,10 @@ layers() {
   expect "--set over the file" "$in_set" --config "$tmp/file.yaml" --set "$key=$in_set"
   expect "the flag over the file" "$in_flag" --config "$tmp/file.yaml" "$flag" "$in_flag"
   expect "the flag over --set" "$in_flag" --config "$tmp/file.yaml" --set "$key=$in_set" "$flag" "$in_flag"
-  # The printed options are a file of this verb that gives the same options, inputs included (the header line names
-  # the sources).
+  # The printed options are a file of this verb that gives the same options (the header line names the sources; the
+  # inputs are given again: scenario random requires --seed and --out on the command line).
   "$wingman" "${cmd[@]}" --config "$tmp/file.yaml" "$flag" "$in_flag" --print-config >"$tmp/printed.yaml"
-  "$wingman" "${words[@]}" --config "$tmp/printed.yaml" --print-config >"$tmp/again.yaml" ||
+  "$wingman" "${cmd[@]}" --config "$tmp/printed.yaml" --print-config >"$tmp/again.yaml" ||
     fail "wingman $verb: its printed options do not read back"
   diff <(tail -n +2 "$tmp/printed.yaml") <(tail -n +2 "$tmp/again.yaml") >/dev/null ||
     fail "wingman $verb: its printed options read back differ: $(diff "$tmp/printed.yaml" "$tmp/again.yaml")"
@@ -68,6 +69,11 @@ layers "predict" "a.jpg images" detection.max_detections --max-detections 3 4 5
 layers "eval" "flight.lcmlog" eval.leader_id --leader-id 2 3 4
 layers "report" "flight.lcmlog -o report.html" report.frames --frames 2 3 4
 layers "bench detector" "" bench.repetitions --repetitions 2 3 4
+layers "import-halmstad" "halmstad dataset" sample.frame_step --frame-step 2 3 4
+if "$wingman" scenario --help >/dev/null 2>&1; then  # a build with the simulator
+  layers "scenario random" "--seed 5 --out $tmp/f.yaml" flight.airframe --airframe hex octo quad text
+  layers "scenario sweep" "--out $tmp/s.yaml" sweep.frames_per_step --frames-per-step 2 3 4
+fi
 
 # Text and list keys take the same way, and the inputs may come from a file alone.
 printf 'input:\n  log: "a flight.lcmlog"\neval:\n  range_bins_m: [1, 2]\nformation:\n  follower_set: [a.b=1]\n' \

@@ -6,6 +6,7 @@
 
 #include "run_verb.hpp"
 #include "synth_random.hpp"
+#include "verb_layers.hpp"
 
 #include <wingman/common/config.hpp>
 #include <wingman/common/json.hpp>
@@ -428,6 +429,99 @@ std::string scenario_value(const std::string& path, const std::string& key) {
 
 }  // namespace
 
+namespace {
+
+/// `wingman scenario random`'s options as keys (the seed as an int64_t: the loader's integer).
+struct RandomVerbOptions {
+  ScenarioRandomOptions random;
+  int64_t seed = static_cast<int64_t>(ScenarioRandomOptions{}.seed);
+
+  template <class V>
+  void visit(V& v) {
+    v("flight.seed", seed, "everything random (path, offset, airframe, scene) follows from it");
+    v("flight.airframe", random.airframe, "quad, hex or octo (procedural) or a mesh file");
+    v("flight.view", random.view, "behind (the leader's rear faces the camera) or side");
+    v("flight.lighting", random.lighting, "A (midday, clear) or B (evening, low sun, haze)");
+    v("random.duration_min_s", random.duration_min_s, "flight length drawn in [min, max], s");
+    v("random.duration_max_s", random.duration_max_s, "the range's upper end");
+    v("random.speed_min_mps", random.speed_min_mps, "each leg's cruise speed drawn in [min, max], m/s");
+    v("random.speed_max_mps", random.speed_max_mps, "the range's upper end");
+    v("random.offset_min_m", random.offset_min_m, "follower-to-leader distance drawn in [min, max], m");
+    v("random.offset_max_m", random.offset_max_m, "the range's upper end");
+    v("random.offset_elevation_max_deg", random.offset_elevation_max_deg,
+      "the follower within +-this above or below the leader, degrees");
+    v("random.altitude_min_m", random.altitude_min_m, "the leader's height stays in [min, max], m");
+    v("random.altitude_max_m", random.altitude_max_m, "the range's upper end");
+    v("random.leg_min_m", random.leg_min_m, "horizontal length of each leg of the leader's path in [min, max], m");
+    v("random.leg_max_m", random.leg_max_m, "the range's upper end");
+    v("random.climb_max", random.climb_max, "a leg climbs or descends by up to this fraction of its length");
+    v("random.accel_mps2", random.accel_mps2, "the leader's acceleration at the ends of each leg, m/s^2");
+    v("output.scenario", random.out, "the scenario file to write, FILE.yaml (its configs beside it)");
+  }
+  std::vector<std::string> validate() const {
+    std::vector<std::string> p =
+        named_by_key(random.validate(), {{"--view", "flight.view"},
+                                         {"--lighting", "flight.lighting"},
+                                         {"--airframe", "flight.airframe"},
+                                         {"--out", "output.scenario"},
+                                         {"duration_min_s", "random.duration_min_s"},
+                                         {"speed_min_mps", "random.speed_min_mps"},
+                                         {"offset_min_m", "random.offset_min_m"},
+                                         {"altitude_min_m", "random.altitude_min_m"},
+                                         {"leg_min_m", "random.leg_min_m"},
+                                         {"offset_elevation_max_deg", "random.offset_elevation_max_deg"},
+                                         {"climb_max", "random.climb_max"},
+                                         {"accel_mps2", "random.accel_mps2"}});
+    if (seed < 0) p.push_back(common::problem("flight.seed", static_cast<double>(seed), "must be >= 0"));
+    return p;
+  }
+  ScenarioRandomOptions options() const {
+    ScenarioRandomOptions o = random;
+    o.seed = static_cast<uint64_t>(seed);
+    return o;
+  }
+};
+
+/// `wingman scenario sweep`'s options as keys.
+struct SweepVerbOptions {
+  ScenarioSweepOptions sweep;
+  int64_t seed = static_cast<int64_t>(ScenarioSweepOptions{}.seed);
+
+  template <class V>
+  void visit(V& v) {
+    v("sweep.airframe", sweep.airframe, "quad, hex or octo (procedural, drawn with sweep.seed) or a mesh file");
+    v("sweep.seed", seed, "seed of a procedural airframe, the scene and the image noise");
+    v("sweep.view", sweep.view, "behind (the rear faces the camera) or side");
+    v("sweep.lighting", sweep.lighting, "A (midday) or B (evening)");
+    v("sweep.from_m", sweep.from_m, "first distance, camera to the target's centre, m");
+    v("sweep.to_m", sweep.to_m, "last distance, m");
+    v("sweep.step_m", sweep.step_m, "distance added at each step, m");
+    v("sweep.frames_per_step", sweep.frames_per_step, "frames at each distance");
+    v("sweep.height_m", sweep.height_m, "both vehicles at this height (the target seen level), m");
+    v("output.scenario", sweep.out, "the scenario file to write, FILE.yaml (its configs beside it)");
+  }
+  std::vector<std::string> validate() const {
+    std::vector<std::string> p = named_by_key(sweep.validate(), {{"--view", "sweep.view"},
+                                                                 {"--lighting", "sweep.lighting"},
+                                                                 {"--airframe", "sweep.airframe"},
+                                                                 {"--out", "output.scenario"},
+                                                                 {"--from", "sweep.from_m"},
+                                                                 {"--to", "sweep.to_m"},
+                                                                 {"--step", "sweep.step_m"},
+                                                                 {"--frames-per-step", "sweep.frames_per_step"},
+                                                                 {"height_m", "sweep.height_m"}});
+    if (seed < 0) p.push_back(common::problem("sweep.seed", static_cast<double>(seed), "must be >= 0"));
+    return p;
+  }
+  ScenarioSweepOptions options() const {
+    ScenarioSweepOptions o = sweep;
+    o.seed = static_cast<uint64_t>(seed);
+    return o;
+  }
+};
+
+}  // namespace
+
 struct ScenarioVerbs::State {
   CLI::App* random = nullptr;
   CLI::App* sweep = nullptr;
@@ -435,8 +529,9 @@ struct ScenarioVerbs::State {
   std::string get_file, get_key;
   CLI::App* set = nullptr;
   ScenarioSetOptions set_options;
-  ScenarioRandomOptions options;
-  ScenarioSweepOptions sweep_options;
+  ScenarioRandomOptions options;       // what the flags say; random runs with what its layers load
+  ScenarioSweepOptions sweep_options;  // likewise
+  std::unique_ptr<VerbLayers> random_layers, sweep_layers;
 };
 
 ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
@@ -456,6 +551,14 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->random->add_option("--view", o.view, "behind (the leader's rear faces the camera) or side");
   s_->random->add_option("--lighting", o.lighting, "A (midday, clear) or B (evening, low sun, haze)");
   s_->random->add_option("--out", o.out, "The scenario file to write, FILE.yaml")->required();
+  s_->random_layers = std::make_unique<VerbLayers>(s_->random);
+  s_->random_layers->keys({
+      {"--seed", "flight.seed", false},
+      {"--airframe", "flight.airframe", true},
+      {"--view", "flight.view", true},
+      {"--lighting", "flight.lighting", true},
+      {"--out", "output.scenario", true},
+  });
 
   ScenarioSweepOptions& w = s_->sweep_options;
   s_->sweep = scenario->add_subcommand(
@@ -472,6 +575,18 @@ ScenarioVerbs::ScenarioVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s_->sweep->add_option("--step", w.step_m, "Step, m");
   s_->sweep->add_option("--frames-per-step", w.frames_per_step, "Frames at each distance");
   s_->sweep->add_option("--out", w.out, "The scenario file to write, FILE.yaml")->required();
+  s_->sweep_layers = std::make_unique<VerbLayers>(s_->sweep);
+  s_->sweep_layers->keys({
+      {"--airframe", "sweep.airframe", true},
+      {"--seed", "sweep.seed", false},
+      {"--view", "sweep.view", true},
+      {"--lighting", "sweep.lighting", true},
+      {"--from", "sweep.from_m", false},
+      {"--to", "sweep.to_m", false},
+      {"--step", "sweep.step_m", false},
+      {"--frames-per-step", "sweep.frames_per_step", false},
+      {"--out", "output.scenario", true},
+  });
 
   s_->get = scenario->add_subcommand(
       "get", "Print one top-level value of a scenario file, read (and checked) with wingman-sim's scenario loader");
@@ -510,8 +625,11 @@ int ScenarioVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     });
   }
   if (*s_->sweep) {
+    int rc = -1;
+    const auto o = s_->sweep_layers->load_or_exit<SweepVerbOptions>(out, err, &rc);
+    if (!o) return rc;
     return run_verb("wingman scenario sweep", err, [&] {
-      const ScenarioRandomResult r = write_sweep_scenario(s_->sweep_options);
+      const ScenarioRandomResult r = write_sweep_scenario(o->options());
       out << fmt::format("wrote {} ({} steps, {}, bounding radius {:.3f} m) and its configs", r.scenario_path, r.legs,
                          r.airframe, r.bounding_radius_m)
           << std::endl;
@@ -519,8 +637,11 @@ int ScenarioVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     });
   }
   if (!*s_->random) return -1;
+  int rc = -1;
+  const auto o = s_->random_layers->load_or_exit<RandomVerbOptions>(out, err, &rc);
+  if (!o) return rc;
   return run_verb("wingman scenario random", err, [&] {
-    out << write_random_scenario(s_->options).one_line() << std::endl;
+    out << write_random_scenario(o->options()).one_line() << std::endl;
     return 0;
   });
 }

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// `wingman val`, `wingman import-halmstad`: command lines over the training library (`train`: train_verb.cpp).
+// `wingman val`, `wingman import-halmstad` (its options as data: --config, --set, --print-config): command lines over
+// the training library (`train`: train_verb.cpp).
 #include "wingman/tools/train_cli.hpp"
 
 #include "run_verb.hpp"
+#include "verb_layers.hpp"
 
 #include <wingman/common/progress.hpp>
 #include <wingman/detector/darknet_cfg.hpp>
@@ -14,12 +16,54 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <cstdint>
 #include <fstream>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace wingman::tools {
+
+namespace {
+
+/// `wingman import-halmstad`'s options as keys (the seed as an int64_t: the loader's integer).
+struct ImportVerbOptions {
+  training::HalmstadImportOptions import;
+  int64_t seed = static_cast<int64_t>(training::HalmstadImportOptions{}.seed);
+
+  template <class V>
+  void visit(V& v) {
+    v("input.root", import.root, "the dataset folder (clips.csv, videos/, labels/)");
+    v("input.clips", import.clips, "only these clips (names as in clips.csv); [] = all");
+    v("input.exclude", import.exclude, "leave out these clips");
+    v("sample.frame_step", import.frame_step, "every n-th frame of drone clips");
+    v("sample.negative_frame_step", import.negative_frame_step, "every n-th frame of airplane/bird/helicopter clips");
+    v("sample.negatives", import.negatives, "include the airplane/bird/helicopter clips");
+    v("sample.distractor_classes", import.distractor_classes,
+      "label the airplane/bird/helicopter clips' boxes as classes 1, 2, 3 instead of empty negatives");
+    v("sample.max_frames_per_clip", import.max_frames_per_clip, "at most this many frames per clip; 0 = all");
+    v("split.val_fraction", import.val_fraction, "share of clips in val, per class and distance");
+    v("split.seed", seed, "seed of the clip split");
+    v("boxes.tighten", import.tighten, "tighten each drone box; false = keep the loose boxes as labelled");
+    v("output.dir", import.out_dir, "the YOLO dataset to write");
+    v("output.jpeg_quality", import.jpeg_quality, "quality of the written frames, 1..100");
+  }
+  std::vector<std::string> validate() const {
+    std::vector<std::string> p = named_by_key(import.validate(), {{"root", "input.root"},
+                                                                  {"out_dir", "output.dir"},
+                                                                  {"frame_step", "sample.frame_step"},
+                                                                  {"negative_frame_step", "sample.negative_frame_step"},
+                                                                  {"max_frames_per_clip", "sample.max_frames_per_clip"},
+                                                                  {"val_fraction", "split.val_fraction"},
+                                                                  {"jpeg_quality", "output.jpeg_quality"},
+                                                                  {"distractor_classes", "sample.distractor_classes"}});
+    if (seed < 0) p.push_back(common::problem("split.seed", static_cast<double>(seed), "must be >= 0"));
+    return p;
+  }
+};
+
+}  // namespace
 
 struct TrainingVerbs::State {
   CLI::App* val = nullptr;
@@ -36,8 +80,9 @@ struct TrainingVerbs::State {
   bool val_sequences = false;
   training::SequenceEvalOptions sequences;
 
-  training::HalmstadImportOptions import;
+  ImportVerbOptions import_flags;  // what the flags say; the import runs with what its layers load
   bool no_tighten = false, no_negatives = false;
+  std::unique_ptr<VerbLayers> import_layers;
 };
 
 TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
@@ -122,10 +167,9 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.halmstad = app.add_subcommand(
       "import-halmstad", "Sample the Halmstad drone videos into a YOLO dataset (split by clip, tightened boxes)");
   auto* h = s.halmstad;
-  training::HalmstadImportOptions& io = s.import;
-  h->add_option("root", io.root, "The dataset folder (clips.csv, videos/, labels/), e.g. ../shared/datasets/halmstad")
-      ->required();
-  h->add_option("out", io.out_dir, "The YOLO dataset to write")->required();
+  training::HalmstadImportOptions& io = s.import_flags.import;
+  h->add_option("root", io.root, "The dataset folder (clips.csv, videos/, labels/), e.g. ../shared/datasets/halmstad");
+  h->add_option("out", io.out_dir, "The YOLO dataset to write");
   h->add_option("--frame-step", io.frame_step, "Every n-th frame of drone clips");
   h->add_option("--negative-frame-step", io.negative_frame_step, "Every n-th frame of airplane/bird/helicopter clips");
   h->add_flag("--no-negatives", s.no_negatives, "Leave out the airplane/bird/helicopter clips");
@@ -138,6 +182,22 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   h->add_option("--clips", io.clips, "Only these clips (comma-separated names)")->delimiter(',');
   h->add_option("--exclude", io.exclude, "Leave out these clips")->delimiter(',');
   h->add_option("--jpeg-quality", io.jpeg_quality, "Quality of the written frames");
+  s.import_layers = std::make_unique<VerbLayers>(h);
+  s.import_layers->keys(
+      {
+          {"root", "input.root", true},
+          {"out", "output.dir", true},
+          {"--frame-step", "sample.frame_step", false},
+          {"--negative-frame-step", "sample.negative_frame_step", false},
+          {"--distractor-classes", "sample.distractor_classes", false},
+          {"--max-frames-per-clip", "sample.max_frames_per_clip", false},
+          {"--val-fraction", "split.val_fraction", false},
+          {"--seed", "split.seed", false},
+          {"--clips", "input.clips", true},
+          {"--exclude", "input.exclude", true},
+          {"--jpeg-quality", "output.jpeg_quality", false},
+      },
+      {"--no-negatives", "--no-tighten"});  // sample.negatives and boxes.tighten, false
 }
 
 TrainingVerbs::~TrainingVerbs() = default;
@@ -209,18 +269,24 @@ int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     });
   }
   if (*s.halmstad) {
-    s.import.tighten = !s.no_tighten;
-    s.import.negatives = !s.no_negatives;
+    std::vector<std::string> off;  // the two flags that turn a key off
+    if (s.no_negatives) off.emplace_back("sample.negatives=false");
+    if (s.no_tighten) off.emplace_back("boxes.tighten=false");
+    int rc = -1;
+    const auto loaded = s.import_layers->load_or_exit<ImportVerbOptions>(out, err, &rc, off);
+    if (!loaded) return rc;
+    training::HalmstadImportOptions import = loaded->import;
+    import.seed = static_cast<uint64_t>(loaded->seed);
     return run_verb("wingman import-halmstad", err, [&] {
       std::optional<common::Progress> clips;  // the number of clips is known once clips.csv is read
       const training::HalmstadImportSummary summary = training::import_halmstad(
-          s.import, [&](const std::string& line) { err << "wingman import-halmstad: " << line << "\n"; },
+          import, [&](const std::string& line) { err << "wingman import-halmstad: " << line << "\n"; },
           [&](size_t done, size_t total) {
             if (!clips) clips.emplace("wingman import-halmstad", static_cast<int64_t>(total), "clips", &err);
             clips->update(static_cast<int64_t>(done));
           });
       if (clips) clips->finish();
-      out << summary.report() << "wrote " << s.import.out_dir << "/data.yaml\n" << std::flush;
+      out << summary.report() << "wrote " << import.out_dir << "/data.yaml\n" << std::flush;
       return 0;
     });
   }

@@ -13,10 +13,28 @@
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace wingman::tools {
+
+/// `problems` as a library's validate() words them (each line beginning with a field's or a flag's name), with each
+/// name of `to_key` at the start of a line replaced by its key: the lines a verb's validate() returns.
+inline std::vector<std::string> named_by_key(
+    std::vector<std::string> problems, std::initializer_list<std::pair<std::string_view, std::string_view>> to_key) {
+  for (std::string& line : problems) {
+    for (const auto& [name, key] : to_key) {
+      const bool starts = line.compare(0, name.size(), name) == 0 &&
+                          (line.size() == name.size() || line[name.size()] == ' ' || line[name.size()] == ':');
+      if (!starts) continue;
+      line = std::string(key) + line.substr(name.size());
+      break;
+    }
+  }
+  return problems;
+}
 
 /// Layers for one verb whose options struct has visit() and validate(). Each flag of the verb is bound to a CLI
 /// variable as usual and registered with its key; after the parse, load() reads the options from the defaults, the
