@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Every verb with its options as data (replay, localize, predict, eval, report, bench detector, import-halmstad,
-# scenario random and sweep here; fly, load and demo-camera in fly_config_test.sh) takes `--config FILE` (repeatable),
+# scenario random and sweep, dataset synth here; fly, load and demo-camera in fly_config_test.sh) takes `--config FILE` (repeatable),
 # `--set KEY=VALUE` and `--print-config` through common's one loader (issue #32): for each, the printed options read back as a file print the same, a flag
 # wins over a file and over --set, a --set over a file, and bad keys are all named at once (exit 2). Nothing runs:
 # every call ends at --print-config or at the bad key.
@@ -73,6 +73,7 @@ layers "import-halmstad" "halmstad dataset" sample.frame_step --frame-step 2 3 4
 if "$wingman" scenario --help >/dev/null 2>&1; then  # a build with the simulator
   layers "scenario random" "--seed 5 --out $tmp/f.yaml" flight.airframe --airframe hex octo quad text
   layers "scenario sweep" "--out $tmp/s.yaml" sweep.frames_per_step --frames-per-step 2 3 4
+  layers "dataset synth" "--out $tmp/d --count 3" dataset.seed --seed 5 6 7
 fi
 
 # Text and list keys take the same way, and the inputs may come from a file alone.

@@ -6,6 +6,7 @@
 
 #include "run_verb.hpp"
 #include "synth_random.hpp"
+#include "verb_layers.hpp"
 
 #include <wingman/common/config.hpp>
 #include <wingman/common/json.hpp>
@@ -309,11 +310,18 @@ common::Json sphere_box_json(const geometry::CameraModel& camera, const Eigen::V
 }  // namespace
 
 DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress) {
-  const auto start = std::chrono::steady_clock::now();
   if (request.count <= 0) throw std::invalid_argument(fmt::format("--count {}: must be > 0", request.count));
   if (request.out_dir.empty()) throw std::invalid_argument("--out: a dataset folder is required");
   DatasetSynthConfig config;  // the defaults are valid (tested)
   if (!request.config.empty()) config = common::load_options<DatasetSynthConfig>(request.config);
+  return run_dataset_synth(request, config, progress);
+}
+
+DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const DatasetSynthConfig& config,
+                                      std::ostream& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (request.count <= 0) throw std::invalid_argument(fmt::format("--count {}: must be > 0", request.count));
+  if (request.out_dir.empty()) throw std::invalid_argument("--out: a dataset folder is required");
   const fs::path out(request.out_dir);
   if (fs::exists(out / "images") && !fs::is_empty(out / "images")) {
     throw std::runtime_error(
@@ -482,10 +490,48 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::o
   return summary;
 }
 
+namespace {
+
+/// `wingman dataset synth`'s options as keys: the run's dataset.* and the configuration's synth.* and render.* (the
+/// seed as an int64_t: the loader's integer).
+struct SynthVerbOptions {
+  std::string out;
+  int count = 0;
+  int64_t seed = static_cast<int64_t>(DatasetSynthRequest{}.seed);
+  std::vector<std::string> meshes;
+  DatasetSynthConfig config;
+
+  template <class V>
+  void visit(V& v) {
+    v("dataset.out", out, "dataset folder to create (must not hold images yet)");
+    v("dataset.count", count, "number of images");
+    v("dataset.seed", seed, "the same seed gives the same dataset");
+    v("dataset.meshes", meshes, "airframe mesh files or folders, e.g. ../shared/meshes");
+    config.visit(v);
+  }
+  std::vector<std::string> validate() const {
+    std::vector<std::string> p = config.validate();
+    if (out.empty()) p.emplace_back("dataset.out: give the dataset folder (--out, or the key)");
+    if (count <= 0) p.push_back(common::problem("dataset.count", count, "must be > 0"));
+    if (seed < 0) p.push_back(common::problem("dataset.seed", static_cast<double>(seed), "must be >= 0"));
+    return p;
+  }
+  DatasetSynthRequest request() const {
+    DatasetSynthRequest r;
+    r.out_dir = out;
+    r.count = count;
+    r.seed = static_cast<uint64_t>(seed);
+    r.meshes = meshes;
+    return r;
+  }
+};
+
+}  // namespace
+
 struct DatasetVerbs::State {
   CLI::App* synth = nullptr;
-  DatasetSynthRequest request;
-  bool print_config = false;
+  DatasetSynthRequest request;  // what the flags say; synth runs with what its layers load
+  std::unique_ptr<VerbLayers> synth_layers;
   CLI::App* from_log = nullptr;
   DatasetFromLogRequest from_log_request;
   bool skip_negatives = false;
@@ -502,10 +548,15 @@ DatasetVerbs::DatasetVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       ->required();
   s_->synth->add_option("--count", s_->request.count, "Number of images")->required()->check(CLI::PositiveNumber);
   s_->synth->add_option("--seed", s_->request.seed, "Seed: the same seed gives the same dataset");
-  s_->synth->add_option("--config", s_->request.config, "YAML with synth.* and render.* keys (see --print-config)");
   s_->synth->add_option("--meshes", s_->request.meshes,
                         "Airframe mesh file or folder (repeatable), e.g. ../shared/meshes");
-  s_->synth->add_flag("--print-config", s_->print_config, "Print the effective configuration and exit");
+  s_->synth_layers = std::make_unique<VerbLayers>(s_->synth);  // --config: synth.* and render.* keys too
+  s_->synth_layers->keys({
+      {"--out", "dataset.out", true},
+      {"--count", "dataset.count", false},
+      {"--seed", "dataset.seed", false},
+      {"--meshes", "dataset.meshes", true},
+  });
 
   DatasetFromLogRequest& f = s_->from_log_request;
   s_->from_log = dataset->add_subcommand(
@@ -536,14 +587,11 @@ int DatasetVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
     });
   }
   if (!*s_->synth) return -1;
+  int rc = -1;
+  const auto o = s_->synth_layers->load_or_exit<SynthVerbOptions>(out, err, &rc);
+  if (!o) return rc;
   return run_verb("wingman dataset synth", err, [&] {
-    if (s_->print_config) {
-      DatasetSynthConfig config;
-      if (!s_->request.config.empty()) config = common::load_options<DatasetSynthConfig>(s_->request.config);
-      out << common::print_options(config, "wingman dataset synth: effective configuration");
-      return 0;
-    }
-    out << run_dataset_synth(s_->request, err).one_line() << std::endl;
+    out << run_dataset_synth(o->request(), o->config, err).one_line() << std::endl;
     return 0;
   });
 }

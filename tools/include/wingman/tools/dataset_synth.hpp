@@ -129,6 +129,9 @@ struct DatasetSynthSummary {
 /// the config, the meshes and i. Progress lines go to `progress` about once a second.
 /// Throws common::ConfigError for a bad config, std::runtime_error naming the file or folder for I/O problems.
 DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress);
+/// The same with `config` (validated) in place of the file `request.config` (the CLI's layers: --config, --set).
+DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const DatasetSynthConfig& config,
+                                      std::ostream& progress);
 
 /// Adds `dataset synth` and `dataset from-log` to the CLI and runs the one chosen.
 class DatasetVerbs {
