@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Every verb with its options as data (replay, localize, predict, eval, report, bench detector, import-halmstad,
-# scenario random and sweep, dataset synth here; fly, load and demo-camera in fly_config_test.sh) takes `--config FILE` (repeatable),
-# `--set KEY=VALUE` and `--print-config` through common's one loader (issue #32): for each, the printed options read back as a file print the same, a flag
-# wins over a file and over --set, a --set over a file, and bad keys are all named at once (exit 2). Nothing runs:
-# every call ends at --print-config or at the bad key.
+# Every verb with its options as data (replay, loginfo, make-video, spy, localize, predict, eval, report, bench
+# detector, import-halmstad, scenario random and sweep, dataset synth here; fly, load and demo-camera in
+# fly_config_test.sh) takes `--config FILE` (repeatable), `--set KEY=VALUE` and `--print-config` through common's one
+# loader (issue #32): for each, the printed options read back as a file print the same, a flag wins over a file and
+# over --set, a --set over a file, and bad keys are all named at once (exit 2). Nothing runs: every call ends at
+# --print-config or at the bad key.
 # Usage: verb_config_test.sh WINGMAN
 set -euo pipefail
 wingman="$1"
@@ -64,6 +65,9 @@ layers() {
 }
 
 layers "replay" "flight.lcmlog" input.max_events --max-events 5 7 9
+layers "loginfo" "flight.lcmlog" output.snapshot --snapshot a.png b.png c.png text
+layers "make-video" "clip.avi" video.frames --frames 2 3 4
+layers "spy" "" spy.java --java java8 java11 java17 text
 layers "localize" "cam.yaml --box 1,2,3,4" border.margin_px --border-margin 2.5 3.5 4.5
 layers "predict" "a.jpg images" detection.max_detections --max-detections 3 4 5
 layers "eval" "flight.lcmlog" eval.leader_id --leader-id 2 3 4

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The log verbs' command lines: `wingman replay` (its options as data: --config, --set, --print-config), `spy`,
-// `make-video` and `loginfo`.
+// The log verbs' command lines: `wingman replay`, `spy`, `make-video` and `loginfo`, each with its options as data
+// (--config FILE, --set KEY=VALUE, --print-config: VerbLayers).
 #include "wingman/tools/log_cli.hpp"
 
 #include "verb_layers.hpp"
@@ -59,6 +59,69 @@ struct ReplayVerbOptions {
   }
 };
 
+/// `wingman spy`'s options as keys.
+struct SpyVerbOptions {
+  SpyOptions spy;
+
+  template <class V>
+  void visit(V& v) {
+    v("bus.lcm_url", spy.lcm_url, "LCM URL to listen on; \"\" = LCM_DEFAULT_URL");
+    v("spy.java", spy.java, "Java runtime");
+    v("spy.types_jar", spy.types_jar, "jar with the wingman message classes; \"\" = the built one");
+    v("spy.dry_run", spy.dry_run, "print the java command instead of running it");
+  }
+  std::vector<std::string> validate() const {
+    if (spy.java.empty()) return {"spy.java: must not be empty"};
+    return {};
+  }
+};
+
+/// `wingman make-video`'s options as keys.
+struct MakeVideoVerbOptions {
+  MakeVideoOptions video;
+
+  template <class V>
+  void visit(V& v) {
+    v("output.file", video.output, "the .avi file to write (MJPG)");
+    v("video.frames", video.frames, "number of frames, 1..100000");
+    v("video.width", video.width, "width, pixels, 16..8192");
+    v("video.height", video.height, "height, pixels, 16..8192");
+    v("video.fps", video.fps, "frames per second, (0, 1000]");
+  }
+  /// MakeVideoOptions::validate()'s rules, every problem named by its key.
+  std::vector<std::string> validate() const {
+    using common::problem;
+    std::vector<std::string> p;
+    if (video.output.empty()) p.emplace_back("output.file: give the file to write (OUTPUT, or the key)");
+    if (video.frames < 1 || video.frames > 100000)
+      p.push_back(problem("video.frames", video.frames, "must be 1..100000"));
+    if (video.width < 16 || video.width > 8192) p.push_back(problem("video.width", video.width, "must be 16..8192"));
+    if (video.height < 16 || video.height > 8192)
+      p.push_back(problem("video.height", video.height, "must be 16..8192"));
+    if (!(video.fps > 0 && video.fps <= 1000)) p.push_back(problem("video.fps", video.fps, "must be in (0, 1000]"));
+    return p;
+  }
+};
+
+/// `wingman loginfo`'s options as keys.
+struct LogInfoVerbOptions {
+  std::string log;
+  std::string snapshot;
+  bool skip_corrupt = false;
+
+  template <class V>
+  void visit(V& v) {
+    v("input.log", log, "the LCM log to summarize");
+    v("input.skip_corrupt", skip_corrupt,
+      "skip and count corrupt log events; false = stop at the first, naming its byte offset");
+    v("output.snapshot", snapshot, "save the last image_t as this PNG file; \"\" = none");
+  }
+  std::vector<std::string> validate() const {
+    if (log.empty()) return {"input.log: give the log (LOG, or the key)"};
+    return {};
+  }
+};
+
 }  // namespace
 
 struct LogVerbs::State {
@@ -66,12 +129,14 @@ struct LogVerbs::State {
   ReplayVerbOptions replay_flags;  // what the flags say; replay runs with what its layers load
   std::unique_ptr<VerbLayers> replay_layers;
   CLI::App* spy = nullptr;
-  SpyOptions spy_options;
+  SpyVerbOptions spy_flags;
+  std::unique_ptr<VerbLayers> spy_layers;
   CLI::App* video = nullptr;
-  MakeVideoOptions video_options;
+  MakeVideoVerbOptions video_flags;
+  std::unique_ptr<VerbLayers> video_layers;
   CLI::App* info = nullptr;
-  std::string info_log, info_snapshot;
-  bool info_skip_corrupt = false;
+  LogInfoVerbOptions info_flags;
+  std::unique_ptr<VerbLayers> info_layers;
 };
 
 LogVerbs::LogVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
@@ -111,29 +176,50 @@ LogVerbs::LogVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
       {"--skip-corrupt", "input.skip_corrupt", false},
   });
 
-  SpyOptions& spy = s_->spy_options;
+  SpyOptions& spy = s_->spy_flags.spy;
   auto* s = s_->spy = app.add_subcommand("spy", "Start lcm-spy with the Wingman message types");
   s->add_option("--lcm-url", spy.lcm_url, "LCM URL to listen on (empty: LCM_DEFAULT_URL)");
   s->add_option("--java", spy.java, "Java runtime");
   s->add_option("--types-jar", spy.types_jar, "Jar with the wingman message classes (empty: the built one)");
   s->add_flag("--dry-run", spy.dry_run, "Print the java command instead of running it");
+  s_->spy_layers = std::make_unique<VerbLayers>(s);
+  s_->spy_layers->keys({
+      {"--lcm-url", "bus.lcm_url", true},
+      {"--java", "spy.java", true},
+      {"--types-jar", "spy.types_jar", true},
+      {"--dry-run", "spy.dry_run", false},
+  });
 
-  MakeVideoOptions& video = s_->video_options;
+  MakeVideoOptions& video = s_->video_flags.video;
   auto* mv = s_->video =
       app.add_subcommand("make-video", "Write a synthetic test clip (MJPG .avi) for the camera driver's file source");
-  mv->add_option("output", video.output, "Output .avi file")->required();
+  mv->add_option("output", video.output, "Output .avi file");
   mv->add_option("--frames", video.frames, "Number of frames");
   mv->add_option("--width", video.width, "Width, pixels");
   mv->add_option("--height", video.height, "Height, pixels");
   mv->add_option("--fps", video.fps, "Frames per second");
+  s_->video_layers = std::make_unique<VerbLayers>(mv);
+  s_->video_layers->keys({
+      {"output", "output.file", true},
+      {"--frames", "video.frames", false},
+      {"--width", "video.width", false},
+      {"--height", "video.height", false},
+      {"--fps", "video.fps", false},
+  });
 
   auto* li = s_->info =
       app.add_subcommand("loginfo", "Summarize an LCM log: channels, types, counts, time spans, process statuses");
-  li->add_option("log", s_->info_log, "LCM log file")->required();
-  li->add_option("--snapshot", s_->info_snapshot, "Save the last image_t as this PNG file");
+  li->add_option("log", s_->info_flags.log, "LCM log file");
+  li->add_option("--snapshot", s_->info_flags.snapshot, "Save the last image_t as this PNG file");
   li->add_flag(
-      "--skip-corrupt", s_->info_skip_corrupt,
+      "--skip-corrupt", s_->info_flags.skip_corrupt,
       "Skip and count corrupt log events (without it: stop at the first with an error naming its byte offset)");
+  s_->info_layers = std::make_unique<VerbLayers>(li);
+  s_->info_layers->keys({
+      {"log", "input.log", true},
+      {"--snapshot", "output.snapshot", true},
+      {"--skip-corrupt", "input.skip_corrupt", false},
+  });
 }
 
 LogVerbs::~LogVerbs() = default;
@@ -150,16 +236,26 @@ int LogVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
       err << summary.one_line() << std::endl;
       return summary.ok ? 0 : 1;
     }
-    if (*s_->spy) return run_spy(s_->spy_options);
+    if (*s_->spy) {
+      int rc = -1;
+      const auto o = s_->spy_layers->load_or_exit<SpyVerbOptions>(out, err, &rc);
+      return o ? run_spy(o->spy) : rc;
+    }
     if (*s_->video) {
-      make_video(s_->video_options);
-      err << "wrote " << s_->video_options.frames << " frames to " << s_->video_options.output << std::endl;
+      int rc = -1;
+      const auto o = s_->video_layers->load_or_exit<MakeVideoVerbOptions>(out, err, &rc);
+      if (!o) return rc;
+      make_video(o->video);
+      err << "wrote " << o->video.frames << " frames to " << o->video.output << std::endl;
       return 0;
     }
-    const LogSummary summary = summarize_log(s_->info_log, s_->info_snapshot, s_->info_skip_corrupt, &err);
+    int rc = -1;
+    const auto o = s_->info_layers->load_or_exit<LogInfoVerbOptions>(out, err, &rc);
+    if (!o) return rc;
+    const LogSummary summary = summarize_log(o->log, o->snapshot, o->skip_corrupt, &err);
     out << summary.report() << std::flush;
-    if (!s_->info_snapshot.empty() && summary.images_with_pixels > 0)
-      out << "last image saved to " << s_->info_snapshot << std::endl;
+    if (!o->snapshot.empty() && summary.images_with_pixels > 0)
+      out << "last image saved to " << o->snapshot << std::endl;
     return 0;
   } catch (const std::exception& e) {
     err << "wingman: error: " << e.what() << std::endl;
