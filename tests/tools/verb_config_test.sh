@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Every verb with its options as data (replay, loginfo, make-video, spy, localize, predict, eval, report, bench
-# detector, import-halmstad, scenario random and sweep, dataset synth here; fly, load and demo-camera in
+# detector, val, import-halmstad, scenario random and sweep, dataset synth here; fly, load and demo-camera in
 # fly_config_test.sh) takes `--config FILE` (repeatable), `--set KEY=VALUE` and `--print-config` through common's one
 # loader (issue #32): for each, the printed options read back as a file print the same, a flag wins over a file and
 # over --set, a --set over a file, and bad keys are all named at once (exit 2). Nothing runs: every call ends at
@@ -74,6 +74,7 @@ layers "eval" "flight.lcmlog" eval.leader_id --leader-id 2 3 4
 layers "report" "flight.lcmlog -o report.html" report.frames --frames 2 3 4
 layers "bench detector" "" bench.repetitions --repetitions 2 3 4
 layers "import-halmstad" "halmstad dataset" sample.frame_step --frame-step 2 3 4
+layers "val" "--data data.yaml" input.max_images --max-images 2 3 4
 if "$wingman" scenario --help >/dev/null 2>&1; then  # a build with the simulator
   layers "scenario random" "--seed 5 --out $tmp/f.yaml" flight.airframe --airframe hex octo quad text
   layers "scenario sweep" "--out $tmp/s.yaml" sweep.frames_per_step --frames-per-step 2 3 4

@@ -13,6 +13,7 @@
 #include <wingman/training/val.hpp>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -63,6 +64,78 @@ struct ImportVerbOptions {
   }
 };
 
+/// `wingman val`'s options as keys: the image metrics (ValOptions) and, with sequences.enabled, the track metrics
+/// (SequenceEvalOptions: the data, model and detection keys are shared). The libraries validate their options when
+/// they run, naming the fields; here only what the verb needs to start.
+struct ValVerbOptions {
+  training::ValOptions val = [] {
+    training::ValOptions v;
+    v.backend = "auto";  // as `wingman predict` and the detector process (one default per flag, issue 34)
+    return v;
+  }();
+  training::SequenceEvalOptions sequences;
+  bool sequences_enabled = false;
+  int list = 10;
+  std::string json;  ///< "" = the table; "-" = the JSON instead; FILE = the table, and the JSON written to FILE
+
+  template <class V>
+  void visit(V& v) {
+    v("input.data", val.data, "data.yaml or YOLO-layout folder");
+    v("input.split", val.split, "split to evaluate; \"\" = a folder's images/");
+    v("input.predictions", val.predictions, "instead of model.weights: folder of `wingman predict` <stem>.txt files");
+    v("input.class", val.class_id, "class to evaluate (0: drone)");
+    v("input.max_images", val.max_images, "evaluate at most this many images; 0 = all");
+    v("model.weights", val.weights,
+      "Darknet .weights or builtin:wingman-small; \"\" without input.predictions = the shipped model");
+    v("model.cfg", val.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
+    v("model.backend", val.backend, "detector backend: auto, opencl or cpu");
+    v("model.input_size", val.input_size, "network input: auto, cfg or WxH");
+    v("metrics.conf", val.metrics.conf_thresh, "operating confidence for precision / recall / mean IoU");
+    v("metrics.iou", val.metrics.iou_thresh, "IoU match threshold");
+    v("metrics.size_edges_px", val.metrics.size_edges_px, "size-bin edges, sqrt(w h) in pixels");
+    v("metrics.pr_points", val.metrics.pr_points, "points of the PR curve in the JSON");
+    v("metrics.edge_margin_px", val.metrics.edge_margin_px,
+      "a truth within this many pixels of the image's border touches the edge");
+    val.detection.visit(v);
+    v("sequences.enabled", sequences_enabled,
+      "track-level metrics of the split's Halmstad clips (input.data: the folder of `wingman import-halmstad`)");
+    v("sequences.halmstad_root", sequences.halmstad_root, "the Halmstad dataset (videos/, labels/)");
+    v("sequences.localizer_config", sequences.localizer_config,
+      "wingman-localizer's YAML; \"\" = its built-in defaults");
+    v("sequences.hfov_deg", sequences.hfov_deg, "horizontal field of view of the static camera's pinhole, degrees");
+    v("sequences.frame_step", sequences.frame_step, "track every n-th frame (1: every frame)");
+    v("sequences.clips", sequences.clips, "only these clips of the split; [] = all");
+    v("sequences.boxes_cache", sequences.boxes_cache, "folder of each clip's detector boxes (read, or written)");
+    v("sequences.confirm_within_s", sequences.scoring.confirm_within_s,
+      "a drone confirmed this long after its first label counts as in time, s");
+    v("sequences.on_target_fraction", sequences.scoring.on_target_fraction,
+      "a track is on the drone when more than this share of its confirmed hits is");
+    v("output.list", list, "list this many of the largest truths not found, per criterion");
+    v("output.json", json, "\"\" = the table; - = one JSON object instead; FILE = the table and the JSON in FILE");
+  }
+  std::vector<std::string> validate() const {
+    std::vector<std::string> p;
+    if (val.data.empty()) p.emplace_back("input.data: give the data (--data, or the key)");
+    if (list < 0) p.push_back(common::problem("output.list", list, "must be >= 0"));
+    return p;
+  }
+};
+
+/// Whether `key` (section.name) is in one of `files` (YAML) or `sets` (KEY=VALUE).
+bool given_in(const common::ConfigSources& sources, const std::string& section, const std::string& name) {
+  for (const auto& set : sources.sets)
+    if (set.rfind(section + "." + name + "=", 0) == 0) return true;
+  for (const auto& file : sources.files) {
+    try {
+      const YAML::Node root = YAML::LoadFile(file);
+      if (root.IsMap() && root[section].IsMap() && root[section][name]) return true;
+    } catch (const YAML::Exception&) {
+      // unreadable: the loader has named it already
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 struct TrainingVerbs::State {
@@ -72,13 +145,11 @@ struct TrainingVerbs::State {
   training::ValOptions val_options;
   CLI::Option* val_json = nullptr;  // --json [FILE]
   std::string val_json_path;
-  CLI::Option* val_p_thresh = nullptr;
-  CLI::Option* val_predictions = nullptr;
-  CLI::Option* val_class = nullptr;
   size_t val_list = 10;
   // val --sequences: the track-level metrics (training/sequence_eval.hpp)
   bool val_sequences = false;
   training::SequenceEvalOptions sequences;
+  std::unique_ptr<VerbLayers> val_layers;  // val runs with what its layers load; the variables above: the flags
 
   ImportVerbOptions import_flags;  // what the flags say; the import runs with what its layers load
   bool no_tighten = false, no_negatives = false;
@@ -93,7 +164,7 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   auto* v = s.val;
   training::ValOptions& vo = s.val_options;
   vo.backend = "auto";  // as `wingman predict` and the detector process (one default per flag, issue 34)
-  v->add_option("--data", vo.data, "data.yaml or YOLO-layout folder")->required();
+  v->add_option("--data", vo.data, "data.yaml or YOLO-layout folder");
   v->add_option("--split", vo.split, "Split to evaluate (empty: a folder's images/)");
   v->add_option("--weights", vo.weights,
                 "Darknet .weights, or builtin:wingman-small: run the detector (Algorithm 2) (empty without "
@@ -102,15 +173,14 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--backend", vo.backend, "Detector backend: auto, opencl or cpu");
   v->add_option("--input-size", vo.input_size,
                 "Network input: auto (the cfg's longer side, the other fitted to each image's aspect), cfg or WxH");
-  s.val_predictions = v->add_option("--predictions", vo.predictions,
-                                    "Instead of --weights: folder of `wingman predict` <stem>.txt files");
+  v->add_option("--predictions", vo.predictions, "Instead of --weights: folder of `wingman predict` <stem>.txt files");
   v->add_option("--conf", vo.metrics.conf_thresh, "Operating confidence for precision / recall / mean IoU");
   v->add_option("--iou", vo.metrics.iou_thresh, "IoU match threshold");
   v->add_option("--size-edges", vo.metrics.size_edges_px, "Size-bin edges, sqrt(w h) in pixels")->delimiter(',');
   v->add_option("--pr-points", vo.metrics.pr_points, "Points of the PR curve in the JSON");
-  s.val_p_thresh = v->add_option("--p-thresh", vo.detection.p_thresh,
-                                 "Detector's confidence floor, low for the curve (not given with --sequences: 0.2, "
-                                 "the detector's p_thresh)");
+  v->add_option("--p-thresh", vo.detection.p_thresh,
+                "Detector's confidence floor, low for the curve (not given with --sequences: 0.2, "
+                "the detector's p_thresh)");
   v->add_option("--o-thresh", vo.detection.o_thresh, "Detector's NMS IoU threshold");
   v->add_flag("--subsquare", vo.detection.subsquare, "Detect in the centred h x h square of a wide image");
   v->add_flag("--zoom-in", vo.detection.zoom_in, "Re-detect in full-resolution crops (Algorithm 2)");
@@ -130,7 +200,7 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--coarse-min-size", vo.detection.coarse_min_size,
                 "--coarse-pass: drop its boxes below this sqrt(w h), image pixels");
   v->add_option("--max-detections", vo.detection.max_detections, "At most this many boxes per image");
-  s.val_class = v->add_option("--class", vo.class_id, "Class to evaluate (0: drone)");
+  v->add_option("--class", vo.class_id, "Class to evaluate (0: drone)");
   v->add_option("--max-images", vo.max_images, "Evaluate at most this many images (0: all)");
   v->add_option("--edge-margin", vo.metrics.edge_margin_px,
                 "A truth within this many pixels of the image's border touches the edge");
@@ -162,6 +232,47 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                 "--sequences: a drone confirmed this long after its first label counts as in time, s");
   v->add_option("--on-target-fraction", so.scoring.on_target_fraction,
                 "--sequences: a track is on the drone when more than this share of its confirmed hits is");
+  s.val_layers = std::make_unique<VerbLayers>(v);
+  s.val_layers->keys(
+      {
+          {"--data", "input.data", true},
+          {"--split", "input.split", true},
+          {"--weights", "model.weights", true},
+          {"--cfg", "model.cfg", true},
+          {"--backend", "model.backend", true},
+          {"--input-size", "model.input_size", true},
+          {"--predictions", "input.predictions", true},
+          {"--conf", "metrics.conf", false},
+          {"--iou", "metrics.iou", false},
+          {"--size-edges", "metrics.size_edges_px", false},
+          {"--pr-points", "metrics.pr_points", false},
+          {"--p-thresh", "detection.p_thresh", false},
+          {"--o-thresh", "detection.o_thresh", false},
+          {"--subsquare", "detection.subsquare", false},
+          {"--zoom-in", "detection.zoom_in", false},
+          {"--drone-first", "detection.drone_first", false},
+          {"--zoom-max-fraction", "detection.zoom_max_fraction", false},
+          {"--flip-fusion", "detection.flip_fusion", false},
+          {"--fusion-iou", "detection.fusion_iou", false},
+          {"--coarse-pass", "detection.coarse_pass", false},
+          {"--coarse-scale", "detection.coarse_scale", false},
+          {"--coarse-min-size", "detection.coarse_min_size", false},
+          {"--max-detections", "detection.max_detections", false},
+          {"--class", "input.class", false},
+          {"--max-images", "input.max_images", false},
+          {"--edge-margin", "metrics.edge_margin_px", false},
+          {"--list", "output.list", false},
+          {"--sequences", "sequences.enabled", false},
+          {"--halmstad-root", "sequences.halmstad_root", true},
+          {"--localizer-config", "sequences.localizer_config", true},
+          {"--hfov-deg", "sequences.hfov_deg", false},
+          {"--frame-step", "sequences.frame_step", false},
+          {"--clips", "sequences.clips", true},
+          {"--boxes-cache", "sequences.boxes_cache", true},
+          {"--confirm-within", "sequences.confirm_within_s", false},
+          {"--on-target-fraction", "sequences.on_target_fraction", false},
+      },
+      {"--json"});  // output.json: FILE, or - alone
 
   // ---- import-halmstad ----
   s.halmstad = app.add_subcommand(
@@ -204,67 +315,74 @@ TrainingVerbs::~TrainingVerbs() = default;
 
 int TrainingVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   State& s = *s_;
-  if (*s.val && s.val_sequences) {
-    return run_verb("wingman val", err, [&] {
-      training::SequenceEvalOptions so = s.sequences;
-      const training::ValOptions& vo = s.val_options;
-      if (s.val_predictions->count() > 0)
-        throw std::invalid_argument("--predictions: --sequences runs the detector on every frame; give --weights");
-      if (s.val_class->count() > 0 && vo.class_id != 0)
-        throw std::invalid_argument(
-            fmt::format("--class {}: --sequences tracks class 0 (drone), as wingman-localizer", vo.class_id));
-      so.data = vo.data;
-      so.split = vo.split;
-      so.cfg = vo.cfg;
-      if (!vo.weights.empty()) so.weights = vo.weights;
-      so.backend = vo.backend;
-      so.input_size = vo.input_size;
-      so.detection = vo.detection;  // Algorithm 2's flags as given, and the detector's p_thresh unless given
-      if (s.val_p_thresh->count() == 0) so.detection.p_thresh = detector::DetectorPipelineOptions{}.p_thresh;
-      const auto t0 = std::chrono::steady_clock::now();
-      std::optional<common::Progress> clips;  // the number of clips is known once the split is read
-      const training::SequenceEvalResult r = training::run_sequence_eval(
-          so, {}, [&](const std::string& line) { err << "wingman val: " << line << "\n"
-                                                     << std::flush; },
-          [&](size_t done, size_t total) {
-            if (!clips) clips.emplace("wingman val", static_cast<int64_t>(total), "clips", &err);
-            clips->update(static_cast<int64_t>(done));
-          });
-      err << fmt::format("wingman val: {} clips in {:.0f} s\n", r.clips.size(),
-                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      const bool json_stdout = s.val_json->count() > 0 && (s.val_json_path.empty() || s.val_json_path == "-");
-      if (!json_stdout && !s.val_json_path.empty()) {
-        std::ofstream f(s.val_json_path);
-        f << r.json() << "\n";
-        f.close();
-        if (!f) throw std::runtime_error(s.val_json_path + ": cannot write the JSON");
-      }
-      out << (json_stdout ? r.json() + "\n" : r.report()) << std::flush;
-      return 0;
-    });
-  }
   if (*s.val) {
+    std::vector<std::string> json;  // --json alone or -: the JSON instead of the table; --json FILE: beside it
+    if (s.val_json->count() > 0)
+      json.push_back("output.json=" + VerbLayers::quoted(s.val_json_path.empty() ? "-" : s.val_json_path));
+    int rc = -1;
+    const auto loaded = s.val_layers->load_or_exit<ValVerbOptions>(out, err, &rc, json);
+    if (!loaded) return rc;
+    const bool json_stdout = loaded->json == "-";
+    const std::string json_path = json_stdout ? "" : loaded->json;
+    if (loaded->sequences_enabled) {
+      const bool p_thresh_given = given_in(s.val_layers->sources(), "detection", "p_thresh");
+      return run_verb("wingman val", err, [&] {
+        training::SequenceEvalOptions so = loaded->sequences;
+        const training::ValOptions& vo = loaded->val;
+        if (!vo.predictions.empty())
+          throw std::invalid_argument("--predictions: --sequences runs the detector on every frame; give --weights");
+        if (vo.class_id != 0)
+          throw std::invalid_argument(
+              fmt::format("--class {}: --sequences tracks class 0 (drone), as wingman-localizer", vo.class_id));
+        so.data = vo.data;
+        so.split = vo.split;
+        so.cfg = vo.cfg;
+        if (!vo.weights.empty()) so.weights = vo.weights;
+        so.backend = vo.backend;
+        so.input_size = vo.input_size;
+        so.detection = vo.detection;  // Algorithm 2's flags as given, and the detector's p_thresh unless given
+        if (!p_thresh_given) so.detection.p_thresh = detector::DetectorPipelineOptions{}.p_thresh;
+        const auto t0 = std::chrono::steady_clock::now();
+        std::optional<common::Progress> clips;  // the number of clips is known once the split is read
+        const training::SequenceEvalResult r = training::run_sequence_eval(
+            so, {}, [&](const std::string& line) { err << "wingman val: " << line << "\n"
+                                                       << std::flush; },
+            [&](size_t done, size_t total) {
+              if (!clips) clips.emplace("wingman val", static_cast<int64_t>(total), "clips", &err);
+              clips->update(static_cast<int64_t>(done));
+            });
+        err << fmt::format("wingman val: {} clips in {:.0f} s\n", r.clips.size(),
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        if (!json_path.empty()) {
+          std::ofstream f(json_path);
+          f << r.json() << "\n";
+          f.close();
+          if (!f) throw std::runtime_error(json_path + ": cannot write the JSON");
+        }
+        out << (json_stdout ? r.json() + "\n" : r.report()) << std::flush;
+        return 0;
+      });
+    }
     return run_verb("wingman val", err, [&] {
+      training::ValOptions vo = loaded->val;
       // Neither a model nor saved predictions: the shipped model, as `wingman predict`.
-      if (s.val_options.weights.empty() && s.val_options.predictions.empty())
-        s.val_options.weights = "builtin:wingman-small";
+      if (vo.weights.empty() && vo.predictions.empty()) vo.weights = "builtin:wingman-small";
       std::optional<common::Progress> images;  // the number of images is known once the set is read
       const training::DetectionMetrics m = training::run_val(
-          s.val_options,
+          vo,
           [&](size_t done, size_t total) {
             if (!images) images.emplace("wingman val", static_cast<int64_t>(total), "images", &err);
             images->update(static_cast<int64_t>(done));
           },
           [&](const std::string& line) { err << "wingman val: " << line << "\n"; });
       if (images) images->finish();
-      const bool json_stdout = s.val_json->count() > 0 && (s.val_json_path.empty() || s.val_json_path == "-");
-      if (!json_stdout && !s.val_json_path.empty()) {
-        std::ofstream f(s.val_json_path);
+      if (!json_path.empty()) {
+        std::ofstream f(json_path);
         f << m.json() << "\n";
         f.close();
-        if (!f) throw std::runtime_error(s.val_json_path + ": cannot write the JSON");
+        if (!f) throw std::runtime_error(json_path + ": cannot write the JSON");
       }
-      out << (json_stdout ? m.json() + "\n" : m.report(s.val_list)) << std::flush;
+      out << (json_stdout ? m.json() + "\n" : m.report(static_cast<size_t>(loaded->list))) << std::flush;
       return 0;
     });
   }
