@@ -94,6 +94,13 @@ int run(common::Runtime& rt, const detector::DetectorOptions& o) {
     const detector::WindowStats& s = det.window_stats();
     if (det.windows_enabled())
       spdlog::info("windows: {} searched in {} crops, {} found their track's drone", s.windows, s.crops, s.found);
+    if (const detector::MotionStats* m = det.motion_stats()) {
+      const detector::WindowStats& w = det.motion_window_stats();
+      spdlog::info(
+          "motion: {} of {} frames compared ({} not aligned, {} restarts), {} moving blobs, {} searched in {} crops, "
+          "{} found a drone",
+          m->compared, m->frames, m->unaligned, m->restarts, m->blobs, w.windows, w.crops, w.found);
+    }
   };
 
   if (o.mode == "replay" || rt.input_is_file()) {

@@ -51,10 +51,16 @@ Detector::Detector(const DetectorOptions& options)
   // Tracker-driven windows: the localizer's predictions, and a second network at the crop size, built after the single
   // pass's (with model.backend auto, the single pass's network decides the backend and the window's takes the same).
   std::optional<DarknetModel> window_model;
-  if (options_.windows.enabled) window_model = model;
+  if (options_.windows.enabled || options_.motion.enabled) window_model = model;
   pipeline_ = std::make_unique<SizedDetector>(options_.detection, std::move(model), input_size, factory, on_build);
   if (window_model)
     window_detector_ = std::make_unique<WindowDetector>(options_.windows, options_.detection, *window_model, factory);
+  // The motion cue's windows go through the same window network, with their own budget.
+  if (options_.motion.enabled) {
+    motion_ = std::make_unique<MotionCue>(options_.motion);
+    motion_window_options_ = options_.windows;
+    motion_window_options_.max_per_frame = options_.motion.max_windows;
+  }
 }
 
 Detector::~Detector() = default;
@@ -111,7 +117,7 @@ void Detector::on_windows(const wingman::track_windows_t& windows) {
   if (image_camera_id_ >= 0 && windows.camera_id != image_camera_id_)
     throw std::invalid_argument(
         fmt::format("track_windows_t.camera_id = {}: the frames are camera {}", windows.camera_id, image_camera_id_));
-  if (!window_detector_) return;
+  if (!windows_enabled()) return;
   auto fresh = std::make_shared<const wingman::track_windows_t>(windows);
   std::lock_guard<std::mutex> lock(mutex_);
   newest_windows_ = std::move(fresh);
@@ -125,7 +131,7 @@ FrameDetections Detector::detect(const wingman::image_t& image) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameDetections d;
   d.boxes = pipeline_->detect(bgr);
-  if (window_detector_) {
+  if (windows_enabled()) {
     std::shared_ptr<const wingman::track_windows_t> windows;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -137,6 +143,13 @@ FrameDetections Detector::detect(const wingman::image_t& image) {
                                                            pipeline_->net_px_per_image_px(size), options_.windows);
       if (!search.empty()) d.boxes = window_detector_->detect(bgr, std::move(d.boxes), search, &window_stats_);
     }
+  }
+  if (motion_) {
+    // Where something small moves and no box is yet: the window network looks there at full resolution.
+    const std::vector<Window> moving = motion_->windows(bgr, image.utime, d.boxes);
+    if (!moving.empty())
+      d.boxes =
+          window_detector_->detect(bgr, std::move(d.boxes), moving, motion_window_options_, &motion_window_stats_);
   }
   d.latency_us = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
   return d;

@@ -25,7 +25,8 @@ std::vector<std::string> DetectorOptions::validate() const {
     p.push_back(problem("model.input_size", input_size, "expected auto, cfg or WxH (multiples of 32, 32..4096)"));
   if (cfg.empty())
     p.push_back(problem("model.cfg", cfg, "must be a .cfg path, builtin:wingman-small or builtin:tiny-yolo-thesis"));
-  for (const auto& part : {detection.validate(), windows.validate(), opencl.validate(), time.validate()})
+  for (const auto& part :
+       {detection.validate(), windows.validate(), motion.validate(), opencl.validate(), time.validate()})
     p.insert(p.end(), part.begin(), part.end());
   return p;
 }

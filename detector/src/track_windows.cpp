@@ -172,11 +172,19 @@ WindowDetector::WindowDetector(WindowOptions options, const DetectorPipelineOpti
 
 std::vector<Box> WindowDetector::detect(const cv::Mat& bgr_image, std::vector<Box> first_pass,
                                         const std::vector<Window>& windows, WindowStats* stats) {
-  const std::vector<cv::Rect> crops = place_window_crops(windows, bgr_image.size(), options_, crop_of_window_);
+  return detect(bgr_image, std::move(first_pass), windows, options_, stats);
+}
+
+std::vector<Box> WindowDetector::detect(const cv::Mat& bgr_image, std::vector<Box> first_pass,
+                                        const std::vector<Window>& windows, const WindowOptions& options,
+                                        WindowStats* stats) {
+  if (options.crop_px != options_.crop_px)
+    throw std::logic_error("WindowDetector::detect: crop_px differs from the network's input");
+  const std::vector<cv::Rect> crops = place_window_crops(windows, bgr_image.size(), options, crop_of_window_);
   // Every crop of the frame in one forward (up to the backend's max_batch).
   const std::vector<std::vector<Box>> crop_boxes = pipeline_->detect_regions(bgr_image, crops);
   return merge_window_boxes(std::move(first_pass), windows, crops, crop_of_window_, crop_boxes, pipeline_options_,
-                            options_, stats);
+                            options, stats);
 }
 
 }  // namespace wingman::detector

@@ -88,6 +88,25 @@ if python3 "$summary" suite "$work/suite" --max-rms 0.0001 "$work/suite/s1001/ev
 fi
 grep -q "BROKEN: s1001: 3-D RMS" "$work/out" || fail "broken bound not named: $(cat "$work/out")"
 
+# Approach (issue 31's motion cue): per flight folder, the leader's first target (targets_r15.csv's first row on
+# vehicle 1: time and true range) and the eval's false targets.
+for f in single motion; do
+  mkdir -p "$work/approach/$f"
+  cp "$work/run/eval.json" "$work/approach/$f/eval.json"
+  cp "$work/run/eval.json" "$work/approach/$f/eval_r15.json"
+  cp "$work/run/targets.csv" "$work/approach/$f/targets_r15.csv"
+done
+python3 "$summary" approach "$work/approach" "$work/approach/single" "$work/approach/motion" > /dev/null
+first=$(python3 - "$work/run/targets.csv" <<'PY'
+import csv, sys
+r = [x for x in csv.DictReader(open(sys.argv[1])) if x["vehicle_id"] == "1"][0]
+print("%.1f s, %.1f m" % (float(r["t_s"]), float(r["range_m"])))
+PY
+)
+false_targets=$(val "$run" "r['false_targets']")
+grep -q "^| motion | $first | .* | $false_targets / $false_targets |" "$work/approach/results.md" \
+  || fail "approach row, want first target $first and $false_targets false: $(cat "$work/approach/results.md")"
+
 # Wrong arguments: the usage, not a traceback.
 if python3 "$summary" formation_2d "$work" "$run" 2> "$work/err"; then fail "two runs accepted"; fi
 grep -q "Usage" "$work/err" || fail "no usage on bad arguments: $(cat "$work/err")"

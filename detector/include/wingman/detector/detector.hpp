@@ -4,6 +4,7 @@
 
 #include "wingman/detector/box.hpp"
 #include "wingman/detector/detector_options.hpp"
+#include "wingman/detector/motion_cue.hpp"
 #include "wingman/detector/sized_detector.hpp"
 #include "wingman/detector/track_windows.hpp"
 
@@ -64,7 +65,7 @@ class Detector {
   /// "" with a model, else kNoModelDetail.
   std::string degraded() const { return has_model() ? "" : kNoModelDetail; }
   /// true with a model and windows.enabled: the caller subscribes to windows.channel.
-  bool windows_enabled() const { return window_detector_ != nullptr; }
+  bool windows_enabled() const { return options_.windows.enabled && window_detector_ != nullptr; }
 
   /// Admits a frame by its time (time.*): notes its camera (the camera the windows must be of), then throws
   /// std::invalid_argument naming image_t.utime, its value and the rule for a frame dated more than
@@ -96,6 +97,9 @@ class Detector {
 
   /// What the windows did since construction (written by detect()).
   const WindowStats& window_stats() const { return window_stats_; }
+  /// What the motion cue (motion.enabled) found and what its windows did since construction (written by detect()).
+  const MotionStats* motion_stats() const { return motion_ ? &motion_->stats() : nullptr; }
+  const WindowStats& motion_window_stats() const { return motion_window_stats_; }
 
  private:
   std::unique_ptr<InferenceBackend> build_backend(const DarknetModel& sized);
@@ -116,6 +120,9 @@ class Detector {
   std::shared_ptr<const wingman::track_windows_t> newest_windows_;  ///< swapped whole: a frame takes the pointer
   std::vector<DetectorNote> notes_;
   WindowStats window_stats_;
+  std::unique_ptr<MotionCue> motion_;    ///< motion.enabled: only detect() touches it (one frame at a time)
+  WindowOptions motion_window_options_;  ///< windows.* with motion.max_windows as the crop budget
+  WindowStats motion_window_stats_;
 };
 
 }  // namespace wingman::detector

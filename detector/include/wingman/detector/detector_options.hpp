@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wingman/detector/detection_pipeline.hpp"
+#include "wingman/detector/motion_cue.hpp"
 #include "wingman/detector/opencl_options.hpp"
 #include "wingman/detector/track_windows.hpp"
 
@@ -42,6 +43,7 @@ struct DetectorOptions {
   std::string input_size = "auto";
   DetectorPipelineOptions detection;
   WindowOptions windows;  ///< tracker-driven windows (windows.*)
+  MotionOptions motion;   ///< motion-proposed windows (motion.*; the window network of windows.*)
   OpenClOptions opencl;
   /// Time sanity of the images (time.*): an image dated more than max_ahead_s after the newest accepted image, or
   /// not after the previous one, is dropped and counted (never detected, its time never passed on); after
@@ -67,6 +69,7 @@ struct DetectorOptions {
       "(the cfg's size) or WxH (multiples of 32)");
     detection.visit(v);
     windows.visit(v);
+    motion.visit(v);
     opencl.visit(v);
     time.visit(v);
   }

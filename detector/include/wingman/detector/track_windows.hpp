@@ -123,6 +123,10 @@ class WindowDetector {
   /// Returns merge_window_boxes() of the crops place_window_crops() gives.
   std::vector<Box> detect(const cv::Mat& bgr_image, std::vector<Box> first_pass, const std::vector<Window>& windows,
                           WindowStats* stats = nullptr);
+  /// The same with another crop budget (max_per_frame) and gate (gate_sigma) than the options' (the motion cue's
+  /// windows); crop_px must be the options' (the network's input; else std::logic_error), p_thresh is the network's.
+  std::vector<Box> detect(const cv::Mat& bgr_image, std::vector<Box> first_pass, const std::vector<Window>& windows,
+                          const WindowOptions& options, WindowStats* stats);
   const WindowOptions& options() const { return options_; }
 
  private:
