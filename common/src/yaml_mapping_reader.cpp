@@ -42,6 +42,21 @@ YAML::Node YamlMappingReader::take(const std::string& key) {
   return it == leaves_.end() ? YAML::Node(YAML::NodeType::Undefined) : it->second;
 }
 
+std::vector<YAML::Node> YamlMappingReader::take_list(const std::string& key, bool required) {
+  const YAML::Node n = take(key);
+  std::vector<YAML::Node> items;
+  if (!n.IsDefined() || n.IsNull()) {
+    if (required) problem(key, "missing (a list of mappings)");
+    return items;
+  }
+  if (!n.IsSequence()) {
+    problem(key, "expected a list of mappings, got " + describe(n));
+    return items;
+  }
+  for (const YAML::Node& item : n) items.push_back(item);
+  return items;
+}
+
 void YamlMappingReader::problem(const std::string& key, const std::string& message) {
   const auto it = leaves_.find(key);
   const YAML::Node node = it == leaves_.end() ? YAML::Node() : it->second;

@@ -7,7 +7,9 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 namespace wingman::launcher {
@@ -42,6 +44,18 @@ int run_in_foreground(const ProcessSpec& spec) {
     restore();
     throw;
   }
+}
+
+std::string output_tail(const std::string& path, size_t lines) {
+  std::ifstream in(path);
+  std::deque<std::string> last;
+  for (std::string line; std::getline(in, line);) {
+    last.push_back(line);
+    if (last.size() > lines) last.pop_front();
+  }
+  std::string text;
+  for (const auto& l : last) text += l + "\n";
+  return text;
 }
 
 std::string executable_dir() {

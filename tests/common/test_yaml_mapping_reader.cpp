@@ -151,6 +151,23 @@ TEST(YamlMappingReader, UnknownKeysAreNamedWithTheirLineAndTheHint) {
   EXPECT_EQ(problems, expected);
 }
 
+TEST(YamlMappingReader, TakeListGivesTheItemsOrNamesWhatIsThereInstead) {
+  const YAML::Node root = YAML::Load("flights:\n  - {name: a}\n  - {name: b}\ntables: 3\nnone:\n");
+  Problems problems;
+  YamlMappingReader r("l.yaml", root, "", &problems);
+  const auto flights = r.take_list("flights", true);
+  ASSERT_EQ(flights.size(), 2u);
+  EXPECT_EQ(flights[1]["name"].as<std::string>(), "b");
+  EXPECT_TRUE(r.take_list("tables", true).empty());
+  EXPECT_TRUE(r.take_list("none", false).empty());    // null, optional: nothing, no problem
+  EXPECT_TRUE(r.take_list("absent", false).empty());  // absent, optional: the same
+  EXPECT_TRUE(r.take_list("stages", true).empty());
+  r.finish();  // every key taken: none unknown
+  const Problems expected = {"l.yaml:4: tables: expected a list of mappings, got '3'",
+                             "l.yaml: stages: missing (a list of mappings)"};
+  EXPECT_EQ(problems, expected);
+}
+
 TEST(YamlMappingReader, AKeyThatIsNotAPlainNameIsNamedByTheMappingHoldingIt) {
   // Found by fuzz.config in ConfigLoader: YAML's complex keys ("? ...") made yaml-cpp throw.
   const YAML::Node root = YAML::Load(

@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -48,21 +47,6 @@ const std::vector<std::string>& runner_keys() {
   static const std::vector<std::string> keys = {"flight.out", "flight.detections", "run.config_dir", "run.bin_dir",
                                                 "run.lcm_url"};
   return keys;
-}
-
-std::vector<YAML::Node> sequence(YamlMappingReader& r, const std::string& key, bool required) {
-  const YAML::Node n = r.take(key);
-  std::vector<YAML::Node> items;
-  if (!n.IsDefined() || n.IsNull()) {
-    if (required) r.problem(key, "missing (a list of mappings)");
-    return items;
-  }
-  if (!n.IsSequence()) {
-    r.problem(key, "expected a list of mappings, got " + YamlMappingReader::describe(n));
-    return items;
-  }
-  for (const YAML::Node& item : n) items.push_back(item);
-  return items;
 }
 
 /// Whether the reader has a leaf under `prefix` (a mapping given there).
@@ -151,19 +135,6 @@ std::string read_text(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-/// The last `n` lines of the file at `path` ("" when it cannot be read).
-std::string tail(const std::string& path, size_t n) {
-  std::ifstream in(path);
-  std::deque<std::string> lines;
-  for (std::string line; std::getline(in, line);) {
-    lines.push_back(line);
-    if (lines.size() > n) lines.pop_front();
-  }
-  std::string text;
-  for (const auto& l : lines) text += l + "\n";
-  return text;
 }
 
 /// `name` as a file: itself when it names one (has a '/' or ends in .yaml), else config_dir/experiments/NAME.yaml.
@@ -296,7 +267,7 @@ Experiment read_experiment(const std::string& path, bool quick) {
   if (x.folder.empty()) x.folder = x.name;
   top("detections", x.detections, "");
   top("experiments", x.experiments, "");
-  const auto tables = sequence(top, "tables", x.experiments.empty());
+  const auto tables = top.take_list("tables", x.experiments.empty());
   top.finish();
   if (!x.experiments.empty() && !tables.empty()) top.problem("experiments", "give either experiments or tables");
   for (const auto& d : x.detections) {
@@ -317,7 +288,7 @@ Experiment read_experiment(const std::string& path, bool quick) {
     tr("quick.args", quick_args, "");
     if (quick) table.args.insert(table.args.end(), quick_args.begin(), quick_args.end());
     tr("inputs", table.inputs, "");
-    const auto flights = sequence(tr, "flights", true);
+    const auto flights = tr.take_list("flights", true);
     // The defaults: read onto a scratch flight once, so that their keys are known and checked.
     ExperimentFlight scratch;
     read_flight_part(tr, "defaults.", scratch);
@@ -478,7 +449,7 @@ int run_experiments(const ExperimentOptions& o, std::ostream& out, std::ostream&
           return 130;
         }
         if (rc != 0) {
-          err << tail(pf.log_path, kFailureTailLines) << "experiment: the flight " << pf.flight->name
+          err << launcher::output_tail(pf.log_path, kFailureTailLines) << "experiment: the flight " << pf.flight->name
               << " failed (exit " << rc << "; its output: " << pf.log_path << ", its processes' in " << pf.dir
               << "/*.out)" << std::endl;
           return 1;

@@ -15,7 +15,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -42,19 +41,6 @@ const char* const kExtrinsics[4] = {"0, 0, 1, -1, 0, 0, 0, -1, 0", "1, 0, 0, 0, 
 
 void append(std::vector<std::string>& to, const std::vector<std::string>& more) {
   to.insert(to.end(), more.begin(), more.end());
-}
-
-/// The last `n` lines of a file (a process's stderr, for a failure).
-std::string tail(const std::string& path, size_t n) {
-  std::ifstream in(path);
-  std::deque<std::string> lines;
-  for (std::string line; std::getline(in, line);) {
-    lines.push_back(line);
-    if (lines.size() > n) lines.pop_front();
-  }
-  std::string text;
-  for (const auto& l : lines) text += l + "\n";
-  return text;
 }
 
 /// A counter of the `Udp:` lines of /proc/net/snmp (this network namespace's), -1 when absent.
@@ -342,7 +328,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
     for (const auto& [i, name] : names) {
       if (const auto code = group.poll(i)) {
         err << "load_test: FAILED: " << name << " exited " << *code << " " << when << "; its stderr:\n"
-            << tail((out_dir / (name + ".stderr")).string(), 5) << std::flush;
+            << launcher::output_tail((out_dir / (name + ".stderr")).string(), 5) << std::flush;
         return true;
       }
     }

@@ -75,21 +75,6 @@ void apply_override(YAML::Node root, const std::string& item, std::vector<std::s
   node[keys.back()] = value;
 }
 
-std::vector<YAML::Node> sequence(YamlMappingReader& r, const std::string& key, bool required) {
-  const YAML::Node n = r.take(key);
-  std::vector<YAML::Node> items;
-  if (!n.IsDefined()) {
-    if (required) r.problem(key, "missing");
-    return items;
-  }
-  if (!n.IsSequence()) {
-    r.problem(key, "expected a list of mappings, got " + YamlMappingReader::describe(n));
-    return items;
-  }
-  for (const YAML::Node& item : n) items.push_back(item);
-  return items;
-}
-
 }  // namespace
 
 const RecipeDataset* Recipe::dataset(const std::string& name) const { return find_named(datasets, name); }
@@ -143,10 +128,10 @@ Recipe load_recipe(const std::string& path, const std::vector<std::string>& over
   top("train.checkpoint_interval", t.checkpoint_interval, "");
   top("train.log_interval", t.log_interval, "");
   top("train.val_max_images", t.val_max_images, "");
-  const auto datasets = sequence(top, "datasets", true);
-  const auto mixes = sequence(top, "mixes", true);
-  const auto cfgs = sequence(top, "cfgs", false);
-  const auto stages = sequence(top, "stages", true);
+  const auto datasets = top.take_list("datasets", true);
+  const auto mixes = top.take_list("mixes", true);
+  const auto cfgs = top.take_list("cfgs", false);
+  const auto stages = top.take_list("stages", true);
   top.finish();
   if (t.threads < 1) top.problem("train.threads", "expected at least 1");
 

@@ -51,6 +51,10 @@ class YamlMappingReader {
   /// The leaf node of `key` (marks it known): for values read by hand, e.g. a sequence of mappings. When absent, an
   /// undefined node (IsDefined() false; a `key:` with no value is a defined null).
   YAML::Node take(const std::string& key);
+  /// The leaf `key` as a list of mappings (marks it known), each to be read by its own reader: a problem ("missing (a
+  /// list of mappings)" when `required`, "expected a list of mappings, got ..." for another value) and an empty list
+  /// otherwise. An absent or null `key` that is not `required` is an empty list.
+  std::vector<YAML::Node> take_list(const std::string& key, bool required);
   /// Records a problem about `key`: "<file>:<line>: <prefix><key>: <message>" (no line when `key` is absent).
   void problem(const std::string& key, const std::string& message);
   /// Records a "key = value: rule" line from a validate() as "<file>:<line>: <prefix><line>": the key (up to the

@@ -4,6 +4,7 @@
 
 #include "wingman/launcher/process_group.hpp"
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@ ProcessSpec process(std::string name, std::vector<std::string> argv);
 /// them, at their defaults: Ctrl-C stops the child, and then this process reports its exit). Returns the exit code
 /// (128 + signal when killed). Throws std::runtime_error naming the program when it cannot be started.
 int run_in_foreground(const ProcessSpec& spec);
+
+/// The last `lines` lines of the file at `path` (a process's output, shown when it failed); "" when it cannot be read.
+std::string output_tail(const std::string& path, size_t lines);
 
 /// The folder of the running executable (the build's or the installation's bin/), from /proc/self/exe. Throws
 /// std::runtime_error when it cannot be read.
