@@ -54,6 +54,18 @@ TEST(ProcessGroup, SendsOutputToFilesOrInheritsIt) {
   EXPECT_EQ(read_file(dir.file("e.txt")), "err\n");
 }
 
+TEST(OutputTail, TheLastLinesOfAProcesssOutputOrNothing) {
+  TempDir dir;
+  ProcessGroup group;
+  ProcessSpec spec = process("seq", {"sh", "-c", "seq 1 30"});
+  spec.stdout_path = dir.file("out.txt");
+  ASSERT_EQ(group.run(spec), 0);
+  EXPECT_EQ(output_tail(dir.file("out.txt"), 3), "28\n29\n30\n");
+  EXPECT_EQ(output_tail(dir.file("out.txt"), 100).size(),
+            std::string("1\n").size() * 9 + std::string("10\n").size() * 21);
+  EXPECT_EQ(output_tail(dir.file("missing.txt"), 3), "");
+}
+
 TEST(ProcessGroup, GivesTheChildItsEnvironmentWithTheSpecsEntriesOver) {
   TempDir dir;
   ::setenv("WINGMAN_TEST_KEPT", "kept", 1);
