@@ -106,6 +106,13 @@ struct ValVerbOptions {
     v("sequences.frame_step", sequences.frame_step, "track every n-th frame (1: every frame)");
     v("sequences.clips", sequences.clips, "only these clips of the split; [] = all");
     v("sequences.boxes_cache", sequences.boxes_cache, "folder of each clip's detector boxes (read, or written)");
+    sequences.motion.visit(v);  // motion.*: the detector's motion cue over each clip's frames
+    // The motion windows' network (the detector's windows.* keys that apply; tracker-driven windows need a tracker
+    // that publishes them: not here).
+    v("windows.crop_px", sequences.windows.crop_px, "motion.enabled: side of each full-resolution crop, pixels");
+    v("windows.p_thresh", sequences.windows.p_thresh, "motion.enabled: confidence threshold inside a crop (0..1)");
+    v("windows.gate_sigma", sequences.windows.gate_sigma,
+      "motion.enabled: a crop's box must lie within this many sigma_px of the moving blob");
     v("sequences.confirm_within_s", sequences.scoring.confirm_within_s,
       "a drone confirmed this long after its first label counts as in time, s");
     v("sequences.on_target_fraction", sequences.scoring.on_target_fraction,

@@ -14,6 +14,7 @@
 #include <wingman/detector/input_size.hpp>
 #include <wingman/detector/model_loader.hpp>
 #include <wingman/detector/sized_detector.hpp>
+#include <wingman/detector/track_windows.hpp>
 #include <wingman/geometry/message_eigen.hpp>
 #include <wingman/localizer/sphere_localizer.hpp>
 
@@ -26,6 +27,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -148,6 +150,10 @@ std::vector<std::string> SequenceEvalOptions::validate() const {
   if (frame_step < 1) p.push_back(fmt::format("frame_step = {}: must be >= 1", frame_step));
   for (const auto& s : detection.validate()) p.push_back(s);
   for (const auto& s : scoring.validate()) p.push_back(s);
+  if (motion.enabled) {
+    for (const auto& s : motion.validate()) p.push_back(s);
+    for (const auto& s : windows.validate()) p.push_back(s);
+  }
   return p;
 }
 
@@ -398,6 +404,14 @@ std::string SequenceEvalResult::report() const {
   if (!late_list.empty())
     s += fmt::format("drone clips not confirmed within {:g} s:\n", scoring.confirm_within_s) + late_list;
   if (!skip_list.empty()) s += "skipped clips:\n" + skip_list;
+  if (motion.frames > 0) {
+    s += fmt::format(
+        "motion cue: {} of {} frames compared ({} not aligned, {} restarts), {} moving blobs, {} windows searched in "
+        "{} "
+        "crops, {} found a drone\n",
+        motion.compared, motion.frames, motion.unaligned, motion.restarts, motion.blobs, motion_windows.windows,
+        motion_windows.crops, motion_windows.found);
+  }
   return s;
 }
 
@@ -464,6 +478,12 @@ std::string SequenceEvalResult::json() const {
   j["skipped"] = skipped();
   j["groups"] = std::move(groups_json);
   j["clips"] = std::move(clips_json);
+  if (motion.frames > 0) {
+    j["motion"] = {{"frames", motion.frames},       {"compared", motion.compared},
+                   {"unaligned", motion.unaligned}, {"restarts", motion.restarts},
+                   {"blobs", motion.blobs},         {"windows_searched", motion_windows.windows},
+                   {"crops", motion_windows.crops}, {"found", motion_windows.found}};
+  }
   return common::json_text(j);
 }
 
@@ -541,18 +561,33 @@ ClipBoxes read_clip_boxes(const std::string& path) {
   return b;
 }
 
+/// The motion cue's settings as a cache key (" motion=..."), when it is on.
+std::string motion_settings(const SequenceEvalOptions& o) {
+  const detector::MotionOptions& m = o.motion;
+  const detector::WindowOptions& w = o.windows;
+  return fmt::format(
+      " motion=scale:{},lag:{},sigma:{},min_diff:{},min_contrast:{},max_blob:{}/"
+      "{},repeat:{},windows:{},gap:{},border:{},"
+      "window_sigma:{},max_shift:{} crop_px={} window_p_thresh={} gate_sigma={}",
+      m.scale, m.lag_frames, m.threshold_sigma, m.min_difference, m.min_contrast, m.max_blob_px, m.max_blob_side_px,
+      m.repeat_radius_px, m.max_windows, m.max_gap_s, m.border_px, m.sigma_px, m.max_shift_fraction, w.crop_px,
+      w.p_thresh, w.gate_sigma);
+}
+
 std::string detection_settings(const SequenceEvalOptions& o) {
   const detector::DetectorPipelineOptions& d = o.detection;
   // A cfg file is keyed by its bytes' SHA-256 too (a built-in one by its name).
   const std::string cfg_id =
       o.cfg.rfind("builtin:", 0) == 0 ? std::string("builtin") : detector::weights_model_id(o.cfg);
   return fmt::format(
-      "cfg={} cfg_sha256={} weights_sha256={} backend={} input_size={} p_thresh={} o_thresh={} subsquare={} zoom_in={} "
-      "zoom_max_fraction={} flip_fusion={} fusion_iou={} coarse_pass={} coarse_scale={} coarse_min_size={} "
-      "drone_first={} policy={} max_detections={}",
-      o.cfg, cfg_id, detector::weights_model_id(o.weights), o.backend, o.input_size, d.p_thresh, d.o_thresh,
-      d.subsquare, d.zoom_in, d.zoom_max_fraction, d.flip_fusion, d.fusion_iou, d.coarse_pass, d.coarse_scale,
-      d.coarse_min_size, d.drone_first, d.policy, d.max_detections);
+             "cfg={} cfg_sha256={} weights_sha256={} backend={} input_size={} p_thresh={} o_thresh={} subsquare={} "
+             "zoom_in={} "
+             "zoom_max_fraction={} flip_fusion={} fusion_iou={} coarse_pass={} coarse_scale={} coarse_min_size={} "
+             "drone_first={} policy={} max_detections={}",
+             o.cfg, cfg_id, detector::weights_model_id(o.weights), o.backend, o.input_size, d.p_thresh, d.o_thresh,
+             d.subsquare, d.zoom_in, d.zoom_max_fraction, d.flip_fusion, d.fusion_iou, d.coarse_pass, d.coarse_scale,
+             d.coarse_min_size, d.drone_first, d.policy, d.max_detections) +
+         (o.motion.enabled ? motion_settings(o) : std::string());
 }
 
 SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDetector& detect_in,
@@ -564,6 +599,10 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
     for (const auto& p : problems) msg += "\n  " + p;
     throw std::invalid_argument(msg);
   }
+  if (o.motion.enabled && detect_in)
+    throw std::invalid_argument(
+        "run_sequence_eval: motion.enabled needs the built-in detector (its window network searches the motion cue's "
+        "windows); a given FrameDetector has none");
   // splits.csv beside the data.yaml, or in the folder.
   const fs::path data(o.data);
   if (!fs::exists(data))
@@ -601,6 +640,9 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
   // wholly from the boxes cache never loads it).
   FrameDetector detect = detect_in;
   std::shared_ptr<detector::SizedDetector> pipeline;
+  std::shared_ptr<detector::WindowDetector> windows;  // the motion cue's window network (motion.enabled)
+  detector::WindowOptions motion_windows = o.windows;
+  motion_windows.max_per_frame = o.motion.max_windows;
   auto detector_for_frames = [&]() -> FrameDetector& {
     if (!detect) {
       auto make_backend = [&](const detector::DarknetModel& sized) {
@@ -609,9 +651,12 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
         if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
         return backend;
       };
-      pipeline = std::make_shared<detector::SizedDetector>(o.detection, detector::load_model(o.cfg, o.weights),
+      const detector::DarknetModel model = detector::load_model(o.cfg, o.weights);
+      pipeline = std::make_shared<detector::SizedDetector>(o.detection, model,
                                                            *detector::InputSize::parse(o.input_size), make_backend);
       detect = [pipeline](const cv::Mat& bgr) { return pipeline->detect(bgr); };
+      if (o.motion.enabled)
+        windows = std::make_shared<detector::WindowDetector>(o.windows, o.detection, model, make_backend);
     }
     return detect;
   };
@@ -690,6 +735,9 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
         record.fps = c.fps;
         record.frame_step = o.frame_step;
         cv::Mat frame;
+        // The motion cue sees this clip's frames only, at their video times.
+        std::optional<detector::MotionCue> cue;
+        if (o.motion.enabled) cue.emplace(o.motion);
         for (int k = 0;; ++k) {
           if (k % o.frame_step != 0) {
             if (!cap.grab()) break;
@@ -707,8 +755,22 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
             break;
           }
           std::vector<detector::Box> boxes = detector_for_frames()(frame);
+          if (cue && windows) {
+            const auto utime = static_cast<int64_t>(std::llround(k * 1e6 / c.fps));
+            const std::vector<detector::Window> moving = cue->windows(frame, utime, boxes);
+            if (!moving.empty())
+              boxes = windows->detect(frame, std::move(boxes), moving, motion_windows, &result.motion_windows);
+          }
           tracker->add_frame(k, boxes, truths_at(k));
           if (!boxes.empty()) record.boxes[k] = std::move(boxes);
+        }
+        if (cue) {
+          result.motion.frames += cue->stats().frames;
+          result.motion.compared += cue->stats().compared;
+          result.motion.blobs += cue->stats().blobs;
+          result.motion.windows += cue->stats().windows;
+          result.motion.unaligned += cue->stats().unaligned;
+          result.motion.restarts += cue->stats().restarts;
         }
         if (c.skipped.empty() && c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
         record.frames = c.frames;

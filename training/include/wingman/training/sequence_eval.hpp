@@ -4,6 +4,7 @@
 
 #include <wingman/detector/box.hpp>
 #include <wingman/detector/detection_pipeline.hpp>
+#include <wingman/detector/motion_cue.hpp>
 #include <wingman/geometry/camera_model.hpp>
 #include <wingman/localizer/localizer.hpp>
 #include <wingman/localizer/localizer_options.hpp>
@@ -141,6 +142,11 @@ struct SequenceEvalOptions {
   std::string input_size = "auto";                ///< network input, as ValOptions::input_size
   /// Algorithm 2's settings: the detector's defaults (p_thresh 0.2, what wingman-detector publishes).
   detector::DetectorPipelineOptions detection;
+  /// The detector's motion cue (motion.enabled): each clip's frames (every frame_step-th, at their video times) through
+  /// detector::MotionCue, its windows searched by the window network (windows.crop_px, p_thresh, gate_sigma; budget
+  /// motion.max_windows), as wingman-detector does. Off by default.
+  detector::MotionOptions motion;
+  detector::WindowOptions windows;  ///< the window network's settings for the motion cue's windows
   /// wingman-localizer's YAML (config/localizer.yaml's keys) read by the common loader; "" = its built-in defaults.
   /// Its camera.* keys are not used: the camera is nominal_pinhole(frame size, hfov_deg).
   std::string localizer_config;
@@ -183,6 +189,8 @@ struct SequenceEvalResult {
   std::string split;
   double hfov_deg = 0, focal_px = 0;  ///< the nominal pinhole used (focal_px of the first clip's frame size)
   int frame_step = 1;
+  detector::MotionStats motion;          ///< the motion cue's work over every clip detected (motion.enabled)
+  detector::WindowStats motion_windows;  ///< and its windows' (searched, crops, found a drone)
   TrackScoringOptions scoring;
   std::vector<ClipTrackResult> clips;  ///< by clip name; skipped ones included (ClipTrackResult::skipped)
 
