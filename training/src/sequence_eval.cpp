@@ -406,9 +406,8 @@ std::string SequenceEvalResult::report() const {
   if (!skip_list.empty()) s += "skipped clips:\n" + skip_list;
   if (motion.frames > 0) {
     s += fmt::format(
-        "motion cue: {} of {} frames compared ({} not aligned, {} restarts), {} moving blobs, {} windows searched in "
-        "{} "
-        "crops, {} found a drone\n",
+        "motion cue: {} of {} frames compared ({} not aligned, {} restarts), {} moving blobs, "
+        "{} windows searched in {} crops, {} found a drone\n",
         motion.compared, motion.frames, motion.unaligned, motion.restarts, motion.blobs, motion_windows.windows,
         motion_windows.crops, motion_windows.found);
   }
@@ -566,9 +565,8 @@ std::string motion_settings(const SequenceEvalOptions& o) {
   const detector::MotionOptions& m = o.motion;
   const detector::WindowOptions& w = o.windows;
   return fmt::format(
-      " motion=scale:{},lag:{},sigma:{},min_diff:{},min_contrast:{},max_blob:{}/"
-      "{},repeat:{},windows:{},gap:{},border:{},"
-      "window_sigma:{},max_shift:{} crop_px={} window_p_thresh={} gate_sigma={}",
+      " motion=scale:{},lag:{},sigma:{},min_diff:{},min_contrast:{},max_blob:{}/{},repeat:{},windows:{},gap:{},"
+      "border:{},window_sigma:{},max_shift:{} crop_px={} window_p_thresh={} gate_sigma={}",
       m.scale, m.lag_frames, m.threshold_sigma, m.min_difference, m.min_contrast, m.max_blob_px, m.max_blob_side_px,
       m.repeat_radius_px, m.max_windows, m.max_gap_s, m.border_px, m.sigma_px, m.max_shift_fraction, w.crop_px,
       w.p_thresh, w.gate_sigma);
@@ -581,9 +579,8 @@ std::string detection_settings(const SequenceEvalOptions& o) {
       o.cfg.rfind("builtin:", 0) == 0 ? std::string("builtin") : detector::weights_model_id(o.cfg);
   return fmt::format(
              "cfg={} cfg_sha256={} weights_sha256={} backend={} input_size={} p_thresh={} o_thresh={} subsquare={} "
-             "zoom_in={} "
-             "zoom_max_fraction={} flip_fusion={} fusion_iou={} coarse_pass={} coarse_scale={} coarse_min_size={} "
-             "drone_first={} policy={} max_detections={}",
+             "zoom_in={} zoom_max_fraction={} flip_fusion={} fusion_iou={} coarse_pass={} coarse_scale={} "
+             "coarse_min_size={} drone_first={} policy={} max_detections={}",
              o.cfg, cfg_id, detector::weights_model_id(o.weights), o.backend, o.input_size, d.p_thresh, d.o_thresh,
              d.subsquare, d.zoom_in, d.zoom_max_fraction, d.flip_fusion, d.fusion_iou, d.coarse_pass, d.coarse_scale,
              d.coarse_min_size, d.drone_first, d.policy, d.max_detections) +
