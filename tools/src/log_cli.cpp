@@ -43,20 +43,7 @@ struct ReplayVerbOptions {
     v("output.record", replay.record_log, "write every message seen on the bus (but status) to this LCM log");
     v("output.quiet", quiet, "no progress on stderr");
   }
-  /// ReplayOptions::validate()'s rules, every problem named by its key.
-  std::vector<std::string> validate() const {
-    using common::problem;
-    std::vector<std::string> p;
-    if (replay.input_log.empty()) p.emplace_back("input.log: give the log to play (LOG, or the key)");
-    if (replay.speed < 0) p.push_back(problem("playback.speed", replay.speed, "must be >= 0"));
-    if (replay.start_timeout_s <= 0)
-      p.push_back(problem("lockstep.start_timeout_s", replay.start_timeout_s, "must be > 0 seconds"));
-    if (replay.step_timeout_s <= 0)
-      p.push_back(problem("lockstep.step_timeout_s", replay.step_timeout_s, "must be > 0 seconds"));
-    if (replay.max_events < 0)
-      p.push_back(problem("input.max_events", static_cast<double>(replay.max_events), "must be >= 0"));
-    return p;
-  }
+  std::vector<std::string> validate() const { return replay.validate(); }
 };
 
 /// `wingman spy`'s options as keys.
@@ -88,19 +75,7 @@ struct MakeVideoVerbOptions {
     v("video.height", video.height, "height, pixels, 16..8192");
     v("video.fps", video.fps, "frames per second, (0, 1000]");
   }
-  /// MakeVideoOptions::validate()'s rules, every problem named by its key.
-  std::vector<std::string> validate() const {
-    using common::problem;
-    std::vector<std::string> p;
-    if (video.output.empty()) p.emplace_back("output.file: give the file to write (OUTPUT, or the key)");
-    if (video.frames < 1 || video.frames > 100000)
-      p.push_back(problem("video.frames", video.frames, "must be 1..100000"));
-    if (video.width < 16 || video.width > 8192) p.push_back(problem("video.width", video.width, "must be 16..8192"));
-    if (video.height < 16 || video.height > 8192)
-      p.push_back(problem("video.height", video.height, "must be 16..8192"));
-    if (!(video.fps > 0 && video.fps <= 1000)) p.push_back(problem("video.fps", video.fps, "must be in (0, 1000]"));
-    return p;
-  }
+  std::vector<std::string> validate() const { return video.validate(); }
 };
 
 /// `wingman loginfo`'s options as keys.

@@ -3,25 +3,29 @@
 #include "wingman/tools/make_video.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <wingman/common/config.hpp>
 
 #include <cmath>
 #include <stdexcept>
 
 namespace wingman::tools {
 
-std::string MakeVideoOptions::validate() const {
-  if (output.empty()) return "output: a file name is needed";
-  if (frames < 1 || frames > 100000) return fmt::format("--frames = {}: must be in 1..100000", frames);
-  if (width < 16 || width > 8192 || height < 16 || height > 8192)
-    return fmt::format("--size = {}x{}: each side must be in 16..8192", width, height);
-  if (!(fps > 0 && fps <= 1000)) return fmt::format("--fps = {}: must be in (0, 1000]", fps);
-  return "";
+std::vector<std::string> MakeVideoOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (output.empty()) p.emplace_back("output.file: give the file to write (OUTPUT, or the key)");
+  if (frames < 1 || frames > 100000) p.push_back(problem("video.frames", frames, "must be 1..100000"));
+  if (width < 16 || width > 8192) p.push_back(problem("video.width", width, "must be 16..8192"));
+  if (height < 16 || height > 8192) p.push_back(problem("video.height", height, "must be 16..8192"));
+  if (!(fps > 0 && fps <= 1000)) p.push_back(problem("video.fps", fps, "must be in (0, 1000]"));
+  return p;
 }
 
 void make_video(const MakeVideoOptions& o) {
-  if (const std::string bad = o.validate(); !bad.empty()) throw std::runtime_error(bad);
+  if (const auto bad = o.validate(); !bad.empty()) throw std::runtime_error(fmt::format("{}", fmt::join(bad, "; ")));
   cv::VideoWriter writer(o.output, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), o.fps,
                          cv::Size(o.width, o.height));
   if (!writer.isOpened()) throw std::runtime_error(fmt::format("{}: cannot write a video here", o.output));

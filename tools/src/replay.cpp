@@ -9,8 +9,10 @@
 #include <wingman/status_t.hpp>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <lcm/lcm-cpp.hpp>
+#include <wingman/common/config.hpp>
 
 #include <chrono>
 #include <map>
@@ -84,13 +86,15 @@ std::string unsettled(const BusObserver& bus, const launcher::BusWatch& watch, c
 
 }  // namespace
 
-std::string ReplayOptions::validate() const {
-  if (input_log.empty()) return "input log: must be given";
-  if (speed < 0) return fmt::format("--speed = {}: must be >= 0", speed);
-  if (start_timeout_s <= 0) return fmt::format("--start-timeout = {}: must be > 0 seconds", start_timeout_s);
-  if (step_timeout_s <= 0) return fmt::format("--step-timeout = {}: must be > 0 seconds", step_timeout_s);
-  if (max_events < 0) return fmt::format("--max-events = {}: must be >= 0", max_events);
-  return "";
+std::vector<std::string> ReplayOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (input_log.empty()) p.emplace_back("input.log: give the log to play (LOG, or the key)");
+  if (speed < 0) p.push_back(problem("playback.speed", speed, "must be >= 0"));
+  if (start_timeout_s <= 0) p.push_back(problem("lockstep.start_timeout_s", start_timeout_s, "must be > 0 seconds"));
+  if (step_timeout_s <= 0) p.push_back(problem("lockstep.step_timeout_s", step_timeout_s, "must be > 0 seconds"));
+  if (max_events < 0) p.push_back(problem("input.max_events", static_cast<double>(max_events), "must be >= 0"));
+  return p;
 }
 
 std::string ReplaySummary::one_line() const {
@@ -102,7 +106,8 @@ std::string ReplaySummary::one_line() const {
 }
 
 ReplaySummary run_replay(const ReplayOptions& options) {
-  if (const std::string bad = options.validate(); !bad.empty()) throw std::runtime_error(bad);
+  if (const auto bad = options.validate(); !bad.empty())
+    throw std::runtime_error(fmt::format("{}", fmt::join(bad, "; ")));
   const auto t_start = Clock::now();
   ReplaySummary summary;
 

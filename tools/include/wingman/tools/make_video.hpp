@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace wingman::tools {
 
@@ -14,8 +15,8 @@ struct MakeVideoOptions {
   int height = 480;    ///< pixels
   double fps = 30.0;   ///< frames per second
 
-  /// "" or one line naming the bad option.
-  std::string validate() const;
+  /// Every problem, one line each named by `wingman make-video`'s key (output.file, video.*); empty when valid.
+  std::vector<std::string> validate() const;
 };
 
 /// Writes a clip of a sky-like gradient with a dark quadcopter-like shape moving across it, so the

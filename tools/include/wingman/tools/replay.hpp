@@ -25,8 +25,9 @@ struct ReplayOptions {
   /// Progress through the log (common::Progress, every 5 s) goes here; nullptr = quiet.
   std::ostream* progress = nullptr;
 
-  /// "" or one line naming the bad option.
-  std::string validate() const;
+  /// Every problem, one line each named by `wingman replay`'s key (input.log, playback.speed, lockstep.*,
+  /// input.max_events); empty when valid.
+  std::vector<std::string> validate() const;
 };
 
 /// What a replay did.
