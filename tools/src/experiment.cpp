@@ -201,10 +201,7 @@ FlyOptions flight_options(const ExperimentOptions& o, const ExperimentFlight& f,
   } else if (!f.scenario_sets.empty()) {
     // A copy named as the original, so that the flight finds its config/flights/NAME.* files.
     ScenarioSetOptions s;
-    std::error_code ec;  // as plan_flight resolves it: a file, else config_dir/scenarios/NAME.yaml
-    s.file = fs::is_regular_file(fly.scenario, ec)
-                 ? fly.scenario
-                 : (fs::path(o.config_dir) / "scenarios" / (fly.scenario + ".yaml")).string();
+    s.file = scenario_file(fly.scenario, o.config_dir);
     s.sets = f.scenario_sets;
     s.out = (scenarios / f.name / fs::path(s.file).filename()).string();
     fs::create_directories(fs::path(s.out).parent_path());

@@ -94,15 +94,9 @@ FlightPlan plan_flight(const FlyOptions& o) {
     throw std::invalid_argument(all);
   }
   FlightPlan plan;
-  // The scenario: a file, else config/scenarios/NAME.yaml.
-  std::error_code ec;
-  if (fs::is_regular_file(o.scenario, ec)) {
-    plan.scenario_file = absolute(o.scenario);
-    plan.name = fs::path(o.scenario).stem().string();
-  } else {
-    plan.scenario_file = absolute((fs::path(o.config_dir) / "scenarios" / (o.scenario + ".yaml")).string());
-    plan.name = o.scenario;
-  }
+  // The scenario: a file, else config/scenarios/NAME.yaml (its name: the file's stem, or NAME).
+  plan.scenario_file = absolute(scenario_file(o.scenario, o.config_dir));
+  plan.name = fs::path(plan.scenario_file).stem().string();
   if (!readable_file(plan.scenario_file))
     throw std::invalid_argument(fmt::format("no scenario '{}' (looked for {})", o.scenario, plan.scenario_file));
   // The box noise follows the scenario's seed (as the rendered noise does), so runs of different seeds differ.
@@ -264,6 +258,12 @@ FlightPlan plan_flight(const FlyOptions& o) {
       formation_offset_for(plan.eval_target, plan.eval.follower_id, plan.eval.leader_id);
   plan.eval.has_formation = true;
   return plan;
+}
+
+std::string scenario_file(const std::string& scenario, const std::string& config_dir) {
+  std::error_code ec;
+  if (fs::is_regular_file(scenario, ec)) return scenario;
+  return (fs::path(config_dir) / "scenarios" / (scenario + ".yaml")).string();
 }
 
 int fly(const FlightPlan& plan, std::ostream& out, std::ostream& err) {

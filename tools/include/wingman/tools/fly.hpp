@@ -93,6 +93,10 @@ struct FlightPlan {
   FlightTargetSources eval_target;              ///< the follower configuration and scenario eval measures against
 };
 
+/// The scenario file `scenario` names: itself when it is a file, else `config_dir`/scenarios/SCENARIO.yaml (not
+/// checked to exist). As plan_flight reads flight.scenario.
+std::string scenario_file(const std::string& scenario, const std::string& config_dir);
+
 /// The plan for `o`: checks the options, the scenario (read with the simulator's loader for its seed), the
 /// executables and the configuration files. Throws std::invalid_argument (or common::ConfigError) naming the option
 /// or file and what was expected. Reads files; starts nothing.
