@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: MIT
 // wingman-localizer: detections and own pose in, tracked 3D targets out.
-#include <wingman/geometry/calibration.hpp>
 #include "wingman/localizer/localizer.hpp"
 
 #include <wingman/common/runtime.hpp>
@@ -12,9 +11,11 @@ namespace {
 using namespace wingman;
 
 int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
-  localizer::Localizer loc(o, geometry::make_camera(o.camera));
+  // One camera (camera.*), or the cameras of cameras.rig, each with its own detections and windows channels.
+  localizer::Localizer loc = localizer::Localizer::from_options(o);
   rt.status().declare_output(o.output_channel);
-  if (o.windows.publish) rt.status().declare_output(o.windows.channel);
+  if (o.windows.publish)
+    for (const localizer::LocalizerCamera& c : loc.cameras()) rt.status().declare_output(c.windows_channel);
   // A time resync (one input re-anchored the clock) is worth a log line each time.
   const auto log_notes = [&] {
     for (const std::string& note : loc.take_notes()) spdlog::warn("{}", note);
@@ -23,24 +24,44 @@ int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
     loc.on_own_pose(p);
     log_notes();
   });
-  rt.subscribe<detections_t>(o.detections_channel, [&](const detections_t& d) {
-    const localizer::LocalizerOutput out = loc.on_detections(d);
-    log_notes();
-    rt.status().set_last_processed_seq(d.seq);
-    for (const auto& why : out.rejections) rt.status().item_dropped(o.detections_channel, why);
-    // Boxes of other classes than drone are expected, not drops: their counts since start are in the detail.
-    // So are tracks the confidence bar holds back (a model scoring below it confirms nothing: the detail says why).
-    std::string detail = loc.non_drone_boxes().summary();
-    if (const std::string held = loc.tracker_summary(); !held.empty()) detail += (detail.empty() ? "" : "; ") + held;
-    if (out.camera_frame_only) {
-      rt.status().set_state(status_t::STATE_DEGRADED,
-                            "camera frame only: no fresh own pose" + (detail.empty() ? "" : "; " + detail));
-    } else {
-      rt.status().set_state(status_t::STATE_OK, detail);
-    }
-    if (out.windows) rt.publish(o.windows.channel, *out.windows);  // before the targets: see LocalizerOutput
-    if (out.targets) rt.publish(o.output_channel, *out.targets);
-  });
+  bool camera_frame_only = false;  // the newest exposure had no fresh own pose
+  for (const localizer::LocalizerCamera& camera : loc.cameras()) {
+    const std::string channel = camera.detections_channel;
+    // A message that cannot be used throws: the runtime drops and counts it on its channel, never fatal.
+    rt.subscribe<detections_t>(channel, [&, channel](const detections_t& d) {
+      const std::vector<localizer::LocalizerOutput> outputs = loc.add_detections(d);
+      log_notes();
+      rt.status().set_last_processed_seq(d.seq);
+      for (const localizer::LocalizerOutput& out : outputs) {
+        for (const auto& why : out.rejections) rt.status().item_dropped(channel, why);
+        camera_frame_only = out.camera_frame_only;
+      }
+      // Boxes of other classes than drone are expected, not drops: their counts since start are in the detail.
+      // So are tracks the confidence bar holds back (a model scoring below it confirms nothing: the detail says why),
+      // and with a camera rig the detections per camera and the silent cameras.
+      std::string detail;
+      const auto add = [&detail](const std::string& part) {
+        if (!part.empty()) detail += (detail.empty() ? "" : "; ") + part;
+      };
+      const std::string silent = loc.silent_summary();
+      add(silent);
+      add(loc.cameras_summary());
+      add(loc.non_drone_boxes().summary());
+      add(loc.tracker_summary());
+      if (camera_frame_only) {
+        rt.status().set_state(status_t::STATE_DEGRADED,
+                              "camera frame only: no fresh own pose" + (detail.empty() ? "" : "; " + detail));
+      } else {
+        rt.status().set_state(silent.empty() ? status_t::STATE_OK : status_t::STATE_DEGRADED, detail);
+      }
+      for (const localizer::LocalizerOutput& out : outputs) {
+        // Windows before the targets: see LocalizerOutput.
+        if (out.windows) rt.publish(o.windows.channel, *out.windows);
+        for (const localizer::CameraWindows& w : out.camera_windows) rt.publish(w.channel, w.windows);
+        if (out.targets) rt.publish(o.output_channel, *out.targets);
+      }
+    });
+  }
   return rt.spin();
 }
 

@@ -6,8 +6,10 @@
 
 #include <fmt/format.h>
 #include <wingman/common/detection_class.hpp>
+#include <wingman/geometry/calibration.hpp>
 #include <wingman/geometry/message_eigen.hpp>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace wingman::localizer {
@@ -25,13 +27,39 @@ std::string NonDroneCounts::summary() const {
 Localizer::Localizer(const LocalizerOptions& options, geometry::CameraModel camera)
     : options_(options),
       cnn_relation_(BoxRelation::load(options.sphere.box_relation)),
-      camera_(std::move(camera)),
-      extrinsics_(geometry::Extrinsics::from_options(options.extrinsics)),
       poses_(options.pose),
       tracker_(options.tracker),
       clock_(options.time),
-      own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)),
-      detections_input_(clock_.add_input("detections_t.utime", "detections_t", true)) {}
+      own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)) {
+  cameras_.emplace_back(options.camera.camera_id, std::move(camera),
+                        geometry::Extrinsics::from_options(options.extrinsics), options.detections_channel,
+                        options.windows.channel);
+  camera_inputs_.push_back(clock_.add_input("detections_t.utime", "detections_t", true));
+}
+
+Localizer::Localizer(const LocalizerOptions& options, const geometry::CameraRig& rig)
+    : options_(options),
+      rig_(true),
+      cnn_relation_(BoxRelation::load(options.sphere.box_relation)),
+      poses_(options.pose),
+      tracker_(options.tracker),
+      clock_(options.time),
+      own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)) {
+  if (rig.cameras.empty()) throw std::invalid_argument("cameras.rig = '" + rig.source + "': no cameras");
+  if (!(options.cameras.silent_after_s > 0) || options.cameras.max_pending < 1)
+    throw std::invalid_argument("invalid cameras.silent_after_s or cameras.max_pending");
+  for (const geometry::RigCamera& c : rig.cameras) {
+    cameras_.emplace_back(c.camera.camera_id, geometry::make_camera(c.camera),
+                          geometry::Extrinsics::from_options(c.extrinsics), c.detections_channel, c.windows_channel);
+    camera_inputs_.push_back(
+        clock_.add_input("detections_t.utime", fmt::format("camera {} detections_t", c.camera.camera_id), true));
+  }
+}
+
+Localizer Localizer::from_options(const LocalizerOptions& options) {
+  if (options.cameras.rig.empty()) return Localizer(options, geometry::make_camera(options.camera));
+  return Localizer(options, geometry::load_camera_rig(options.cameras.rig));
+}
 
 void Localizer::on_own_pose(const wingman::own_pose_t& m) {
   PoseSample s;
@@ -56,79 +84,232 @@ void Localizer::on_own_pose(const wingman::own_pose_t& m) {
   newest_pose_utime_ = std::max(newest_pose_utime_, m.utime);
 }
 
-LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
-  if (d.camera_id != options_.camera.camera_id) {
-    throw std::invalid_argument(fmt::format("detections_t.camera_id = {}: this localizer takes camera {}", d.camera_id,
-                                            options_.camera.camera_id));
-  }
-  if (d.image_width != camera_.width() || d.image_height != camera_.height()) {
+void Localizer::admit(LocalizerCamera& c, int clock_input, const wingman::detections_t& d) {
+  if (d.image_width != c.camera.width() || d.image_height != c.camera.height()) {
     if (!options_.camera.scale_to_image) {
       throw std::invalid_argument("detections_t.image_width x image_height: " +
-                                  camera_.check_image_size(d.image_width, d.image_height));
+                                  c.camera.check_image_size(d.image_width, d.image_height));
     }
-    camera_ = camera_.scaled_to(d.image_width, d.image_height);
+    c.camera = c.camera.scaled_to(d.image_width, d.image_height);
   }
   const bool ground_truth = d.source == wingman::detections_t::SOURCE_GROUND_TRUTH;
   if (!ground_truth) {
     if (const std::string bad = cnn_relation_.check_model(d.model_id); !bad.empty()) throw std::invalid_argument(bad);
   }
-  const common::TimeAdmission admission = clock_.admit(detections_input_, d.utime);
+  const common::TimeAdmission admission = clock_.admit(clock_input, d.utime);
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);
   if (admission.resynced()) {  // its tracks live in the old times
     tracker_ = Tracker(options_.tracker);
     previous_detections_utime_ = -1;
-    notes_.push_back(admission.problem + "; the tracker restarts (new track ids)");
+    if (rig_) {  // so do the waiting exposures and what each camera sent
+      pending_.clear();
+      processed_utime_ = -1;
+      first_utime_ = -1;
+      for (LocalizerCamera& other : cameras_) other.last_utime = -1;
+      notes_.push_back(admission.problem +
+                       "; the tracker restarts (new track ids) and the waiting exposures are "
+                       "dropped");
+    } else {
+      notes_.push_back(admission.problem + "; the tracker restarts (new track ids)");
+    }
   }
+  ++c.messages;
+  c.last_utime = d.utime;
+}
 
+LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
+  if (rig_) throw std::logic_error("Localizer::on_detections: a camera rig takes add_detections()");
+  if (d.camera_id != cameras_[0].camera_id) {
+    throw std::invalid_argument(fmt::format("detections_t.camera_id = {}: this localizer takes camera {}", d.camera_id,
+                                            options_.camera.camera_id));
+  }
+  admit(cameras_[0], camera_inputs_[0], d);
+  return process(d.utime, {&d});
+}
+
+std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections_t& d) {
+  if (!rig_) return {on_detections(d)};
+  size_t i = 0;
+  while (i < cameras_.size() && cameras_[i].camera_id != d.camera_id) ++i;
+  if (i == cameras_.size()) {
+    std::string ids;
+    for (const LocalizerCamera& c : cameras_) ids += fmt::format("{}{}", ids.empty() ? "" : ", ", c.camera_id);
+    throw std::invalid_argument(fmt::format("detections_t.camera_id = {}: not a camera of the rig {} (cameras.rig: {})",
+                                            d.camera_id, options_.cameras.rig, ids));
+  }
+  admit(cameras_[i], camera_inputs_[i], d);
+  if (first_utime_ < 0) first_utime_ = d.utime;
+  if (d.utime <= processed_utime_) {  // a sign of life all the same (admit() counted it)
+    ++exposure_stats_.late;
+    throw std::invalid_argument(fmt::format(
+        "detections_t.utime = {}: camera {} is late: the exposure{} was processed without it (the exposure {})",
+        d.utime, d.camera_id, d.utime == processed_utime_ ? "" : " after it", processed_utime_));
+  }
+  auto [it, added] = pending_.try_emplace(d.utime);
+  if (added) it->second.resize(cameras_.size());
+  it->second[i] = d;
+
+  std::vector<LocalizerOutput> out;
+  while (!pending_.empty()) {
+    const auto oldest = pending_.begin();
+    const int64_t utime = oldest->first;
+    // Ready when no camera it lacks is still to be waited for: such a camera sent a later exposure (it will not send
+    // this one), is silent, or is overtaken (every other camera that is not silent has sent a later exposure).
+    bool ready = true, missing = false;
+    for (size_t c = 0; c < cameras_.size() && ready; ++c) {
+      if (oldest->second[c]) continue;
+      missing = true;
+      if (cameras_[c].last_utime > utime || silent(c)) continue;
+      for (size_t o = 0; o < cameras_.size(); ++o)
+        if (o != c && cameras_[o].last_utime <= utime && !silent(o)) ready = false;
+    }
+    const bool overflow = static_cast<int>(pending_.size()) > options_.cameras.max_pending;
+    if (!ready && !overflow) break;
+    std::vector<const wingman::detections_t*> per_camera(cameras_.size(), nullptr);
+    for (size_t c = 0; c < cameras_.size(); ++c)
+      if (oldest->second[c]) per_camera[c] = &*oldest->second[c];
+    ++exposure_stats_.processed;
+    if (missing) ++exposure_stats_.incomplete;
+    if (!ready) ++exposure_stats_.overflowed;
+    processed_utime_ = utime;
+    out.push_back(process(utime, per_camera));
+    pending_.erase(oldest);
+  }
+  return out;
+}
+
+bool Localizer::silent(size_t i) const {
+  if (first_utime_ < 0) return false;
+  int64_t newest = first_utime_;
+  for (const LocalizerCamera& c : cameras_) newest = std::max(newest, c.last_utime);
+  const int64_t since = cameras_[i].last_utime >= 0 ? cameras_[i].last_utime : first_utime_;
+  return static_cast<double>(newest - since) > options_.cameras.silent_after_s * 1e6;
+}
+
+std::string Localizer::silent_summary() const {
+  if (!rig_ || first_utime_ < 0) return "";
+  int64_t newest = first_utime_;
+  for (const LocalizerCamera& c : cameras_) newest = std::max(newest, c.last_utime);
+  std::string out;
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    if (!silent(i)) continue;
+    const LocalizerCamera& c = cameras_[i];
+    const int64_t since = c.last_utime >= 0 ? c.last_utime : first_utime_;
+    out += fmt::format("{}camera {} silent for {:.1f} s{}", out.empty() ? "" : ", ", c.camera_id,
+                       static_cast<double>(newest - since) * 1e-6, c.last_utime >= 0 ? "" : " (no message yet)");
+  }
+  return out;
+}
+
+std::string Localizer::cameras_summary() const {
+  if (!rig_) return "";
+  std::string out = "detections_t per camera:";
+  for (size_t i = 0; i < cameras_.size(); ++i)
+    out += fmt::format("{} {} {}", i == 0 ? "" : ",", cameras_[i].camera_id, cameras_[i].messages);
+  return out;
+}
+
+namespace {
+
+/// The camera-frame targets of `measurements` (no own pose: untracked), of camera `d.camera_id`, appended to `out`.
+void append_camera_frame_targets(const wingman::detections_t& d, const std::vector<CameraMeasurement>& measurements,
+                                 wingman::targets_t& out) {
+  for (const auto& m : measurements) {
+    wingman::target_t t{};
+    t.track_id = 0;  // untracked: tracks live in the world frame
+    t.camera_id = d.camera_id;
+    geometry::to_array(m.p_target_in_cam, t.p_target_in_cam);
+    geometry::to_array(m.cov_p_in_cam, t.position_covariance);
+    t.world_valid = false;
+    t.range = m.range_valid ? m.range : 0.0;
+    t.confidence = static_cast<float>(m.confidence);
+    t.source_utime = d.utime;
+    t.predicted_utime = d.utime;
+    t.detection_source = d.source;
+    out.targets.push_back(t);
+  }
+}
+
+}  // namespace
+
+LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingman::detections_t*>& per_camera) {
   LocalizerOutput result;
-  std::vector<CameraMeasurement> measurements;
+  result.utime = utime;
   const bool track_every_class = options_.class_decision == "track";
   result.non_drone.tracked = track_every_class;
-  for (size_t i = 0; i < d.detections.size(); ++i) {
-    const auto& det = d.detections[i];
-    if (det.class_id != common::kDroneClassId) {  // a distractor class of a multi-class model
-      ++result.non_drone.total;
-      ++result.non_drone.by_class[det.class_id];
-      if (!track_every_class) continue;  // decided per box: never a target
+  const wingman::detections_t* first = nullptr;  // the first camera's message that is there
+  std::vector<std::vector<CameraMeasurement>> measurements(per_camera.size());
+  for (size_t c = 0; c < per_camera.size(); ++c) {
+    const wingman::detections_t* d = per_camera[c];
+    if (d == nullptr) continue;
+    if (first == nullptr) first = d;
+    const bool ground_truth = d->source == wingman::detections_t::SOURCE_GROUND_TRUTH;
+    for (size_t i = 0; i < d->detections.size(); ++i) {
+      const auto& det = d->detections[i];
+      if (det.class_id != common::kDroneClassId) {  // a distractor class of a multi-class model
+        ++result.non_drone.total;
+        ++result.non_drone.by_class[det.class_id];
+        if (!track_every_class) continue;  // decided per box: never a target
+      }
+      const geometry::PixelBox box{det.cx, det.cy, det.w, det.h};
+      const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d->image_width);
+      LocalizeResult r = localize_box(box, cameras_[c].camera, options_.sphere, scale);
+      if (!r.ok) {
+        result.rejections.push_back(
+            rig_ ? fmt::format("camera {}: detections_t.detections[{}]: {}", d->camera_id, i, r.reason)
+                 : fmt::format("detections_t.detections[{}]: {}", i, r.reason));
+        continue;
+      }
+      // Decided per track: the tracker's evidence is the box's drone score (the same as its confidence for a drone
+      // box).
+      r.measurement.confidence = track_every_class ? det.drone_score : det.confidence;
+      measurements[c].push_back(r.measurement);
     }
-    const geometry::PixelBox box{det.cx, det.cy, det.w, det.h};
-    const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d.image_width);
-    LocalizeResult r = localize_box(box, camera_, options_.sphere, scale);
-    if (!r.ok) {
-      result.rejections.push_back(fmt::format("detections_t.detections[{}]: {}", i, r.reason));
-      continue;
-    }
-    // Decided per track: the tracker's evidence is the box's drone score (the same as its confidence for a drone box).
-    r.measurement.confidence = track_every_class ? det.drone_score : det.confidence;
-    measurements.push_back(r.measurement);
   }
   non_drone_boxes_.tracked = track_every_class;
   non_drone_boxes_.total += result.non_drone.total;
   for (const auto& [class_id, n] : result.non_drone.by_class) non_drone_boxes_.by_class[class_id] += n;
 
   std::string why;
-  const std::optional<PoseSample> pose = poses_.at(d.utime, &why);
+  const std::optional<PoseSample> pose = poses_.at(utime, &why);
   if (!pose) {
     result.camera_frame_only = true;
-    result.rejections.push_back("no own pose at detections_t.utime = " + std::to_string(d.utime) + ": " + why);
-    if (options_.publish_camera_frame_only) result.targets = camera_frame_targets(d, measurements);
+    result.rejections.push_back("no own pose at detections_t.utime = " + std::to_string(utime) + ": " + why);
+    if (options_.publish_camera_frame_only) {
+      wingman::targets_t out{};
+      out.utime = utime;
+      out.frame = wingman::own_pose_t::FRAME_ENU;
+      for (size_t c = 0; c < per_camera.size(); ++c)
+        if (per_camera[c] != nullptr) append_camera_frame_targets(*per_camera[c], measurements[c], out);
+      out.num_targets = static_cast<int32_t>(out.targets.size());
+      result.targets = std::move(out);
+    }
     return result;
   }
 
-  std::vector<WorldMeasurement> world;
-  world.reserve(measurements.size());
-  for (const auto& m : measurements) {
-    if (!m.range_valid) continue;  // bearing-only: not a position; the tracker takes positions
-    world.push_back(to_world(m, extrinsics_, *pose, d.utime, d.camera_id));
+  std::vector<std::vector<WorldMeasurement>> world(per_camera.size());
+  for (size_t c = 0; c < per_camera.size(); ++c) {
+    world[c].reserve(measurements[c].size());
+    for (const auto& m : measurements[c]) {
+      if (!m.range_valid) continue;  // bearing-only: not a position; the tracker takes positions
+      world[c].push_back(to_world(m, cameras_[c].extrinsics, *pose, utime, per_camera[c]->camera_id));
+    }
   }
-  if (!tracker_.update(d.utime, world, &why)) {
-    throw std::invalid_argument("detections_t.utime = " + std::to_string(d.utime) + ": " + why);
+  if (!tracker_.update_cameras(utime, world, &why)) {
+    throw std::invalid_argument("detections_t.utime = " + std::to_string(utime) + ": " + why);
   }
-  if (options_.windows.publish) result.windows = track_windows(d, *pose);
-  previous_detections_utime_ = d.utime;
+  if (options_.windows.publish) {
+    if (rig_) {
+      for (const LocalizerCamera& c : cameras_)
+        result.camera_windows.push_back({c.windows_channel, track_windows(utime, c, first->source, *pose)});
+    } else {
+      result.windows = track_windows(utime, cameras_[0], first->source, *pose);
+    }
+  }
+  previous_detections_utime_ = utime;
 
   // Lag compensation: predict to the newest time we know of (own poses arrive with little delay).
-  const int64_t predict_to = std::max(d.utime, newest_pose_utime_);
+  const int64_t predict_to = std::max(utime, newest_pose_utime_);
   wingman::targets_t out{};
   out.utime = predict_to;
   out.frame = wingman::own_pose_t::FRAME_ENU;
@@ -149,7 +330,7 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
     m.age_s = static_cast<float>(t.age_s);
     m.source_utime = t.source_utime;
     m.predicted_utime = t.predicted_utime;
-    m.detection_source = d.source;
+    m.detection_source = first->source;
     out.targets.push_back(m);
   }
   out.num_targets = static_cast<int32_t>(out.targets.size());
@@ -157,58 +338,37 @@ LocalizerOutput Localizer::on_detections(const wingman::detections_t& d) {
   return result;
 }
 
-wingman::track_windows_t Localizer::track_windows(const wingman::detections_t& d, const PoseSample& pose) const {
+wingman::track_windows_t Localizer::track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
+                                                  const PoseSample& pose) const {
   // The next exposure: one frame interval (the last one seen, at most 0.5 s) after this one.
   constexpr int64_t kMaxInterval_us = 500000;
-  const int64_t interval_us = previous_detections_utime_ >= 0 && d.utime - previous_detections_utime_ <= kMaxInterval_us
-                                  ? d.utime - previous_detections_utime_
+  const int64_t interval_us = previous_detections_utime_ >= 0 && utime - previous_detections_utime_ <= kMaxInterval_us
+                                  ? utime - previous_detections_utime_
                                   : 0;
   wingman::track_windows_t out{};
-  out.utime = d.utime;
-  out.utime_predicted = d.utime + interval_us;
-  out.camera_id = d.camera_id;
-  out.image_width = d.image_width;
-  out.image_height = d.image_height;
+  out.utime = utime;
+  out.utime_predicted = utime + interval_us;
+  out.camera_id = c.camera_id;
+  out.image_width = c.camera.width();
+  out.image_height = c.camera.height();
   // The camera then: the pose at this exposure moved on with the body's velocity (its rotation held).
   const double dt = static_cast<double>(interval_us) * 1e-6;
-  const CameraPoseInWorld now = camera_pose_in_world(extrinsics_, pose);
+  const CameraPoseInWorld now = camera_pose_in_world(c.extrinsics, pose);
   CameraAtExposure cam;
   cam.R_cam_to_world = now.R_cam_to_world;
   cam.v_cam_in_world = pose.v_body_in_world;
   cam.p_cam_in_world = now.p_cam_in_world + dt * pose.v_body_in_world;
-  const bool ground_truth = d.source == wingman::detections_t::SOURCE_GROUND_TRUTH;
+  const bool ground_truth = source == wingman::detections_t::SOURCE_GROUND_TRUTH;
   static const BoxRelation sphere = BoxRelation::sphere();  // built once, not per frame
   for (const TrackOutput& t : tracker_.predicted_tracks(out.utime_predicted)) {
     if (static_cast<int>(out.windows.size()) >= options_.windows.max_windows) break;
     // The box relation holds for full-resolution re-detections too (measured: docs/detector.md, "Tracker-driven
     // windows").
-    if (auto w = predict_track_window(t, options_.sphere.radius_m, camera_, cam, ground_truth ? sphere : cnn_relation_))
+    if (auto w =
+            predict_track_window(t, options_.sphere.radius_m, c.camera, cam, ground_truth ? sphere : cnn_relation_))
       out.windows.push_back(*w);
   }
   out.num_windows = static_cast<int32_t>(out.windows.size());
-  return out;
-}
-
-wingman::targets_t Localizer::camera_frame_targets(const wingman::detections_t& d,
-                                                   const std::vector<CameraMeasurement>& measurements) const {
-  wingman::targets_t out{};
-  out.utime = d.utime;
-  out.frame = wingman::own_pose_t::FRAME_ENU;
-  for (const auto& m : measurements) {
-    wingman::target_t t{};
-    t.track_id = 0;  // untracked: tracks live in the world frame
-    t.camera_id = d.camera_id;
-    geometry::to_array(m.p_target_in_cam, t.p_target_in_cam);
-    geometry::to_array(m.cov_p_in_cam, t.position_covariance);
-    t.world_valid = false;
-    t.range = m.range_valid ? m.range : 0.0;
-    t.confidence = static_cast<float>(m.confidence);
-    t.source_utime = d.utime;
-    t.predicted_utime = d.utime;
-    t.detection_source = d.source;
-    out.targets.push_back(t);
-  }
-  out.num_targets = static_cast<int32_t>(out.targets.size());
   return out;
 }
 

@@ -3,8 +3,27 @@
 #include "wingman/localizer/localizer_options.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/geometry/camera_rig.hpp>
+
+#include <cmath>
 
 namespace wingman::localizer {
+
+std::vector<std::string> CameraRigOptions::validate() const {
+  using common::problem;
+  std::vector<std::string> p;
+  if (!(silent_after_s > 0) || !std::isfinite(silent_after_s))
+    p.push_back(problem("cameras.silent_after_s", silent_after_s, "must be finite and > 0"));
+  if (max_pending < 1) p.push_back(problem("cameras.max_pending", max_pending, "must be >= 1"));
+  if (!rig.empty()) {
+    try {
+      (void)geometry::load_camera_rig(rig);
+    } catch (const std::exception& e) {  // common::ConfigError: every problem of the file, each with its line
+      p.push_back(problem("cameras.rig", rig, e.what()));
+    }
+  }
+  return p;
+}
 
 std::vector<std::string> LocalizerOptions::validate() const {
   using common::problem;
@@ -16,7 +35,7 @@ std::vector<std::string> LocalizerOptions::validate() const {
   if (class_decision != "box" && class_decision != "track")
     p.push_back(problem("classes.decision", class_decision, "must be box or track"));
   for (const auto& part : {camera.validate(), sphere.validate(), extrinsics.validate(), pose.validate(),
-                           tracker.validate(), windows.validate(), time.validate()}) {
+                           tracker.validate(), windows.validate(), time.validate(), cameras.validate()}) {
     p.insert(p.end(), part.begin(), part.end());
   }
   return p;

@@ -39,7 +39,8 @@ SizeEstimator::SizeEstimator(SizeEstimatorOptions options) : options_(std::move(
 void SizeEstimator::add(int64_t utime, const Eigen::Vector3d& z_in_world, const Eigen::Matrix3d& R,
                         const Eigen::Vector3d& c_in_world) {
   if (!options_.enabled) return;
-  if (!samples_.empty() && utime <= samples_.back().utime) samples_.clear();  // time went back: start again
+  // Time went back: start again (several cameras of one exposure add samples at the same time).
+  if (!samples_.empty() && utime < samples_.back().utime) samples_.clear();
   samples_.push_back({utime, z_in_world - c_in_world, c_in_world, 0.5 * (R + R.transpose())});
   const int64_t window_us = static_cast<int64_t>(std::llround(options_.window_s * 1e6));
   while (!samples_.empty() && utime - samples_.front().utime > window_us) samples_.pop_front();

@@ -166,6 +166,11 @@ void Tracker::hit(Track& t, const WorldMeasurement& z) {
 }
 
 bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measurements, std::string* why) {
+  return update_cameras(utime, std::vector<std::vector<WorldMeasurement>>(1, measurements), why);
+}
+
+bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldMeasurement>>& per_camera,
+                             std::string* why) {
   if (have_frame_ && utime <= last_frame_utime_) {
     ++stats_.frames_rejected;
     if (why)
@@ -176,26 +181,34 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
   }
   ++stats_.frames;
 
-  // The detections this frame uses; each carries the frame's utime.
-  std::vector<WorldMeasurement> z;
-  z.reserve(measurements.size());
-  for (const WorldMeasurement& m : measurements) {
-    if (!finite(m)) {
-      ++stats_.measurements_rejected;
-      continue;
+  // The detections this frame uses, per camera; each carries the frame's utime.
+  std::vector<std::vector<WorldMeasurement>> zs(per_camera.size());
+  for (size_t c = 0; c < per_camera.size(); ++c) {
+    zs[c].reserve(per_camera[c].size());
+    for (const WorldMeasurement& m : per_camera[c]) {
+      if (!finite(m)) {
+        ++stats_.measurements_rejected;
+        continue;
+      }
+      zs[c].push_back(m);
+      zs[c].back().utime = utime;
     }
-    z.push_back(m);
-    z.back().utime = utime;
   }
-  if (mode_ == TrackerMode::kMostConfident && z.size() > 1) {
-    const auto best = std::max_element(z.begin(), z.end(), [](const WorldMeasurement& a, const WorldMeasurement& b) {
-      return a.confidence < b.confidence;
-    });
-    const WorldMeasurement keep = *best;
-    stats_.measurements_rejected += static_cast<int64_t>(z.size() - 1);
-    z.assign(1, keep);
+  size_t total = 0;
+  for (const auto& z : zs) total += z.size();
+  if (mode_ == TrackerMode::kMostConfident && total > 1) {  // the frame's most confident detection, the first of ties
+    size_t best_c = 0, best_j = 0;
+    bool found = false;
+    for (size_t c = 0; c < zs.size(); ++c)
+      for (size_t j = 0; j < zs[c].size(); ++j)
+        if (!found || zs[c][j].confidence > zs[best_c][best_j].confidence) best_c = c, best_j = j, found = true;
+    const WorldMeasurement keep = zs[best_c][best_j];
+    for (auto& z : zs) z.clear();
+    zs[best_c].assign(1, keep);
+    stats_.measurements_rejected += static_cast<int64_t>(total - 1);
+    total = 1;
   }
-  stats_.measurements += static_cast<int64_t>(z.size());
+  stats_.measurements += static_cast<int64_t>(total);
 
   // Predict every track to the exposure time.
   for (Track& t : tracks_) {
@@ -203,60 +216,102 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
     t.state_utime = utime;
   }
 
-  // Confirmed tracks choose first, tentative ones take the rest.
-  std::vector<bool> z_used(z.size(), false);
+  // Per camera in order: confirmed tracks choose first, tentative ones take the rest, then the tracks the cameras
+  // before started this frame; the detections left start tracks (kept in `born` until the book-keeping is done).
+  const int64_t max_coast_us = static_cast<int64_t>(std::llround(options_.max_prediction_s * 1e6));
   std::vector<bool> track_hit(tracks_.size(), false);
-  for (const bool confirmed_pass : {true, false}) {
-    std::vector<Track*> group;
-    std::vector<size_t> index;
-    for (size_t i = 0; i < tracks_.size(); ++i)
-      if ((tracks_[i].id != 0) == confirmed_pass) {
-        group.push_back(&tracks_[i]);
-        index.push_back(i);
+  std::vector<bool> ambiguous(tracks_.size(), false);  // a coin toss with another confirmed track this frame
+  struct Birth {
+    Track track;
+    bool refused = false;  // below birth_min_confidence: starts nothing, takes nothing
+  };
+  std::vector<Birth> born;
+  for (size_t cam = 0; cam < zs.size(); ++cam) {
+    const std::vector<WorldMeasurement>& z = zs[cam];
+    std::vector<bool> z_used(z.size(), false);
+    for (const bool confirmed_pass : {true, false}) {
+      std::vector<Track*> group;
+      std::vector<size_t> index;  // into tracks_, or tracks_.size() + i for born[i]
+      for (size_t i = 0; i < tracks_.size(); ++i)
+        if ((tracks_[i].id != 0) == confirmed_pass) {
+          group.push_back(&tracks_[i]);
+          index.push_back(i);
+        }
+      if (!confirmed_pass)
+        for (size_t i = 0; i < born.size(); ++i)
+          if (!born[i].refused) {
+            group.push_back(&born[i].track);
+            index.push_back(tracks_.size() + i);
+          }
+      std::vector<int> track_to_z;
+      Eigen::MatrixXd cost;
+      associate(group, z, z_used, track_to_z, &cost);
+      // Two confirmed tracks that could as well have each other's detections (targets crossing): a coin toss, which
+      // would swap their identities half the time; both coast instead (the frame counts for their life), at most
+      // max_prediction_s in a row (two targets flying together: the optimal assignment again).
+      std::vector<bool> coast(group.size(), false);
+      if (confirmed_pass && options_.ambiguity_chi2 > 0) {
+        const auto c = [&](size_t track, int det) { return cost(static_cast<Eigen::Index>(track), det); };
+        for (size_t a = 0; a < group.size(); ++a)
+          for (size_t b = a + 1; b < group.size(); ++b) {
+            const int i = track_to_z[a], j = track_to_z[b];
+            if (i < 0 || j < 0 || is_forbidden(c(a, j)) || is_forbidden(c(b, i))) continue;
+            if ((c(a, j) + c(b, i)) - (c(a, i) + c(b, j)) < options_.ambiguity_chi2) coast[a] = coast[b] = true;
+          }
+        for (size_t k = 0; k < group.size(); ++k) {
+          if (!coast[k]) continue;
+          ambiguous[index[k]] = true;
+          const Track& t = *group[k];
+          if (t.coasting_since_utime >= 0 && utime - t.coasting_since_utime > max_coast_us) coast[k] = false;
+        }
       }
-    std::vector<int> track_to_z;
-    Eigen::MatrixXd cost;
-    associate(group, z, z_used, track_to_z, &cost);
-    // Two confirmed tracks that could as well have each other's detections (targets crossing): a coin toss, which
-    // would swap their identities half the time; both coast instead (the frame counts for their life).
-    std::vector<bool> coast(group.size(), false);
-    if (confirmed_pass && options_.ambiguity_chi2 > 0) {
-      const auto c = [&](size_t track, int det) { return cost(static_cast<Eigen::Index>(track), det); };
-      for (size_t a = 0; a < group.size(); ++a)
-        for (size_t b = a + 1; b < group.size(); ++b) {
-          const int i = track_to_z[a], j = track_to_z[b];
-          if (i < 0 || j < 0 || is_forbidden(c(a, j)) || is_forbidden(c(b, i))) continue;
-          if ((c(a, j) + c(b, i)) - (c(a, i) + c(b, j)) < options_.ambiguity_chi2) coast[a] = coast[b] = true;
-        }
-      const int64_t max_coast_us = static_cast<int64_t>(std::llround(options_.max_prediction_s * 1e6));
       for (size_t k = 0; k < group.size(); ++k) {
-        Track& t = *group[k];
-        if (!coast[k]) {
-          t.coasting_since_utime = -1;
-        } else if (t.coasting_since_utime < 0) {
-          t.coasting_since_utime = utime;
-        } else if (utime - t.coasting_since_utime > max_coast_us) {
-          coast[k] = false;  // coasted long enough (two targets flying together): the optimal assignment again
+        if (track_to_z[k] < 0) continue;
+        if (index[k] < tracks_.size()) track_hit[index[k]] = true;
+        if (coast[k]) {
+          group[k]->last_hit_utime = utime;
+          ++stats_.ambiguous;
+          continue;
         }
+        hit(*group[k], z[static_cast<size_t>(track_to_z[k])]);
+        ++stats_.associated;
       }
     }
-    for (size_t k = 0; k < group.size(); ++k) {
-      if (track_to_z[k] < 0) continue;
-      track_hit[index[k]] = true;
-      if (coast[k]) {
-        group[k]->last_hit_utime = utime;
-        ++stats_.ambiguous;
-        continue;
-      }
-      hit(*group[k], z[static_cast<size_t>(track_to_z[k])]);
-      ++stats_.associated;
+    for (size_t j = 0; j < z.size(); ++j) {
+      if (z_used[j]) continue;
+      Birth b;
+      b.refused = z[j].confidence < options_.birth_min_confidence;
+      Track& t = b.track;
+      t.sc = cv_initialize(z[j].p_target_in_world, z[j].cov_p_in_world, options_.initial_velocity_std);
+      t.state_utime = utime;
+      t.birth_utime = utime;
+      t.last_hit_utime = utime;
+      t.frames = 1;
+      t.hits = 1;
+      t.recent.push_back(true);
+      t.recent_confidence.push_back(z[j].confidence);
+      t.last = z[j];
+      t.window.push_back({utime, z[j].p_target_in_world, z[j].cov_p_in_world});
+      t.size = SizeEstimator(options_.size);
+      t.size.add(utime, z[j].p_target_in_world, z[j].cov_p_in_world, z[j].p_cam_in_world);
+      t.scale = t.size.estimate();  // the prior: 1 +- prior_rel (1 +- 0 when off)
+      born.push_back(std::move(b));
+    }
+  }
+  // A coasting run starts with its first ambiguous frame and ends with the first frame that is not.
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (tracks_[i].id == 0) continue;
+    if (!ambiguous[i]) {
+      tracks_[i].coasting_since_utime = -1;
+    } else if (tracks_[i].coasting_since_utime < 0) {
+      tracks_[i].coasting_since_utime = utime;
     }
   }
 
   // Book-keeping and deletion of the existing tracks.
   const int64_t death_timeout_us = static_cast<int64_t>(std::llround(options_.death_timeout_s * 1e6));
   std::vector<Track> kept;
-  kept.reserve(tracks_.size() + z.size());
+  kept.reserve(tracks_.size() + born.size());
   for (size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
     ++t.frames;
@@ -295,27 +350,14 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
   }
   merge_duplicates(utime);
 
-  // Detections no track took start tentative tracks.
-  for (size_t j = 0; j < z.size(); ++j) {
-    if (z_used[j] || static_cast<int>(tracks_.size()) >= options_.max_tracks) continue;
-    if (z[j].confidence < options_.birth_min_confidence) {
+  // Detections no camera's association took start tentative tracks.
+  for (Birth& b : born) {
+    if (static_cast<int>(tracks_.size()) >= options_.max_tracks) continue;
+    if (b.refused) {
       ++stats_.births_refused;
       continue;
     }
-    Track t;
-    t.sc = cv_initialize(z[j].p_target_in_world, z[j].cov_p_in_world, options_.initial_velocity_std);
-    t.state_utime = utime;
-    t.birth_utime = utime;
-    t.last_hit_utime = utime;
-    t.frames = 1;
-    t.hits = 1;
-    t.recent.push_back(true);
-    t.recent_confidence.push_back(z[j].confidence);
-    t.last = z[j];
-    t.window.push_back({utime, z[j].p_target_in_world, z[j].cov_p_in_world});
-    t.size = SizeEstimator(options_.size);
-    t.size.add(utime, z[j].p_target_in_world, z[j].cov_p_in_world, z[j].p_cam_in_world);
-    t.scale = t.size.estimate();  // the prior: 1 +- prior_rel (1 +- 0 when off)
+    Track& t = b.track;
     ++stats_.births;
     if (t.hits >= options_.birth_hits && confident_enough(t)) {
       t.id = next_id_++;

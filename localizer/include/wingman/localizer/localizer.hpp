@@ -3,6 +3,7 @@
 #pragma once
 
 #include <wingman/geometry/camera_model.hpp>
+#include <wingman/geometry/camera_rig.hpp>
 #include <wingman/geometry/extrinsics.hpp>
 #include "wingman/localizer/box_relation.hpp"
 #include "wingman/localizer/localizer_options.hpp"
@@ -19,6 +20,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace wingman::localizer {
@@ -36,7 +38,40 @@ struct NonDroneCounts {
   std::string summary() const;
 };
 
-/// What one detections message gave.
+/// A camera's windows and the channel they go out on (a camera rig: each camera's own).
+struct CameraWindows {
+  std::string channel;               ///< the rig camera's windows channel
+  wingman::track_windows_t windows;  ///< the tracks predicted into that camera's next image
+};
+
+/// One camera of the localizer: its model, mount and channels, and what it has sent.
+struct LocalizerCamera {
+  LocalizerCamera(int32_t id, geometry::CameraModel model, geometry::Extrinsics mount, std::string detections,
+                  std::string windows)
+      : camera_id(id),
+        camera(std::move(model)),
+        extrinsics(mount),
+        detections_channel(std::move(detections)),
+        windows_channel(std::move(windows)) {}
+
+  int32_t camera_id = 0;
+  geometry::CameraModel camera;  ///< rescaled to the detections' image size when camera.scale_to_image allows
+  geometry::Extrinsics extrinsics;
+  std::string detections_channel;  ///< detections_t input
+  std::string windows_channel;     ///< track_windows_t output (windows.publish)
+  int64_t messages = 0;            ///< detections_t accepted (in order, of the right size)
+  int64_t last_utime = -1;         ///< utime of the newest accepted detections_t; -1 before the first
+};
+
+/// What a camera rig's exposures have been through (cameras.rig).
+struct ExposureStats {
+  int64_t processed = 0;   ///< exposures given to the tracker (one targets_t each, unless nothing is published)
+  int64_t incomplete = 0;  ///< of those, processed without one or more rig cameras (silent, late or overtaken)
+  int64_t overflowed = 0;  ///< of those, processed because cameras.max_pending exposures were waiting
+  int64_t late = 0;        ///< detections_t dropped: their exposure had been processed without them
+};
+
+/// What one detections message gave (one camera), or one exposure (a camera rig).
 struct LocalizerOutput {
   /// Targets to publish; nullopt when there is nothing to publish (no confirmed track and output.publish_empty
   /// off, or no fresh own pose and output.publish_camera_frame_only off).
@@ -51,6 +86,10 @@ struct LocalizerOutput {
   /// before the targets, so that in lockstep the detector has them before the next frame). Empty windows are
   /// published too (the detector then knows its tracks are gone).
   std::optional<wingman::track_windows_t> windows;
+  /// A camera rig with windows.publish and a fresh own pose: every rig camera's windows, in rig order, each for its
+  /// own channel (published before the targets, as `windows`). Empty for one camera (that is `windows`).
+  std::vector<CameraWindows> camera_windows;
+  int64_t utime = 0;  ///< the exposure's utime (every detections_t of it has this utime)
 };
 
 /// Turns detections into tracked targets (Algorithm: eq. 24 / tangent planes per box, then the
@@ -65,6 +104,17 @@ class Localizer {
   /// Throws std::invalid_argument for invalid options.
   Localizer(const LocalizerOptions& options, geometry::CameraModel camera);
 
+  /// Several cameras on one vehicle (cameras.rig): `rig`'s cameras replace options.camera (except scale_to_image,
+  /// which applies to each), options.extrinsics, input.detections_channel and windows.channel. The detections_t of
+  /// one exposure (all rig cameras' messages with the same utime) are buffered per camera and fused into one tracker
+  /// frame, in rig order (Tracker::update_cameras), once every camera that is not silent has sent it: see
+  /// add_detections(). Throws std::invalid_argument for invalid options.
+  Localizer(const LocalizerOptions& options, const geometry::CameraRig& rig);
+
+  /// The localizer of `options`: the rig of cameras.rig (geometry::load_camera_rig(), which throws
+  /// common::ConfigError naming the file's every problem), or with "" the one camera of camera.*.
+  static Localizer from_options(const LocalizerOptions& options);
+
   /// Adds an own pose. Throws std::invalid_argument naming the field when it cannot be used
   /// (out of order, duplicate, dated too far ahead); the caller drops and counts it.
   void on_own_pose(const wingman::own_pose_t& pose);
@@ -75,7 +125,32 @@ class Localizer {
   /// SOURCE_CNN go through target.box_relation, ground-truth boxes are the sphere's. Throws std::invalid_argument
   /// naming the field for a message that cannot be used at all (other camera, other image size, out of order, a
   /// model_id the box relation was not measured for); the caller drops and counts it.
+  /// One camera only (no cameras.rig): a rig throws std::logic_error (use add_detections()).
   LocalizerOutput on_detections(const wingman::detections_t& detections);
+
+  /// Either kind: one camera gives one output per message (on_detections()); a rig buffers the message with its
+  /// exposure and returns the exposures that are now ready, oldest first (none, one, or several). An exposure is
+  /// ready when every rig camera has sent it or is silent (cameras.silent_after_s of message time without a message,
+  /// behind the newest message of any rig camera; a camera that never sent counts from the first message of any), or
+  /// when every camera that sent it has sent a later one (the missing ones are late: their message is dropped when it
+  /// comes), or when more than cameras.max_pending exposures wait; exposures are processed in utime order, never one
+  /// before an older one. Each gives one tracker frame and one LocalizerOutput, whatever order its cameras' messages
+  /// arrived in. Throws std::invalid_argument naming the field for a message that cannot be used at all (a camera_id
+  /// not in the rig, another image size, out of order for its camera, dated too far ahead, an exposure already
+  /// processed, a model_id the box relation was not measured for); the caller drops and counts it.
+  std::vector<LocalizerOutput> add_detections(const wingman::detections_t& detections);
+
+  /// The cameras (one, or the rig's in rig order), with what each has sent.
+  const std::vector<LocalizerCamera>& cameras() const { return cameras_; }
+  /// Whether this localizer fuses a camera rig (cameras.rig).
+  bool is_rig() const { return rig_; }
+  const ExposureStats& exposure_stats() const { return exposure_stats_; }
+  /// The rig cameras that are silent now: "camera 2 silent for 3.4 s" each, joined by ", " ("" when none or one
+  /// camera); a camera that never sent says "(no message yet)".
+  std::string silent_summary() const;
+  /// Per rig camera how many detections_t it has sent, e.g. "camera 0: 120, camera 1: 118 detections_t" ("" for one
+  /// camera).
+  std::string cameras_summary() const;
 
   /// The non-drone boxes of every message since construction that passed the camera, image size and order checks.
   const NonDroneCounts& non_drone_boxes() const { return non_drone_boxes_; }
@@ -89,20 +164,31 @@ class Localizer {
   std::string tracker_summary() const;
 
  private:
-  /// The windows of the tracks after detections `d`, the camera at `pose` (the own pose at d.utime).
-  wingman::track_windows_t track_windows(const wingman::detections_t& d, const PoseSample& pose) const;
-  wingman::targets_t camera_frame_targets(const wingman::detections_t& d,
-                                          const std::vector<CameraMeasurement>& measurements) const;
+  /// Camera `c`'s checks of one message (its camera, image size, model_id and time); throws std::invalid_argument.
+  /// A detections resync restarts the tracker (and forgets the waiting exposures).
+  void admit(LocalizerCamera& c, int clock_input, const wingman::detections_t& d);
+  /// One exposure: `per_camera[i]` is camera i's message or null (missing), at least one not null.
+  LocalizerOutput process(int64_t utime, const std::vector<const wingman::detections_t*>& per_camera);
+  /// Whether rig camera `i` is silent at the newest message time.
+  bool silent(size_t i) const;
+  /// The windows of the tracks after the exposure at `utime`, camera `c` at `pose` (the own pose at utime).
+  wingman::track_windows_t track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
+                                         const PoseSample& pose) const;
 
   LocalizerOptions options_;
-  BoxRelation cnn_relation_;  // options_.sphere.box_relation, for SOURCE_CNN detections
-  geometry::CameraModel camera_;
-  geometry::Extrinsics extrinsics_;
+  bool rig_ = false;
+  BoxRelation cnn_relation_;              // options_.sphere.box_relation, for SOURCE_CNN detections
+  std::vector<LocalizerCamera> cameras_;  ///< one, or the rig's in rig order
+  std::vector<int> camera_inputs_;        ///< clock_ input of each camera
   PoseBuffer poses_;
   Tracker tracker_;
   common::StageClock clock_;  ///< admits own poses and detections by message time
   int own_pose_input_;
-  int detections_input_;
+  /// A rig: the exposures waiting for cameras, by utime: each camera's message or nothing, in rig order.
+  std::map<int64_t, std::vector<std::optional<wingman::detections_t>>> pending_;
+  int64_t processed_utime_ = -1;  ///< a rig: the newest exposure processed
+  int64_t first_utime_ = -1;      ///< a rig: the first accepted detections_t's utime (a silent camera's start)
+  ExposureStats exposure_stats_;
   int64_t newest_pose_utime_ = -1;
   int64_t previous_detections_utime_ = -1;  ///< the last accepted detections_t's utime (frame interval for windows)
   NonDroneCounts non_drone_boxes_;

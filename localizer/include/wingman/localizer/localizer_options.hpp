@@ -32,6 +32,36 @@ struct CameraOptions : geometry::CameraModelOptions {
   // validate(): the shared keys' (scale_to_image has no rule).
 };
 
+/// Several cameras on one vehicle (keys `cameras.*`; docs/localization.md, "Several cameras").
+struct CameraRigOptions {
+  /// A camera rig file (geometry::load_camera_rig(), geometry/include/wingman/geometry/camera_rig.hpp); "" = the one
+  /// camera of camera.*. With a rig its cameras replace camera.* (except camera.scale_to_image, applied to every
+  /// camera), extrinsics.*, input.detections_channel and windows.channel: each camera has its own calibration, mount
+  /// and channels, and the detections of one exposure (one utime) from all cameras are fused into one tracker frame.
+  std::string rig;
+  /// A rig camera that has sent no detections_t for this long of message time (behind the newest of any rig camera) is
+  /// silent: exposures are not held back waiting for it until it sends again. Seconds, finite, > 0.
+  double silent_after_s = 0.2;
+  /// Exposures held waiting for cameras at most; beyond it the oldest is processed without the cameras still
+  /// missing (counted). >= 1.
+  int max_pending = 8;
+
+  template <class V>
+  void visit(V& v) {
+    v("cameras.rig", rig,
+      "camera rig file (several cameras, geometry/include/wingman/geometry/camera_rig.hpp); \"\" = the one camera of "
+      "camera.*. A rig replaces camera.* (camera.scale_to_image applies to every rig camera), extrinsics.*, "
+      "input.detections_channel and windows.channel with each camera's own");
+    v("cameras.silent_after_s", silent_after_s,
+      "rig: a camera without detections for this long of message time is not waited for until it sends again, s");
+    v("cameras.max_pending", max_pending,
+      "rig: exposures held waiting for cameras at most; beyond it the oldest is processed without the missing ones");
+  }
+  /// One "key = value: rule" line per problem; empty when valid. Reads the rig file: every problem load_camera_rig()
+  /// finds, named by cameras.rig.
+  std::vector<std::string> validate() const;
+};
+
 /// Options of the localizer process.
 struct LocalizerOptions {
   std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t input channel
@@ -55,6 +85,7 @@ struct LocalizerOptions {
   PoseBufferOptions pose;
   TrackerOptions tracker;
   TrackWindowOptions windows;  ///< tracker-driven windows (windows.*)
+  CameraRigOptions cameras;    ///< several cameras (cameras.*); "" rig: camera.* and extrinsics.*
   /// Time sanity of the inputs (time.*): how far ahead of the newest accepted time a message may be dated, and when
   /// the clock re-anchors (common/time_sanity.hpp).
   common::TimeSanityOptions time;
@@ -71,6 +102,7 @@ struct LocalizerOptions {
     v("classes.decision", class_decision,
       "box: boxes of other classes than drone are not tracked; track: every box is tracked with its drone score as "
       "its confidence and the tracker's confirmation bar decides per track");
+    cameras.visit(v);
     camera.visit(v);
     sphere.visit(v);
     extrinsics.visit(v);

@@ -180,6 +180,16 @@ class Tracker {
   /// each measurement's own utime is ignored (the frame's `utime` is used).
   bool update(int64_t utime, const std::vector<WorldMeasurement>& measurements, std::string* why = nullptr);
 
+  /// One frame of several cameras (one exposure of a camera rig): `per_camera[i]` are camera i's measurements, in
+  /// the rig's order. Each camera's measurements are associated in turn against the tracks as the cameras before it
+  /// left them (confirmed tracks first, then tentative ones, then the tracks the cameras before it started this
+  /// frame), so a target that two overlapping cameras see stays one track; a measurement no camera's association
+  /// took starts a track. Hits and misses count once per frame: a frame is a hit for a track when any camera hit it.
+  /// most_confident keeps the one most confident measurement of the whole frame. With one camera this is
+  /// update(utime, per_camera[0], why). Returns false (and sets `why`) for a frame that is not later.
+  bool update_cameras(int64_t utime, const std::vector<std::vector<WorldMeasurement>>& per_camera,
+                      std::string* why = nullptr);
+
   /// The confirmed tracks, ordered by track_id, with their state predicted to `predict_to_utime`
   /// (the publish time; lag compensation). The prediction is limited to [state time, state time +
   /// max_prediction_s]; predicted_utime says where it ended. sliding_window mode does not predict
