@@ -141,6 +141,40 @@ TEST(FlyPlan, WindowsTurnOnTheLocalizerTheDetectorAndTheSimulatorsScriptedLockst
   EXPECT_NE(value_of(plan.sim.argv, "--set", "sync=").find("scripted_lockstep: true"), std::string::npos);
 }
 
+TEST(FlyPlan, ARigRunsADetectorPerCameraOnItsChannelsAndTheSimulatorAndLocalizerReadTheSameFile) {
+  FlyOptions o = options_for_tests();
+  o.scenario = "surround";
+  o.rig = "surround4";
+  const FlightPlan plan = plan_flight(o);
+  const std::string rig = fs::weakly_canonical(wingman::testing::source_path("config/rigs/surround4.yaml")).string();
+  EXPECT_EQ(plan.rig_file, rig);
+  ASSERT_EQ(plan.pipeline.size(), 6u);  // four detectors, the localizer, the follower
+  for (int i = 0; i < 4; ++i) {
+    const auto& argv = plan.pipeline[static_cast<size_t>(i)].argv;
+    EXPECT_EQ(plan.pipeline[static_cast<size_t>(i)].name, "wingman-detector-cam" + std::to_string(i));
+    EXPECT_EQ(value_of(argv, "--name", "detector"), "detector" + std::to_string(i));
+    EXPECT_TRUE(has(argv, "input.channel=\"IMAGE_CAM" + std::to_string(i) + "\""));
+    EXPECT_TRUE(has(argv, "output.channel=\"DETECTIONS_CAM" + std::to_string(i) + "\""));
+    EXPECT_TRUE(has(argv, "windows.channel=\"WINDOWS_CAM" + std::to_string(i) + "\""));
+  }
+  EXPECT_EQ(plan.pipeline[4].name, "wingman-localizer");
+  EXPECT_TRUE(has(plan.pipeline[4].argv, "cameras.rig=\"" + rig + "\""));
+  EXPECT_TRUE(has(plan.sim.argv, "cameras.rig=\"" + rig + "\""));
+  const std::string sync = value_of(plan.sim.argv, "--set", "sync=");
+  EXPECT_NE(sync.find("wait_for: [detector0, detector1, detector2, detector3, localizer, follower_ctrl]"),
+            std::string::npos)
+      << sync;
+  EXPECT_NE(sync.find("scripted_lockstep: true"), std::string::npos) << sync;
+
+  o.rig = "no_such_rig";
+  EXPECT_NE(error_of(o).find("cameras.rig (--rig) = 'no_such_rig': no such rig"), std::string::npos) << error_of(o);
+  TempDir dir;
+  const std::string bad = (fs::path(dir.path()) / "bad.yaml").string();
+  std::ofstream(bad) << "cameras:\n  - camera: {camera_id: -1}\n";
+  o.rig = bad;
+  EXPECT_NE(error_of(o).find("cameras[0].camera.camera_id"), std::string::npos) << error_of(o);
+}
+
 TEST(FlyPlan, AFlightsOwnConfigurationIsUsedAndEvalMeasuresAgainstIt) {
   FlyOptions o = options_for_tests();
   o.scenario = "follow_1d";  // config/flights/follow_1d.follower_ctrl.yaml

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <wingman/common/config.hpp>
+#include <wingman/geometry/camera_rig.hpp>
 #include <wingman/sim/scenario.hpp>
 
 #include <chrono>
@@ -102,6 +103,16 @@ FlightPlan plan_flight(const FlyOptions& o) {
   // The box noise follows the scenario's seed (as the rendered noise does), so runs of different seeds differ.
   const uint64_t scenario_seed = sim::load_scenario(plan.scenario_file).seed;  // every problem of the file at once
 
+  // The cameras: one forward camera, or a rig's (read now: every problem of the file before anything starts).
+  std::vector<geometry::RigCamera> rig_cameras;
+  if (!o.rig.empty()) {
+    plan.rig_file = absolute(rig_file(o.rig, o.config_dir));
+    if (!readable_file(plan.rig_file))
+      throw std::invalid_argument(
+          fmt::format("cameras.rig (--rig) = '{}': no such rig (looked for {})", o.rig, plan.rig_file));
+    rig_cameras = geometry::load_camera_rig(plan.rig_file).cameras;
+  }
+
   const bool mavlink = o.autopilot == "mavlink";
   std::vector<std::string> exes = {"wingman-sim", "wingman-detector", "wingman-localizer", "wingman-follower-ctrl"};
   if (mavlink) exes.push_back("wingman-mavlink");
@@ -172,15 +183,22 @@ FlightPlan plan_flight(const FlyOptions& o) {
   // 5x real time: the logger is outside the loop. Unpaced, a truth-mode flight ran ~2600 frames/s and a loaded
   // machine's logger recorded 383 of 600 ground-truth frames; at 10x, 505-600 of 600 with six busy loops beside it; at
   // 5x, 600 of 600 in each of 10 such runs. Slower flights (rendering, the CNN) are not affected.
+  // The processes the simulator waits for (status instance names): one detector, or detector<camera_id> per rig camera.
+  std::string detector_names = "detector";
+  if (!rig_cameras.empty()) {
+    detector_names.clear();
+    for (const auto& c : rig_cameras)
+      detector_names += fmt::format("{}detector{}", detector_names.empty() ? "" : ", ", c.camera.camera_id);
+  }
   const std::string wait_for =
-      mavlink ? "[detector, localizer, follower_ctrl, mavlink_bridge]" : "[detector, localizer, follower_ctrl]";
+      fmt::format("[{}, localizer, follower_ctrl{}]", detector_names, mavlink ? ", mavlink_bridge" : "");
   std::vector<std::string> sim_sets = {
       "--set",
       "scenario.file=" + plan.scenario_file,
       "--set",
       fmt::format("sync={{mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: {}, startup_timeout_s: 60.0, "
                   "scripted_lockstep: {}}}",
-                  wait_for, bool_text(o.windows)),
+                  wait_for, bool_text(o.windows || !plan.rig_file.empty())),
       "--set",
       fmt::format("detections={{from_ground_truth: {}, box: {}, noise_px: 1.0, seed: {}}}", bool_text(!cnn),
                   o.truth_box, scenario_seed),
@@ -192,6 +210,11 @@ FlightPlan plan_flight(const FlyOptions& o) {
       fmt::format("mavlink={{firmware: {}, streams: [odometry, attitude_quaternion, local_position_ned]}}",
                   o.firmware)};
   if (!o.own_pose_error.empty()) append(sim_sets, own_pose_sets(o.own_pose_error));
+  if (!plan.rig_file.empty()) {
+    append(sim_sets, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
+    plan.notes.push_back(fmt::format("fly: {} cameras from the rig {}, a detector each, fused by the localizer",
+                                     rig_cameras.size(), plan.rig_file));
+  }
 
   // The flight's effective simulator configuration, as the loader merged it (a record; the process reads the --set).
   plan.sim_print_config.name = "wingman-sim --print-config";
@@ -219,16 +242,33 @@ FlightPlan plan_flight(const FlyOptions& o) {
   }
   for (const auto& kv : o.detector_sets) append(detector.argv, {"--set", kv});
   append(detector.argv, {"--log-level", "warn"});
+  // With a rig: one detector per camera, on that camera's channels, named detector<camera_id> (its status channel).
+  std::vector<launcher::ProcessSpec> detectors;
+  if (rig_cameras.empty()) detectors.push_back(detector);
+  for (const auto& c : rig_cameras) {
+    launcher::ProcessSpec d = detector;
+    const std::string name = fmt::format("detector{}", c.camera.camera_id);
+    d.name = fmt::format("wingman-detector-cam{}", c.camera.camera_id);
+    d.argv.pop_back();  // the log level: the camera's keys go before it, over the flight's sets
+    d.argv.pop_back();
+    append(d.argv, {"--name", name, "--set", fmt::format("input.channel=\"{}\"", c.image_channel), "--set",
+                    fmt::format("output.channel=\"{}\"", c.detections_channel), "--set",
+                    fmt::format("windows.channel=\"{}\"", c.windows_channel), "--log-level", "warn"});
+    detectors.push_back(d);
+  }
   launcher::ProcessSpec localizer = process("wingman-localizer", {exe("wingman-localizer"), "--lcm-url", url});
   if (!localizer_config.empty()) append(localizer.argv, {"--config", localizer_config});
   if (o.windows) append(localizer.argv, {"--set", "windows.publish=true"});
+  if (!plan.rig_file.empty()) append(localizer.argv, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
   for (const auto& kv : o.localizer_sets) append(localizer.argv, {"--set", kv});
   append(localizer.argv, {"--log-level", "warn"});
   launcher::ProcessSpec follower = process("wingman-follower-ctrl", {exe("wingman-follower-ctrl"), "--lcm-url", url});
   if (!follower_config.empty()) append(follower.argv, {"--config", follower_config});
   for (const auto& kv : o.follower_sets) append(follower.argv, {"--set", kv});
   append(follower.argv, {"--log-level", "warn"});
-  plan.pipeline = {detector, localizer, follower};
+  plan.pipeline = detectors;
+  plan.pipeline.push_back(localizer);
+  plan.pipeline.push_back(follower);
   if (mavlink) {
     const std::string bridge_config = (fs::path(o.config_dir) / "mavlink_bridge.sim.yaml").string();
     if (!readable_file(bridge_config))
@@ -258,6 +298,12 @@ FlightPlan plan_flight(const FlyOptions& o) {
       formation_offset_for(plan.eval_target, plan.eval.follower_id, plan.eval.leader_id);
   plan.eval.has_formation = true;
   return plan;
+}
+
+std::string rig_file(const std::string& rig, const std::string& config_dir) {
+  std::error_code ec;
+  if (fs::is_regular_file(rig, ec)) return rig;
+  return (fs::path(config_dir) / "rigs" / (rig + ".yaml")).string();
 }
 
 std::string scenario_file(const std::string& scenario, const std::string& config_dir) {

@@ -155,6 +155,9 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   f->add_flag("--windows", o.windows,
               "Tracker-driven windows: the localizer publishes where its tracks will be in the next frame and the "
               "detector searches there at full resolution (windows.* of both; docs/detector.md)");
+  f->add_option("--rig", o.rig,
+                "Several cameras: config/rigs/NAME.yaml (under --config-dir) or a rig file; the simulator renders "
+                "each, a detector runs per camera and the localizer fuses them (empty: the one forward camera)");
   f->add_option("--localizer-config", o.localizer_config,
                 "The localizer's config (empty: config/flights/NAME.localizer.yaml if any, else its defaults)");
   f->add_option("--follower-config", o.follower_config,
@@ -203,6 +206,7 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
            {"--flip-fusion", "detector.flip_fusion", false},
            {"--coarse-pass", "detector.coarse_pass", false},
            {"--windows", "windows.enabled", false},
+           {"--rig", "cameras.rig", true},
            {"--localizer-config", "processes.localizer_config", true},
            {"--follower-config", "processes.follower_config", true},
            {"--render-config", "processes.render_config", true},

@@ -33,9 +33,13 @@ struct FlyOptions {
   std::string model_cfg;                  ///< the detector's network ("" = builtin, or beside model_weights)
   std::string model_weights;              ///< its weights ("" = builtin:wingman-small)
   bool windows = false;                   ///< tracker-driven windows (localizer publishes, detector searches)
-  std::string localizer_config;           ///< "" = config_dir/flights/NAME.localizer.yaml if any, else the defaults
-  std::string follower_config;            ///< "" = config_dir/flights/NAME.follower_ctrl.yaml if any, else the defaults
-  std::string render_config;              ///< the simulator's render.* keys from this file ("" = its defaults)
+  /// A camera rig (geometry/camera_rig.hpp): a file, else `config_dir`/rigs/NAME.yaml; "" = the one forward camera.
+  /// With a rig the simulator renders every camera, one detector runs per camera (named detector<camera_id>), and
+  /// the localizer fuses them (each takes cameras.rig).
+  std::string rig;
+  std::string localizer_config;  ///< "" = config_dir/flights/NAME.localizer.yaml if any, else the defaults
+  std::string follower_config;   ///< "" = config_dir/flights/NAME.follower_ctrl.yaml if any, else the defaults
+  std::string render_config;     ///< the simulator's render.* keys from this file ("" = its defaults)
   std::vector<std::string> localizer_sets;  ///< KEY=VALUE over the localizer's configuration (its --set)
   std::vector<std::string> follower_sets;   ///< KEY=VALUE over the follower's (its --set; eval measures against it)
   std::vector<std::string> detector_sets;   ///< KEY=VALUE over the detector's (its --set, after the flight's own)
@@ -61,6 +65,9 @@ struct FlyOptions {
     v("detector.model_cfg", model_cfg, "the network; \"\" = beside model_weights, or the built-in shipped model");
     v("detector.model_weights", model_weights, "the weights; \"\" = the built-in shipped model");
     v("windows.enabled", windows, "tracker-driven windows (localizer publishes, detector searches)");
+    v("cameras.rig", rig,
+      "config/rigs/NAME.yaml (under run.config_dir) or a rig file: several cameras, a detector each, fused by the "
+      "localizer; \"\" = the one forward camera");
     v("processes.localizer_config", localizer_config,
       "\"\" = config/flights/NAME.localizer.yaml if any, else the localizer's defaults");
     v("processes.follower_config", follower_config,
@@ -78,10 +85,14 @@ struct FlyOptions {
   std::vector<std::string> validate() const;
 };
 
+/// The rig file `rig` names: itself when it is a file, else `config_dir`/rigs/RIG.yaml (not checked to exist).
+std::string rig_file(const std::string& rig, const std::string& config_dir);
+
 /// Everything a flight runs, decided before anything starts (so a bad option fails before a process runs).
 struct FlightPlan {
   std::string name;                             ///< the scenario's name (its file's stem)
   std::string scenario_file;                    ///< absolute
+  std::string rig_file;                         ///< absolute; "" = the one forward camera
   std::string out_dir;                          ///< absolute
   std::string log_path;                         ///< out_dir/flight.lcmlog
   std::vector<std::string> notes;               ///< what flies, one "fly: ..." line each, printed before the flight
