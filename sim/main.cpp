@@ -5,6 +5,7 @@
 #include "wingman/sim/mavlink_vehicle.hpp"
 #include "wingman/sim/renderer.hpp"
 #include "wingman/sim/scenario.hpp"
+#include "wingman/sim/sim_cameras.hpp"
 #include "wingman/sim/sim_options.hpp"
 #include "wingman/sim/simulator.hpp"
 #include "wingman/sim/truth_detections.hpp"
@@ -180,25 +181,42 @@ std::string mavlink_detail(MavlinkSide& mav, int64_t own_pose_timeouts, int64_t 
 
 int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scenario) {
   common::StatusTracker& status = rt.status();
-  // The localizer's camera from the same keys (geometry::make_camera): their defaults agree.
-  sim::SimCamera camera{geometry::make_camera(o.camera), geometry::Extrinsics::from_options(o.extrinsics),
-                        o.camera.rate_hz, o.camera.camera_id};
+  // The single camera of camera.*, extrinsics.* and output.* (the localizer's from the same keys: their defaults
+  // agree), or the cameras of the rig file cameras.rig.
+  const std::vector<sim::SimCameraOutput> outputs = sim::sim_cameras(o);
+  std::vector<sim::SimCamera> cameras;
+  for (const auto& c : outputs) cameras.push_back(c.camera);
+  const std::string cameras_note = fmt::format("{} camera{}{}", outputs.size(), outputs.size() == 1 ? "" : "s",
+                                               o.camera_rig.empty() ? "" : " (rig " + o.camera_rig + ")");
 
-  std::unique_ptr<sim::Renderer> renderer;
+  // One renderer per camera, all in the first one's GL context (a lens map and render targets per camera).
+  std::vector<std::unique_ptr<sim::Renderer>> renderers;
+  std::vector<sim::Renderer*> renderer_ptrs;
   if (o.render) {
     try {
-      renderer = std::make_unique<sim::Renderer>(camera.model, o.render_options);
+      for (const auto& c : cameras) {
+        renderers.push_back(renderers.empty()
+                                ? std::make_unique<sim::Renderer>(c.model, o.render_options)
+                                : std::make_unique<sim::Renderer>(c.model, o.render_options, *renderers.front()));
+        renderer_ptrs.push_back(renderers.back().get());
+      }
     } catch (const std::exception& e) {
       throw std::runtime_error(fmt::format("cannot render: {} (render.enabled: false runs without images)", e.what()));
     }
-    spdlog::info("rendering {}x{} with {}", camera.model.width(), camera.model.height(), renderer->gl_renderer());
+    for (const auto& c : outputs) {
+      spdlog::info("rendering camera {} ({}x{}) on {} with {}", c.camera.camera_id, c.camera.model.width(),
+                   c.camera.model.height(), c.image_channel, renderers.front()->gl_renderer());
+    }
   }
-  sim::Simulator simulator(scenario, camera, renderer.get());
+  sim::Simulator simulator(scenario, cameras, renderer_ptrs);
   simulator.set_own_pose_error(o.own_pose_error);
 
-  if (o.render) status.declare_output(o.image_channel);
+  if (o.render) {
+    for (const auto& c : outputs) status.declare_output(c.image_channel);
+  }
+  // The preview is the first camera's.
   camera_driver::PreviewMaker preview(o.preview);
-  const std::string preview_channel = o.preview.channel_for(o.image_channel);
+  const std::string preview_channel = o.preview.channel_for(outputs.front().image_channel);
   if (o.render && o.preview.enabled) status.declare_output(preview_channel);
   const bool via_mavlink = o.autopilot == "mavlink";
   if (via_mavlink && rt.input_is_file())
@@ -214,11 +232,15 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
   }
   status.declare_output(o.ground_truth_channel);
   if (o.detections.from_ground_truth) {
-    status.declare_output(o.detections_channel);
+    std::vector<std::string> channels;
+    for (const auto& c : outputs) {
+      status.declare_output(c.detections_channel);
+      channels.push_back(c.detections_channel);
+    }
     spdlog::warn(
         "detections come from GROUND TRUTH, not from a detector (detections.from_ground_truth: true): "
         "detections_t with source SOURCE_GROUND_TRUTH on {}, {} boxes, edge noise {} px",
-        o.detections_channel, o.detections.box, o.detections.noise_px);
+        fmt::join(channels, ", "), o.detections.box, o.detections.noise_px);
   }
 
   const bool lockstep = o.sync.mode == "lockstep" && (simulator.takes_setpoints() || o.sync.scripted_lockstep);
@@ -264,14 +286,14 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     }
   }
 
-  spdlog::info("scenario '{}' ({}): {} frames at {} Hz from utime {}, {} vehicles; sync {}{}", scenario.name,
+  spdlog::info("scenario '{}' ({}): {} frames at {} Hz from utime {}, {} vehicles, {}; sync {}{}", scenario.name,
                scenario.source, simulator.frame_count(), o.camera.rate_hz, scenario.start_utime,
-               scenario.vehicles.size(), o.sync.mode,
+               scenario.vehicles.size(), cameras_note, o.sync.mode,
                o.sync.mode == "lockstep" && !lockstep
                    ? " (the camera vehicle is scripted: nothing to wait for; sync.scripted_lockstep waits anyway)"
                    : "");
   const std::string gt_note = o.detections.from_ground_truth ? "; detections from ground truth" : "";
-  status.set_state(status_t::STATE_OK, "scenario " + scenario.name + " starting" + gt_note);
+  status.set_state(status_t::STATE_OK, "scenario " + scenario.name + " starting, " + cameras_note + gt_note);
   rt.publish_heartbeat();
 
   int64_t lockstep_timeouts = 0;
@@ -326,14 +348,22 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
             fmt::format("autopilot: mavlink: no OWN_POSE for frame {} within {} s", frame.index, o.sync.timeout_s));
       }
     }
-    if (!frame.bgr.empty()) {
-      rt.publish(o.image_channel, sim::to_image_message(frame.bgr, frame.utime, frame.index, camera.camera_id));
-      if (const auto p = preview.offer_bgr(frame.bgr, frame.utime, frame.index, camera.camera_id))
-        rt.publish(preview_channel, *p);
-    }
-    if (o.detections.from_ground_truth) {
-      rt.publish(o.detections_channel, sim::truth_detections(frame.truth, frame.index, camera.model,
-                                                             frame.T_cam_to_world, camera.camera_id, o.detections));
+    // Every camera's image and detections of this frame, before the lockstep wait (once per frame).
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      const sim::SimCameraFrame& view = frame.cameras[i];
+      const sim::SimCameraOutput& out = outputs[i];
+      if (!view.bgr.empty()) {
+        rt.publish(out.image_channel, sim::to_image_message(view.bgr, frame.utime, frame.index, view.camera_id));
+        if (i == 0) {
+          if (const auto p = preview.offer_bgr(view.bgr, frame.utime, frame.index, view.camera_id))
+            rt.publish(preview_channel, *p);
+        }
+      }
+      if (o.detections.from_ground_truth) {
+        rt.publish(out.detections_channel,
+                   sim::truth_detections(frame.truth, frame.index, out.camera.model, view.T_cam_to_world,
+                                         view.camera_id, o.detections, static_cast<int>(i)));
+      }
     }
     status.set_last_processed_seq(frame.index);
     status.record_latency_ms(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
@@ -378,9 +408,9 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
 
     const auto& c = simulator.setpoint_counts();
     std::string detail = fmt::format(
-        "scenario {}: frame {}/{} at {:.3f} s; {} lockstep timeouts; setpoints {} on time, {} late, {} ignored{}",
+        "scenario {}: frame {}/{} at {:.3f} s, {}; {} lockstep timeouts; setpoints {} on time, {} late, {} ignored{}",
         scenario.name, frame.index + 1, simulator.frame_count(), simulator.clock().seconds_since_start(frame.utime),
-        lockstep_timeouts, c.queued, c.late, c.ignored, gt_note);
+        cameras_note, lockstep_timeouts, c.queued, c.late, c.ignored, gt_note);
     if (mav) detail += "; " + mavlink_detail(*mav, own_pose_timeouts, barrier_timeouts);
     const bool degraded = lockstep_timeouts > 0 || own_pose_timeouts > 0 || barrier_timeouts > 0;
     status.set_state(degraded ? status_t::STATE_DEGRADED : status_t::STATE_OK, detail);
@@ -483,6 +513,8 @@ int main(int argc, char** argv) {
           "no scenario: give --scenario FILE (e.g. config/scenarios/follow_1d.yaml) or "
           "scenario.file in --config");
     }
+    // A bad rig file is a configuration error, found before anything starts: exit 2 naming cameras.rig and the file.
+    if (!options.camera_rig.empty()) (void)sim::load_sim_rig(options);
     scenario = sim::load_scenario(options.scenario);  // a bad scenario is a configuration error: exit 2
     if (duration_arg) scenario->duration_s = *duration_arg;
     return "";

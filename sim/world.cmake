@@ -7,6 +7,7 @@ add_library(wingman_sim_world
   src/world/motion_script.cpp
   src/world/scenario.cpp
   src/world/sim_options.cpp
+  src/world/sim_cameras.cpp
   src/world/simulator.cpp
   src/world/mavlink_vehicle.cpp
   src/world/own_pose_error.cpp

@@ -412,6 +412,110 @@ TEST(SimProcess, RenderedImagesArePublishedLikeTheCameraDriversAfterPoseAndTruth
   }
 }
 
+/// A rig of four cameras all around (config/rigs/surround4.yaml); the tiny scenario's leader is ahead, in camera 0.
+const std::string kRigConfig = "cameras:\n  rig: " + source_path("config/rigs/surround4.yaml") + "\n";
+
+TEST(SimProcess, ARigsCamerasArePublishedEachOnItsChannelWithItsIdAfterPoseAndTruth) {
+  Files f(kRigConfig + "sync:\n  mode: free\ndetections:\n  from_ground_truth: true\npreview:\n  enabled: false\n",
+          std::string(kTinyScenario).replace(kTinyScenario.find("duration_s: 1"), 13, "duration_s: 0.05"));
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-in", "memq://",
+                      "--lcm-out", f.out_url()},
+                     120s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("4 cameras (rig "), std::string::npos) << r.err;
+  const auto events = without_status(read_log(f.out));
+  // Per frame: OWN_POSE, GROUND_TRUTH, then each camera's image and detections, camera by camera.
+  ASSERT_EQ(events.size(), 2u * (2 + 2 * 4));
+  for (int64_t k = 0; k < 2; ++k) {
+    const size_t at = static_cast<size_t>(k) * 10;
+    ASSERT_EQ(events[at].channel, "OWN_POSE");
+    ASSERT_EQ(events[at + 1].channel, "GROUND_TRUTH");
+    const auto truth = decode<wingman::ground_truth_t>(events[at + 1]);
+    ASSERT_EQ(truth.num_boxes, 4);  // the leader in each camera
+    for (int i = 0; i < 4; ++i) {
+      const std::string id = std::to_string(i);
+      ASSERT_EQ(events[at + 2 + 2 * i].channel, "IMAGE_CAM" + id);
+      ASSERT_EQ(events[at + 3 + 2 * i].channel, "DETECTIONS_CAM" + id);
+      const auto image = decode<wingman::image_t>(events[at + 2 + 2 * i]);
+      const auto detections = decode<wingman::detections_t>(events[at + 3 + 2 * i]);
+      EXPECT_EQ(image.camera_id, i);
+      EXPECT_EQ(image.seq, k);
+      EXPECT_EQ(image.utime, truth.utime);
+      EXPECT_EQ(image.width, 1280);
+      EXPECT_EQ(image.height, 720);
+      EXPECT_EQ(detections.camera_id, i);
+      EXPECT_EQ(detections.utime, truth.utime);
+      EXPECT_EQ(truth.boxes[i].camera_id, i);
+      EXPECT_EQ(truth.boxes[i].visible, i == 0) << "camera " << i;
+      EXPECT_EQ(detections.num_detections, i == 0 ? 1 : 0) << "camera " << i;
+    }
+  }
+}
+
+TEST(SimProcess, ARigInLockstepPublishesEveryCamerasDetectionsThenWaitsOncePerFrame) {
+  // The fake follower answers only the last camera's DETECTIONS_CAM3: a simulator that waited after each camera would
+  // time out at camera 0 of every frame. Without images (render off), on the namespace's bus.
+  Files f(kRigConfig +
+          "sync:\n  mode: lockstep\n  timeout_s: 10\n  wait_for: [fake_follower]\n  startup_timeout_s: 20\n"
+          "render:\n  enabled: false\ndetections:\n  from_ground_truth: true\n");
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM bus(url);
+  ASSERT_TRUE(bus.good()) << url;
+  struct Fake {
+    lcm::LCM* bus;
+    std::vector<std::string> seen;  // DETECTIONS_CAM<i> channels in arrival order
+    void on_detections(const lcm::ReceiveBuffer*, const std::string& channel, const wingman::detections_t* d) {
+      seen.push_back(channel + "@" + std::to_string(d->seq));
+      if (channel != "DETECTIONS_CAM3") return;
+      const wingman::setpoint_t sp = velocity_setpoint(d->utime, fake_follower_velocity(d->utime));
+      bus->publish("SETPOINT", &sp);
+    }
+  } fake{&bus, {}};
+  for (int i = 0; i < 4; ++i) bus.subscribe("DETECTIONS_CAM" + std::to_string(i), &Fake::on_detections, &fake);
+  Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
+  wingman::status_t hb{};
+  hb.process = "fake_follower";
+  hb.state = wingman::status_t::STATE_OK;
+  int exit_code = -1;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fake.seen.empty()) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
+    bus.handleTimeout(50);
+    if (!sim.running()) {
+      exit_code = sim.wait(1s);
+      break;
+    }
+  }
+  while (bus.handleTimeout(100) > 0) {
+  }
+  ASSERT_EQ(exit_code, 0) << sim.err();
+  EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
+  ASSERT_EQ(fake.seen.size(), 4u * 30);
+  for (size_t n = 0; n < fake.seen.size(); ++n)
+    EXPECT_EQ(fake.seen[n], "DETECTIONS_CAM" + std::to_string(n % 4) + "@" + std::to_string(n / 4));
+}
+
+TEST(SimProcess, ABadRigFileIsAConfigurationErrorNamingTheKeyAndTheFile) {
+  Files f("render:\n  enabled: false\n");
+  const std::string rig = f.dir.file("rig.yaml");
+  std::ofstream(rig) << "cameras:\n  - camera: {camera_id: 0, focal_px: -1}\n";
+  const auto r = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--lcm-url", "memq://", "--config", f.config,
+                      "--set", "cameras.rig=" + rig},
+                     10s);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line expected: " << r.err;
+  EXPECT_NE(r.err.find("wingman-sim: error: cameras.rig: " + rig + ": 1 problem in the camera rig: " + rig +
+                       ":2: cameras[0].camera.focal_px"),
+            std::string::npos)
+      << r.err;
+  const auto missing = run({bin_path("wingman-sim"), "--scenario", f.scenario, "--lcm-url", "memq://", "--set",
+                            "cameras.rig=/nonexistent/rig.yaml"},
+                           10s);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("cameras.rig: /nonexistent/rig.yaml: cannot read the camera rig file"), std::string::npos)
+      << missing.err;
+}
+
 TEST(SimProcess, BadScenarioAndMissingScenarioAreConfigurationErrors) {
   Files f("render:\n  enabled: false\n",
           std::string(kTinyScenario).replace(kTinyScenario.find("type: hover"), 11, "type: hovr"));

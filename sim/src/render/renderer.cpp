@@ -102,7 +102,9 @@ struct Renderer::Impl {
   geometry::CameraModel camera;
   RenderOptions options;
   TruthBoxProjector projector;
-  detail::EglContext egl;
+  // The GL context: this renderer's own, or shared with other cameras' renderers (one context for a whole rig). Every
+  // pass sets the GL state it needs, so renderers sharing a context do not disturb one another.
+  std::shared_ptr<detail::EglContext> egl;
   std::optional<detail::GlProgram> drone_program;
   // The full-screen passes are compiled per variant of the options (llvmpipe runs every branch of a shader, so what
   // is off is compiled out): name and "#define" lines -> program.
@@ -127,8 +129,12 @@ struct Renderer::Impl {
   uint64_t frame = 0;
   cv::Mat rgba;
 
-  Impl(const geometry::CameraModel& cam, const RenderOptions& opts)
-      : camera(cam), options(checked(opts)), projector(cam, opts.max_half_fov_deg) {
+  Impl(const geometry::CameraModel& cam, const RenderOptions& opts, std::shared_ptr<detail::EglContext> context)
+      : camera(cam),
+        options(checked(opts)),
+        projector(cam, opts.max_half_fov_deg),
+        egl(context ? std::move(context) : std::make_shared<detail::EglContext>()) {
+    egl->make_current();
     drone_program.emplace("drone layer", source(detail::kDroneVertexShader, ""),
                           source(detail::kDroneFragmentShader, ""));
     glGenVertexArrays(1, &empty_vao);
@@ -141,7 +147,7 @@ struct Renderer::Impl {
 
   ~Impl() {
     try {
-      egl.make_current();
+      egl->make_current();
     } catch (...) {
       return;  // the context is gone: so are its objects
     }
@@ -690,7 +696,7 @@ struct Renderer::Impl {
             fmt::format("Renderer::render: drones[{}] (vehicle {}) has no model", i, drones[i].vehicle_id));
       }
     }
-    egl.make_current();
+    egl->make_current();
     ++frame;
     const bool blur = options.motion_blur_exposure_s > 0.0;
     const int samples = blur ? options.motion_blur_samples : 1;
@@ -763,7 +769,7 @@ struct Renderer::Impl {
 
   void set_options(const RenderOptions& next) {
     const RenderOptions valid = checked(next);
-    egl.make_current();
+    egl->make_current();
     const bool rebuild = valid.supersampling != options.supersampling ||
                          valid.max_half_fov_deg != options.max_half_fov_deg ||
                          valid.background_subsampling != options.background_subsampling;
@@ -780,7 +786,9 @@ struct Renderer::Impl {
 };
 
 Renderer::Renderer(const geometry::CameraModel& camera, const RenderOptions& options)
-    : impl_(std::make_unique<Impl>(camera, options)) {}
+    : impl_(std::make_unique<Impl>(camera, options, nullptr)) {}
+Renderer::Renderer(const geometry::CameraModel& camera, const RenderOptions& options, const Renderer& share_context)
+    : impl_(std::make_unique<Impl>(camera, options, share_context.impl_->egl)) {}
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
@@ -793,7 +801,7 @@ RenderResult Renderer::render(const Eigen::Isometry3d& T_cam_to_world, const std
 void Renderer::set_options(const RenderOptions& options) { impl_->set_options(options); }
 const geometry::CameraModel& Renderer::camera() const { return impl_->camera; }
 const RenderOptions& Renderer::options() const { return impl_->options; }
-std::string Renderer::gl_renderer() const { return impl_->egl.renderer(); }
+std::string Renderer::gl_renderer() const { return impl_->egl->renderer(); }
 cv::Size Renderer::pinhole_size() const { return {impl_->layer_w, impl_->layer_h}; }
 
 }  // namespace wingman::sim

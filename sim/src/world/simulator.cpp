@@ -46,12 +46,47 @@ struct Simulator::Vehicle {
   }
 };
 
+namespace {
+
+std::vector<SimCamera> checked_cameras(std::vector<SimCamera> cameras) {
+  if (cameras.empty()) throw std::invalid_argument("Simulator: no camera");
+  if (cameras.size() > 8) throw std::invalid_argument(fmt::format("Simulator: {} cameras, at most 8", cameras.size()));
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (cameras[i].rate_hz != cameras[0].rate_hz)
+      throw std::invalid_argument(
+          fmt::format("Simulator: camera {} has rate_hz {}, camera {} {}: all cameras expose "
+                      "at the same frame times",
+                      cameras[i].camera_id, cameras[i].rate_hz, cameras[0].camera_id, cameras[0].rate_hz));
+    for (size_t j = 0; j < i; ++j) {
+      if (cameras[j].camera_id == cameras[i].camera_id)
+        throw std::invalid_argument(fmt::format("Simulator: two cameras with camera_id {}", cameras[i].camera_id));
+    }
+  }
+  return cameras;
+}
+
+std::vector<Renderer*> single(Renderer* renderer) {
+  return renderer ? std::vector<Renderer*>{renderer} : std::vector<Renderer*>{};
+}
+
+}  // namespace
+
 Simulator::Simulator(Scenario scenario, SimCamera camera, Renderer* renderer)
+    : Simulator(std::move(scenario), std::vector<SimCamera>{std::move(camera)}, single(renderer)) {}
+
+Simulator::Simulator(Scenario scenario, std::vector<SimCamera> cameras, std::vector<Renderer*> renderers)
     : scenario_(std::move(scenario)),
-      camera_(std::move(camera)),
-      renderer_(renderer),
-      clock_(scenario_.start_utime, camera_.rate_hz),
-      projector_(camera_.model, renderer ? renderer->options().max_half_fov_deg : 80.0) {
+      cameras_(checked_cameras(std::move(cameras))),
+      renderers_(std::move(renderers)),
+      clock_(scenario_.start_utime, cameras_.front().rate_hz) {
+  if (!renderers_.empty() && renderers_.size() != cameras_.size())
+    throw std::invalid_argument(fmt::format("Simulator: {} renderers for {} cameras (one per camera, or none)",
+                                            renderers_.size(), cameras_.size()));
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    if (!renderers_.empty() && renderers_[i] == nullptr)
+      throw std::invalid_argument(fmt::format("Simulator: renderer {} is null", i));
+    projectors_.emplace_back(cameras_[i].model, renderers_.empty() ? 80.0 : renderers_[i]->options().max_half_fov_deg);
+  }
   if (scenario_.vehicles.empty()) throw std::invalid_argument("scenario " + scenario_.name + ": no vehicles");
   std::optional<int64_t> last_script_end;
   for (const auto& spec : scenario_.vehicles) {
@@ -199,14 +234,9 @@ SimFrame Simulator::step() {
     for (double& v : f.own_pose.var_rpy_body) v = var_a;
   }
 
-  Eigen::Isometry3d T_cam_to_body = Eigen::Isometry3d::Identity();
-  T_cam_to_body.linear() = camera_.mount.R_cam_to_body;
-  T_cam_to_body.translation() = camera_.mount.p_cam_in_body;
-  f.T_cam_to_world = body_to_world(own) * T_cam_to_body;
-
   f.truth.utime = f.utime;
   f.truth.frame = wingman::own_pose_t::FRAME_ENU;
-  f.truth.image_seq = renderer_ ? f.index : -1;
+  f.truth.image_seq = renderers_.empty() ? -1 : f.index;
   std::vector<DroneInstance> targets;
   for (const auto& v : vehicles_) {
     const MultirotorState& s = v->body.state();
@@ -232,34 +262,51 @@ SimFrame Simulator::step() {
   }
   f.truth.num_vehicles = static_cast<int32_t>(f.truth.vehicles.size());
 
-  std::vector<RenderedBox> boxes;
-  if (renderer_) {
-    CameraMotion motion;
-    motion.v_cam_in_world = own.v_body_in_world;
-    motion.w_cam_in_cam = camera_.mount.R_cam_to_body.transpose() * own.w_body_in_body;
-    RenderResult r =
-        renderer_->render(f.T_cam_to_world, targets, f.utime, detail::mix_seed(scenario_.seed, f.index), motion);
-    f.bgr = std::move(r.bgr);
-    boxes = std::move(r.boxes);
-  } else {
-    for (const auto& d : targets) {
-      boxes.push_back(
-          projector_.project(*d.model, f.T_cam_to_world, d.T_body_to_world, d.prop_angle_rad, d.vehicle_id));
+  // Every camera at the same exposure time, from the same body pose, each through its mount and lens.
+  const Eigen::Isometry3d T_body_to_world = body_to_world(own);
+  const uint64_t frame_seed = detail::mix_seed(scenario_.seed, static_cast<uint64_t>(f.index));
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    const SimCamera& camera = cameras_[i];
+    SimCameraFrame view;
+    view.camera_id = camera.camera_id;
+    Eigen::Isometry3d T_cam_to_body = Eigen::Isometry3d::Identity();
+    T_cam_to_body.linear() = camera.mount.R_cam_to_body;
+    T_cam_to_body.translation() = camera.mount.p_cam_in_body;
+    view.T_cam_to_world = T_body_to_world * T_cam_to_body;
+
+    std::vector<RenderedBox> boxes;
+    if (!renderers_.empty()) {
+      CameraMotion motion;
+      motion.v_cam_in_world = own.v_body_in_world;
+      motion.w_cam_in_cam = camera.mount.R_cam_to_body.transpose() * own.w_body_in_body;
+      // The first camera keeps the single camera's seed; the others get their own noise and exposure jitter.
+      const uint64_t camera_seed = i == 0 ? frame_seed : detail::mix_seed(frame_seed, i);
+      RenderResult r = renderers_[i]->render(view.T_cam_to_world, targets, f.utime, camera_seed, motion);
+      view.bgr = std::move(r.bgr);
+      boxes = std::move(r.boxes);
+    } else {
+      for (const auto& d : targets) {
+        boxes.push_back(
+            projectors_[i].project(*d.model, view.T_cam_to_world, d.T_body_to_world, d.prop_angle_rad, d.vehicle_id));
+      }
     }
-  }
-  for (const auto& b : boxes) {
-    wingman::truth_box_t t{};
-    t.vehicle_id = b.vehicle_id;
-    t.camera_id = camera_.camera_id;
-    t.cx = static_cast<float>(b.cx);
-    t.cy = static_cast<float>(b.cy);
-    t.w = static_cast<float>(b.w);
-    t.h = static_cast<float>(b.h);
-    t.visible = b.visible;
-    t.range = b.range_m;
-    f.truth.boxes.push_back(t);
+    for (const auto& b : boxes) {
+      wingman::truth_box_t t{};
+      t.vehicle_id = b.vehicle_id;
+      t.camera_id = camera.camera_id;
+      t.cx = static_cast<float>(b.cx);
+      t.cy = static_cast<float>(b.cy);
+      t.w = static_cast<float>(b.w);
+      t.h = static_cast<float>(b.h);
+      t.visible = b.visible;
+      t.range = b.range_m;
+      f.truth.boxes.push_back(t);
+    }
+    f.cameras.push_back(std::move(view));
   }
   f.truth.num_boxes = static_cast<int32_t>(f.truth.boxes.size());
+  f.bgr = f.cameras.front().bgr;
+  f.T_cam_to_world = f.cameras.front().T_cam_to_world;
   return f;
 }
 

@@ -33,7 +33,7 @@ bool sphere_box(const wingman::ground_truth_t& truth, int32_t vehicle_id, const 
 
 wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int64_t seq,
                                        const geometry::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
-                                       int32_t camera_id, const TruthDetectionOptions& options) {
+                                       int32_t camera_id, const TruthDetectionOptions& options, int camera_index) {
   const int32_t width = camera.width(), height = camera.height();
   const bool sphere = options.box == "sphere";
   wingman::detections_t d{};
@@ -44,7 +44,9 @@ wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int
   d.image_height = height;
   d.source = wingman::detections_t::SOURCE_GROUND_TRUTH;
   d.inference_latency_us = 0;
-  detail::PortableRandom noise(detail::mix_seed(static_cast<uint64_t>(options.seed), static_cast<uint64_t>(seq)));
+  uint64_t noise_seed = detail::mix_seed(static_cast<uint64_t>(options.seed), static_cast<uint64_t>(seq));
+  if (camera_index != 0) noise_seed = detail::mix_seed(noise_seed, static_cast<uint64_t>(camera_index));
+  detail::PortableRandom noise(noise_seed);
   for (const auto& b : truth.boxes) {
     if (!b.visible || b.camera_id != camera_id) continue;
     if (options.max_range_m > 0 && b.range > options.max_range_m) continue;

@@ -48,9 +48,10 @@ struct RenderResult {
   double exposure_gain = 1.0;      ///< the gain this frame was rendered with (after jitter and drift)
 };
 
-/// Renders one calibrated camera. Owns an EGL context (surfaceless, no window system, no X or Wayland) and its
-/// GL objects; not copyable. render() may be called from any one thread at a time (it makes its context current).
-/// Pixels are deterministic: the same inputs and frame_seed give the same bytes, whatever LP_NUM_THREADS.
+/// Renders one calibrated camera. Owns an EGL context (surfaceless, no window system, no X or Wayland; or shares
+/// another renderer's) and its GL objects; not copyable. render() may be called from any one thread at a time (it makes
+/// its context current). Pixels are deterministic: the same inputs and frame_seed give the same bytes, whatever
+/// LP_NUM_THREADS.
 ///
 /// How: the scene is drawn into an ideal pinhole image that covers the camera's whole field of view at
 /// supersampling times its pixel density, then remapped to the camera through a per-pixel map computed at
@@ -62,6 +63,12 @@ class Renderer {
   /// can be rendered in one pinhole image (the pixels beyond max_half_fov_deg are then black; only if the whole
   /// central region cannot be covered is it an error).
   Renderer(const geometry::CameraModel& camera, const RenderOptions& options);
+  /// The same, for another camera of a rig, in `share_context`'s EGL context instead of a new one: the context (and
+  /// the display) is made once for all cameras; the lens map, render targets, shader programs and the GPU copies of
+  /// the drone models are this renderer's own. The context lives as long as any renderer that uses it. The renderers
+  /// sharing a context must be used from one thread at a time, all of them together. The pixels are those of a
+  /// renderer with its own context (tested).
+  Renderer(const geometry::CameraModel& camera, const RenderOptions& options, const Renderer& share_context);
   ~Renderer();
   Renderer(Renderer&&) noexcept;
   Renderer& operator=(Renderer&&) noexcept;

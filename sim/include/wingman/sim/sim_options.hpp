@@ -113,6 +113,10 @@ struct SimOptions {
   /// Render and publish images. Off: no image is published, no EGL is needed, and truth boxes are projected from
   /// the drone models (no occlusion).
   bool render = true;
+  /// A camera rig file (geometry::load_camera_rig, e.g. config/rigs/surround4.yaml): the simulator renders all its
+  /// cameras, which replace camera.* (except camera.rate_hz, the frame rate of them all), extrinsics.*,
+  /// output.image_channel and output.detections_channel. "" = the single camera of those keys.
+  std::string camera_rig;
   SimCameraOptions camera;
   geometry::ExtrinsicsOptions extrinsics;
   TruthDetectionOptions detections;
@@ -134,6 +138,9 @@ struct SimOptions {
       "lcm (take SETPOINT, publish OWN_POSE) or mavlink (a MAVLink vehicle for wingman-mavlink, keys mavlink.*)");
     mavlink.visit(v);
     own_pose_error.visit(v);
+    v("cameras.rig", camera_rig,
+      "camera rig file (e.g. config/rigs/surround4.yaml): render all its cameras, which replace camera.* (but "
+      "camera.rate_hz), extrinsics.*, output.image_channel and output.detections_channel; \"\" = one camera");
     camera.visit(v);
     extrinsics.visit(v);
     detections.visit(v);

@@ -31,7 +31,7 @@ namespace wingman::sim {
 
 class Renderer;
 
-/// The onboard camera of the camera vehicle (id 0).
+/// An onboard camera of the camera vehicle (id 0).
 struct SimCamera {
   geometry::CameraModel model;  ///< intrinsics and distortion, for the image size the simulator renders
   geometry::Extrinsics mount;   ///< camera optical frame -> body (FLU); the camera tilts with the body
@@ -39,15 +39,25 @@ struct SimCamera {
   int32_t camera_id = 0;        ///< copied into images, truth boxes and detections
 };
 
-/// One simulated camera frame.
+/// What one camera saw of a frame.
+struct SimCameraFrame {
+  int32_t camera_id = 0;  ///< SimCamera::camera_id
+  cv::Mat bgr;            ///< the rendered image (CV_8UC3); empty when rendering is off
+  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the camera at t_k (optical -> ENU)
+};
+
+/// One simulated camera frame: every camera exposed at the same time t_k.
 struct SimFrame {
   int64_t index = 0;  ///< frame number k (the image's seq)
   int64_t utime = 0;  ///< exposure time t_k = start_utime + round(k * 1e6 / rate), microseconds since epoch
   wingman::own_pose_t own_pose{};  ///< the camera vehicle's reported body pose at t_k (ENU world, FLU body)
   MultirotorState own_reported;    ///< the same as a state (the pose error applied), for the MAVLink telemetry
-  wingman::ground_truth_t truth;   ///< every vehicle at t_k and every target's box (image_seq -1 without image)
-  cv::Mat bgr;                     ///< the rendered image (CV_8UC3); empty when rendering is off
-  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the camera at t_k (optical -> ENU)
+  /// Every vehicle at t_k and every target's box in every camera (truth_box_t.camera_id; the first camera's boxes
+  /// first, in the order of the vehicles, then the second's, ...); image_seq -1 without images.
+  wingman::ground_truth_t truth;
+  cv::Mat bgr;  ///< the first camera's rendered image (CV_8UC3, = cameras[0].bgr); empty when rendering is off
+  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the first camera at t_k (optical -> ENU)
+  std::vector<SimCameraFrame> cameras;                               ///< one per camera, in the simulator's order
 };
 
 /// Counts of what happened to setpoints (the process reports them in its status).
@@ -71,12 +81,21 @@ class Simulator {
   /// naming the problem (a vehicle's motion or dynamics invalid, a scenario that never ends), std::runtime_error
   /// when a drone mesh cannot be loaded.
   Simulator(Scenario scenario, SimCamera camera, Renderer* renderer = nullptr);
+  /// Several cameras on the camera vehicle (a rig), all exposed at each frame's time from its pose, each through its
+  /// own mount and lens. `renderers`: one per camera, in the same order (renderers[i] draws cameras[i]; not owned),
+  /// or empty: no images. Frame k's sensor noise and exposure jitter are seeded per camera: the first camera with
+  /// the seed a single camera has (so a rig's first camera gives that camera's images), camera i > 0 with a seed
+  /// mixed from it and i. Throws std::invalid_argument, besides the above, for no camera, more than 8, two with the
+  /// same camera_id, cameras with different rate_hz, or renderers that do not match the cameras one for one.
+  Simulator(Scenario scenario, std::vector<SimCamera> cameras, std::vector<Renderer*> renderers);
   ~Simulator();
   Simulator(const Simulator&) = delete;
   Simulator& operator=(const Simulator&) = delete;
 
   const Scenario& scenario() const { return scenario_; }
-  const SimCamera& camera() const { return camera_; }
+  /// The first camera (the only one of the single-camera constructor).
+  const SimCamera& camera() const { return cameras_.front(); }
+  const std::vector<SimCamera>& cameras() const { return cameras_; }
   const FrameClock& clock() const { return clock_; }
   /// Frames in the scenario: those with t_k < start_utime + duration_s (or before the last script ends).
   int64_t frame_count() const { return frame_count_; }
@@ -113,10 +132,10 @@ class Simulator {
   void apply_due_setpoints();
 
   Scenario scenario_;
-  SimCamera camera_;
-  Renderer* renderer_;
+  std::vector<SimCamera> cameras_;
+  std::vector<Renderer*> renderers_;  ///< one per camera, or empty (no images)
   FrameClock clock_;
-  TruthBoxProjector projector_;
+  std::vector<TruthBoxProjector> projectors_;       ///< one per camera (the boxes without rendering)
   std::vector<std::unique_ptr<Vehicle>> vehicles_;  ///< scenario order
   Vehicle* camera_vehicle_ = nullptr;
   int64_t frame_count_ = 0;

@@ -21,10 +21,11 @@ namespace wingman::sim {
 /// (vehicle_truth_t.bounding_radius about p_body_in_world) seen by `camera` at `T_cam_to_world` (optical frame to
 /// world, metres); either way only drones whose truth box is visible are detected.
 /// With options.noise_px > 0 each box edge moves by independent Gaussian noise (standard deviation noise_px,
-/// seeded by options.seed and `seq`), then the box is clipped to the image. Boxes narrower or shorter than
+/// seeded by options.seed, `seq` and `camera_index`: 0 for a single camera or a rig's first, i for the rig's camera
+/// i, so each camera's noise is its own), then the box is clipped to the image. Boxes narrower or shorter than
 /// options.min_size_px, and drones farther than options.max_range_m (when > 0), are left out.
 wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int64_t seq,
                                        const geometry::CameraModel& camera, const Eigen::Isometry3d& T_cam_to_world,
-                                       int32_t camera_id, const TruthDetectionOptions& options);
+                                       int32_t camera_id, const TruthDetectionOptions& options, int camera_index = 0);
 
 }  // namespace wingman::sim
