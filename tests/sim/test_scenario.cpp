@@ -84,8 +84,8 @@ TEST(Scenario, TheValidExampleParsesWithItsValues) {
 }
 
 TEST(Scenario, EveryShippedScenarioLoadsAndValidates) {
-  const std::set<std::string> expected = {"follow_1d",   "formation_2d", "static_sweep", "crossing",
-                                          "fast_target", "fly_away",     "fly_away_far", "approach"};
+  const std::set<std::string> expected = {"follow_1d", "formation_2d", "static_sweep", "crossing", "fast_target",
+                                          "fly_away",  "fly_away_far", "approach",     "surround"};
   std::set<std::string> found;
   for (const auto& entry : std::filesystem::directory_iterator(source_path("config/scenarios"))) {
     if (entry.path().extension() != ".yaml") continue;
