@@ -464,13 +464,18 @@ TEST(SimProcess, ARigInLockstepPublishesEveryCamerasDetectionsThenWaitsOncePerFr
   struct Fake {
     lcm::LCM* bus;
     std::vector<std::string> seen;  // DETECTIONS_CAM<i> channels in arrival order
+    std::vector<std::string> status_details;
+    void on_status(const lcm::ReceiveBuffer*, const std::string&, const wingman::status_t* st) {
+      status_details.push_back(st->detail);
+    }
     void on_detections(const lcm::ReceiveBuffer*, const std::string& channel, const wingman::detections_t* d) {
       seen.push_back(channel + "@" + std::to_string(d->seq));
       if (channel != "DETECTIONS_CAM3") return;
       const wingman::setpoint_t sp = velocity_setpoint(d->utime, fake_follower_velocity(d->utime));
       bus->publish("SETPOINT", &sp);
     }
-  } fake{&bus, {}};
+  } fake{&bus, {}, {}};
+  bus.subscribe("STATUS_SIM", &Fake::on_status, &fake);
   for (int i = 0; i < 4; ++i) bus.subscribe("DETECTIONS_CAM" + std::to_string(i), &Fake::on_detections, &fake);
   Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
   wingman::status_t hb{};
@@ -490,6 +495,14 @@ TEST(SimProcess, ARigInLockstepPublishesEveryCamerasDetectionsThenWaitsOncePerFr
   }
   ASSERT_EQ(exit_code, 0) << sim.err();
   EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
+  // The status says how many cameras it renders.
+  int running_details = 0;
+  for (const auto& detail : fake.status_details) {
+    if (detail.find("end of scenario") != std::string::npos) continue;  // the last heartbeat says why it stops
+    ++running_details;
+    EXPECT_NE(detail.find("4 cameras (rig "), std::string::npos) << detail;
+  }
+  EXPECT_GE(running_details, 1);  // at least the heartbeat at the start
   ASSERT_EQ(fake.seen.size(), 4u * 30);
   for (size_t n = 0; n < fake.seen.size(); ++n)
     EXPECT_EQ(fake.seen[n], "DETECTIONS_CAM" + std::to_string(n % 4) + "@" + std::to_string(n / 4));
