@@ -141,9 +141,9 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
   if (first_utime_ < 0) first_utime_ = d.utime;
   if (d.utime <= processed_utime_) {  // a sign of life all the same (admit() counted it)
     ++exposure_stats_.late;
-    throw std::invalid_argument(fmt::format(
-        "detections_t.utime = {}: camera {} is late: the exposure{} was processed without it (the exposure {})",
-        d.utime, d.camera_id, d.utime == processed_utime_ ? "" : " after it", processed_utime_));
+    throw std::invalid_argument(
+        fmt::format("detections_t.utime = {}: camera {} is late: the exposures up to {} were processed without it",
+                    d.utime, d.camera_id, processed_utime_));
   }
   auto [it, added] = pending_.try_emplace(d.utime);
   if (added) it->second.resize(cameras_.size());

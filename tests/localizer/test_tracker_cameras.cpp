@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// Tracker::update_cameras: one frame of several cameras. A target two cameras see starts one track and counts one hit
+// per frame; cameras with nothing change nothing; most_confident keeps the frame's one most confident detection.
+#include <gtest/gtest.h>
+#include <wingman/localizer/tracker.hpp>
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace {
+
+using wingman::localizer::Tracker;
+using wingman::localizer::TrackerOptions;
+using wingman::localizer::TrackOutput;
+using wingman::localizer::WorldMeasurement;
+
+constexpr int64_t kT0 = 1'700'000'000'000'000;
+constexpr int64_t kFrameUs = 33'333;
+
+int64_t frame_utime(int k) { return kT0 + kFrameUs * k; }
+
+WorldMeasurement meas(const Eigen::Vector3d& p, int camera, double sigma = 0.2, double confidence = 0.9) {
+  WorldMeasurement m;
+  m.camera_id = camera;
+  m.p_target_in_world = p;
+  m.cov_p_in_world = sigma * sigma * Eigen::Matrix3d::Identity();
+  m.p_target_in_cam = p;
+  m.range = p.norm();
+  m.confidence = confidence;
+  return m;
+}
+
+TEST(TrackerCameras, ATargetTwoCamerasSeeStartsOneTrackAndCountsOneHitPerFrame) {
+  Tracker t;  // birth_hits 10
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 0.2);
+  const Eigen::Vector3d p(8.0, 3.0, 0.5);
+  const auto noisy = [&]() -> Eigen::Vector3d {
+    const double x = n(rng), y = n(rng), z = n(rng);
+    return p + Eigen::Vector3d(x, y, z);
+  };
+  for (int k = 0; k < 9; ++k) {
+    ASSERT_TRUE(t.update_cameras(frame_utime(k), {{meas(noisy(), 0)}, {meas(noisy(), 1)}}));
+    EXPECT_TRUE(t.confirmed(frame_utime(k)).empty()) << "two cameras in one frame are one hit, frame " << k;
+  }
+  ASSERT_TRUE(t.update_cameras(frame_utime(9), {{meas(noisy(), 0)}, {meas(noisy(), 1)}}));
+  const std::vector<TrackOutput> out = t.confirmed(frame_utime(9));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 1);
+  EXPECT_EQ(out[0].camera_id, 1) << "the camera of the last detection used";
+  EXPECT_EQ(t.stats().births, 1) << "camera 1's first detection joined the track camera 0's started";
+  EXPECT_EQ(t.stats().associated, 19);
+  EXPECT_EQ(t.num_tentative(), 0u);
+  // 20 detections of 0.2 m per axis, but the velocity is still nearly free after 0.3 s: a sanity bound.
+  EXPECT_LT((out[0].p_target_in_world - p).norm(), 0.5);
+}
+
+TEST(TrackerCameras, ATrackOneCameraLosesAndTheNextTakesLivesOn) {
+  TrackerOptions o;
+  o.birth_hits = 3;
+  o.birth_window = 5;
+  o.death_timeout_s = 0.2;
+  Tracker t(o);
+  // Camera 0 sees it for 10 frames, then camera 1 for 20: each frame is a hit for the one track.
+  for (int k = 0; k < 30; ++k) {
+    const Eigen::Vector3d p(8.0, 0.1 * k, 0.0);
+    std::vector<std::vector<WorldMeasurement>> frame(2);
+    frame[k < 10 ? 0 : 1].push_back(meas(p, k < 10 ? 0 : 1));
+    ASSERT_TRUE(t.update_cameras(frame_utime(k), frame));
+  }
+  const std::vector<TrackOutput> out = t.confirmed(frame_utime(29));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, 1);
+  EXPECT_EQ(out[0].camera_id, 1);
+  EXPECT_EQ(t.stats().births, 1);
+}
+
+TEST(TrackerCameras, CamerasWithNothingChangeNothing) {
+  Tracker one, three;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 0.3);
+  for (int k = 0; k < 40; ++k) {
+    const double x = n(rng), y = n(rng), z = n(rng);
+    const Eigen::Vector3d p(10.0 + 0.05 * k + x, 2.0 + y, 1.0 + z);
+    ASSERT_TRUE(one.update(frame_utime(k), {meas(p, 0, 0.3)}));
+    ASSERT_TRUE(three.update_cameras(frame_utime(k), {{}, {meas(p, 0, 0.3)}, {}}));
+  }
+  const auto a = one.confirmed(frame_utime(40)), b = three.confirmed(frame_utime(40));
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(a[0].p_target_in_world, b[0].p_target_in_world);  // bit for bit
+  EXPECT_EQ(a[0].cov_p, b[0].cov_p);
+  std::string why;
+  EXPECT_FALSE(three.update_cameras(frame_utime(39), {{}, {}, {}}, &why));
+  EXPECT_NE(why.find("is not after the previous frame's"), std::string::npos) << why;
+}
+
+TEST(TrackerCameras, MostConfidentKeepsTheFramesOneMostConfidentDetection) {
+  TrackerOptions o;
+  o.mode = "most_confident";
+  o.birth_hits = 1;
+  o.birth_window = 1;
+  Tracker t(o);
+  ASSERT_TRUE(t.update_cameras(frame_utime(0), {{meas({5, 0, 0}, 0, 0.2, 0.5)}, {meas({0, 9, 0}, 1, 0.2, 0.8)}}));
+  const auto out = t.confirmed(frame_utime(0));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].camera_id, 1);
+  EXPECT_EQ(t.stats().measurements_rejected, 1);
+}
+
+}  // namespace
