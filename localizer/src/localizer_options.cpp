@@ -6,6 +6,7 @@
 #include <wingman/geometry/camera_rig.hpp>
 
 #include <cmath>
+#include <sstream>
 
 namespace wingman::localizer {
 
@@ -18,8 +19,16 @@ std::vector<std::string> CameraRigOptions::validate() const {
   if (!rig.empty()) {
     try {
       (void)geometry::load_camera_rig(rig);
-    } catch (const std::exception& e) {  // common::ConfigError: every problem of the file, each with its line
-      p.push_back(problem("cameras.rig", rig, e.what()));
+    } catch (const std::exception& e) {  // common::ConfigError: every problem of the file, each on its own line
+      // One line (the process's error is one line): "FILE: N problems in the camera rig: FILE:L: ...; FILE:L: ...".
+      std::istringstream lines(e.what());
+      std::string line, all;
+      while (std::getline(lines, line)) {
+        const size_t start = line.find_first_not_of(' ');
+        if (start == std::string::npos) continue;
+        all += (all.empty() ? "" : all.back() == ':' ? " " : "; ") + line.substr(start);
+      }
+      p.push_back(problem("cameras.rig", rig, all));
     }
   }
   return p;
