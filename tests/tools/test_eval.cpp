@@ -651,6 +651,50 @@ TEST(Eval, LeaderCountsAsDetectedOnlyWithABoxOnItAndOtherBoxesAreFalse) {
                                       "frames_with_false_box": 2})"));
 }
 
+/// Several cameras (a rig): every camera's detections channel is read by default, and each box is judged against its
+/// own camera's truth boxes. Four frames; the leader is in camera 1's view only (truth box at (200, 150)); camera 1
+/// boxes it in frames 0-2; camera 0 has a box at the same pixels in frames 0 and 3 (false: not its camera's truth).
+TEST(Eval, EveryCamerasDetectionsAreJudgedAgainstTheirOwnCamerasTruth) {
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 4; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    ground_truth_t g = truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 8, 5)});
+    truth_box_t b = truth_box(1, 200, 150, 40, true, 8);
+    b.camera_id = 1;
+    g.boxes = {b};
+    g.num_boxes = 1;
+    events.push_back(make_event("GROUND_TRUTH", g, u));
+    detections_t d0 = detections_msg(
+        u, k, k == 0 || k == 3 ? std::vector<detection_t>{box(200, 150, 30, false)} : std::vector<detection_t>{});
+    events.push_back(make_event("DETECTIONS_CAM0", d0, u));
+    detections_t d1 =
+        detections_msg(u, k, k < 3 ? std::vector<detection_t>{box(200, 150, 30, false)} : std::vector<detection_t>{});
+    d1.camera_id = 1;
+    events.push_back(make_event("DETECTIONS_CAM1", d1, u));
+    // Not a detections channel of the default pattern: never read.
+    events.push_back(make_event("DETECTIONS_CAM1_COPY", d1, u));
+  }
+  EvalOptions o;
+  o.log = dir.file("rig.lcmlog");
+  testing::write_log(o.log, events);
+  EvalResult r = evaluate_log(o);
+  EXPECT_EQ(r.frames_leader_visible, 4);
+  EXPECT_EQ(r.frames_leader_detected, 3);
+  EXPECT_EQ(r.detections_total, 5);
+  EXPECT_EQ(r.false_boxes, 2);  // camera 0's two boxes
+  // One camera's channel only: camera 0 never sees the leader.
+  o.detections_channel = "DETECTIONS_CAM0";
+  r = evaluate_log(o);
+  EXPECT_EQ(r.frames_leader_detected, 0);
+  EXPECT_EQ(r.detections_total, 2);
+  // A pattern that cannot be one is named.
+  o.detections_channel = "DETECTIONS_(CAM";
+  bool named = false;
+  for (const auto& line : o.validate()) named = named || line.find("--detections-channel: 'DETECTIONS_(CAM'") == 0;
+  EXPECT_TRUE(named);
+}
+
 TEST(Eval, BoxesOfOtherClassesAreNeitherDetectionsNorFalseBoxes) {
   // Two frames with the leader visible at (200, 150): frame 0 has a bird box (class 2) centred on it and a drone box
   // off it; frame 1 a helicopter box (class 3) on it. Only drone boxes count: nothing finds the leader.

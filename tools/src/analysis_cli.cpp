@@ -142,10 +142,11 @@ struct FlightEvalOptions {
 
   template <class V>
   void visit_flight(V& v) {
-    v("input.log", eval.log, "LCM log with GROUND_TRUTH and TARGETS (and DETECTIONS_CAM0, IMAGE_CAM0)");
+    v("input.log", eval.log, "LCM log with GROUND_TRUTH and TARGETS (and DETECTIONS_CAM*, IMAGE_CAM0)");
     v("input.truth_channel", eval.truth_channel, "ground_truth_t channel");
     v("input.targets_channel", eval.targets_channel, "targets_t channel");
-    v("input.detections_channel", eval.detections_channel, "detections_t channel");
+    v("input.detections_channel", eval.detections_channel,
+      "detections_t channels: a regular expression that whole channel names match (a rig: every camera)");
     v("input.image_channel", eval.image_channel, "image_t channel");
     v("input.preview_channel", eval.preview_channel, "the camera's preview (the report's frames without images)");
     v("formation.offset_m", formation_offset_m,
@@ -264,7 +265,8 @@ void add_eval_options(CLI::App* c, FlightEvalOptions& o) {
       ->delimiter(',');
   c->add_option("--truth-channel", o.eval.truth_channel, "ground_truth_t channel");
   c->add_option("--targets-channel", o.eval.targets_channel, "targets_t channel");
-  c->add_option("--detections-channel", o.eval.detections_channel, "detections_t channel");
+  c->add_option("--detections-channel", o.eval.detections_channel,
+                "detections_t channels: a regular expression that whole channel names match (a rig: every camera)");
   c->add_option("--image-channel", o.eval.image_channel, "image_t channel");
   c->add_option("--title", o.eval.title, "Report title");
   c->add_option("--frames", o.eval.report_frames, "Camera frames shown in the report");

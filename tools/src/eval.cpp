@@ -8,6 +8,7 @@
 #include "eval_metrics.hpp"
 
 #include <fmt/format.h>
+#include <wingman/recorder/channel_pattern.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -20,6 +21,8 @@ std::vector<std::string> EvalOptions::validate() const {
   if (log.empty()) p.push_back("log: an LCM log file is required");
   if (truth_channel.empty()) p.push_back("--truth-channel: must not be empty");
   if (targets_channel.empty()) p.push_back("--targets-channel: must not be empty");
+  if (std::string why; !recorder::ChannelPattern::compile(detections_channel, &why))
+    p.push_back(fmt::format("--detections-channel: '{}' is not a channel pattern: {}", detections_channel, why));
   if (!(settle_s >= 0.0)) p.push_back(fmt::format("--settle: {} must be >= 0 seconds", settle_s));
   if (!(match_radius_m > 0.0)) p.push_back(fmt::format("--match-radius: {} must be > 0 metres", match_radius_m));
   if (follower_id == leader_id) p.push_back(fmt::format("--leader-id: {} must differ from --follower-id", leader_id));

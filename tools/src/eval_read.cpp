@@ -4,12 +4,14 @@
 #include "lcm_fingerprint.hpp"
 #include "log_progress.hpp"
 
+#include <fmt/format.h>
 #include <wingman/common/lcm_log_reader.hpp>
 #include <wingman/common/message_validation.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/geometry/message_eigen.hpp>
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
+#include <wingman/recorder/channel_pattern.hpp>
 #include <wingman/targets_t.hpp>
 
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include <fstream>
 #include <optional>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace wingman::tools {
 namespace {
@@ -100,6 +103,19 @@ EvalLog read_eval_log(const EvalOptions& o) {
 
   EvalLog log;
   size_t targets_messages = 0;
+  // Whether a channel is a detections channel (o.detections_channel matched once per channel name).
+  std::string why;
+  const std::optional<recorder::ChannelPattern> detections_pattern =
+      recorder::ChannelPattern::compile(o.detections_channel, &why);
+  if (!detections_pattern)
+    throw std::runtime_error(
+        fmt::format("wingman eval: detections channel '{}' is not a channel pattern: {}", o.detections_channel, why));
+  std::unordered_map<std::string, bool> is_detections;
+  auto detections_channel = [&](const std::string& channel) {
+    const auto [it, inserted] = is_detections.try_emplace(channel, false);
+    if (inserted) it->second = detections_pattern->matches(channel);
+    return it->second;
+  };
   common::Progress progress = log_progress(o.progress, "wingman: reading " + o.log, o.log);
   while (const common::LcmLogEvent* ev = file.read_next()) {
     progress.update(ev->offset);
@@ -109,7 +125,7 @@ EvalLog read_eval_log(const EvalOptions& o) {
     } else if (ev->channel == o.targets_channel) {
       wingman::targets_t ts;
       if (decode(*ev, &ts)) add_targets(ts, ev->timestamp, targets_messages++, &log);
-    } else if (ev->channel == o.detections_channel) {
+    } else if (detections_channel(ev->channel)) {
       wingman::detections_t d;
       if (decode(*ev, &d)) add_detections(d, &log);
     } else if (ev->channel == o.image_channel || ev->channel == o.preview_channel) {

@@ -23,10 +23,12 @@ namespace wingman::tools {
 /// receive time).
 struct EvalOptions {
   std::string log;  ///< LCM log with ground_truth_t and targets_t (and detections_t, image_t)
-  std::string truth_channel = "GROUND_TRUTH";          ///< ground_truth_t channel
-  std::string targets_channel = "TARGETS";             ///< targets_t channel
-  std::string detections_channel = "DETECTIONS_CAM0";  ///< detections_t channel
-  std::string image_channel = "IMAGE_CAM0";            ///< image_t channel (latency reference, report frames)
+  std::string truth_channel = "GROUND_TRUTH";  ///< ground_truth_t channel
+  std::string targets_channel = "TARGETS";     ///< targets_t channel
+  /// detections_t channels: a POSIX extended regular expression a whole channel name must match (recorder::ChannelPattern, as lcm subscribes); the
+  /// default takes every camera's (a rig's several cameras: each box is judged against its own camera's truth boxes).
+  std::string detections_channel = "DETECTIONS_CAM[0-9]+";
+  std::string image_channel = "IMAGE_CAM0";  ///< image_t channel (latency reference, report frames)
   /// The camera's monitoring preview (small JPEG image_t, 1 Hz: camera_driver/preview.hpp): the report's frames when
   /// the log has no full images (flight logs leave IMAGE_* out).
   std::string preview_channel = "PREVIEW_CAM0";
