@@ -206,6 +206,9 @@ std::string Localizer::cameras_summary() const {
   std::string out = "detections_t per camera:";
   for (size_t i = 0; i < cameras_.size(); ++i)
     out += fmt::format("{} {} {}", i == 0 ? "" : ",", cameras_[i].camera_id, cameras_[i].messages);
+  if (exposure_stats_.incomplete > 0)
+    out += fmt::format(" ({} of {} exposures without every camera)", exposure_stats_.incomplete,
+                       exposure_stats_.processed);
   return out;
 }
 

@@ -148,8 +148,9 @@ TEST(LocalizerRigProcess, ASilentCameraIsNamedAndAStrangerIsDroppedAndCounted) {
   const wingman::status_t& running = r.statuses[r.statuses.size() - 2];
   EXPECT_EQ(running.state, int{wingman::status_t::STATE_DEGRADED}) << running.detail;
   const std::string n = std::to_string(exposures), half = std::to_string(exposures / 2);
-  EXPECT_EQ(running.detail,
-            "camera 1 silent for 6.0 s; detections_t per camera: 0 " + n + ", 1 " + half + ", 2 " + n + ", 3 " + n);
+  EXPECT_EQ(running.detail, "camera 1 silent for 6.0 s; detections_t per camera: 0 " + n + ", 1 " + half + ", 2 " + n +
+                                ", 3 " + n + " (" + std::to_string(exposures - exposures / 2) + " of " + n +
+                                " exposures without every camera)");
   EXPECT_EQ(r.statuses.back().drops_total, 1) << r.statuses.back().last_error;
   EXPECT_NE(r.statuses.back().last_error.find("detections_t.camera_id = 6: not a camera of the rig"), std::string::npos)
       << r.statuses.back().last_error;

@@ -129,15 +129,19 @@ class Localizer {
   LocalizerOutput on_detections(const wingman::detections_t& detections);
 
   /// Either kind: one camera gives one output per message (on_detections()); a rig buffers the message with its
-  /// exposure and returns the exposures that are now ready, oldest first (none, one, or several). An exposure is
-  /// ready when every rig camera has sent it or is silent (cameras.silent_after_s of message time without a message,
-  /// behind the newest message of any rig camera; a camera that never sent counts from the first message of any), or
-  /// when every camera that sent it has sent a later one (the missing ones are late: their message is dropped when it
-  /// comes), or when more than cameras.max_pending exposures wait; exposures are processed in utime order, never one
-  /// before an older one. Each gives one tracker frame and one LocalizerOutput, whatever order its cameras' messages
-  /// arrived in. Throws std::invalid_argument naming the field for a message that cannot be used at all (a camera_id
-  /// not in the rig, another image size, out of order for its camera, dated too far ahead, an exposure already
-  /// processed, a model_id the box relation was not measured for); the caller drops and counts it.
+  /// exposure (its utime) and returns the exposures that are now ready, oldest first (none, one, or several; never one
+  /// before an older one). An exposure is ready when every rig camera it lacks is not to be waited for:
+  /// - it has sent a later exposure (a camera's messages come in order: it will not send this one), or
+  /// - it is silent: no message for cameras.silent_after_s of message time behind the newest message of any rig
+  ///   camera (a camera that never sent counts from the rig's first message), until it sends again, or
+  /// - it is overtaken: every other camera that is not silent has sent a later exposure;
+  /// or, whatever it lacks, when more than cameras.max_pending exposures wait. So with every camera sending, an
+  /// exposure is processed exactly when its last camera's message comes (lockstep: one targets_t per frame, never
+  /// early). Each ready exposure is one tracker frame of its cameras in rig order (Tracker::update_cameras()) and one
+  /// LocalizerOutput, whatever order its cameras' messages arrived in. Throws std::invalid_argument naming the field
+  /// for a message that cannot be used at all (a camera_id not in the rig, another image size, out of order for its
+  /// camera, dated too far ahead, a model_id the box relation was not measured for, or late: its exposure was
+  /// processed without it); the caller drops and counts it.
   std::vector<LocalizerOutput> add_detections(const wingman::detections_t& detections);
 
   /// The cameras (one, or the rig's in rig order), with what each has sent.
@@ -148,7 +152,8 @@ class Localizer {
   /// The rig cameras that are silent now: "camera 2 silent for 3.4 s" each, joined by ", " ("" when none or one
   /// camera); a camera that never sent says "(no message yet)".
   std::string silent_summary() const;
-  /// Per rig camera how many detections_t it has sent, e.g. "camera 0: 120, camera 1: 118 detections_t" ("" for one
+  /// Per rig camera how many detections_t it has sent, and how many exposures went without one or more cameras, e.g.
+  /// "detections_t per camera: 0 120, 1 118, 2 60, 3 120 (62 of 120 exposures without every camera)" ("" for one
   /// camera).
   std::string cameras_summary() const;
 
