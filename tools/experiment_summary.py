@@ -492,11 +492,51 @@ def approach(out, *flights):
     write(out, "approach", data, lines)
 
 
+def surround(out, *flights):
+    """Issue 31's several cameras: a leader circling a camera vehicle with a rig of cameras all around. Per flight: the
+    leader's detection, its track ids and id switches, the hand-overs (its track's camera changing from one published
+    target to the next), localization, false targets, and the number of targets each camera last updated."""
+    import csv
+    rows_out, data = [], {}
+    for d in flights:
+        name = os.path.basename(os.path.normpath(d))
+        r = load(os.path.join(d, "eval.json"))
+        with open(os.path.join(d, "targets.csv")) as f:
+            rows = [row for row in csv.DictReader(f) if row["vehicle_id"] == "1"]
+        handovers, by_camera, previous = 0, {}, {}
+        for row in rows:
+            cam, tid = row.get("camera_id", ""), row["track_id"]
+            by_camera[cam] = by_camera.get(cam, 0) + 1
+            if tid in previous and previous[tid] != cam:
+                handovers += 1
+            previous[tid] = cam
+        loc, los = r["localization"], r["along_line_of_sight"]
+        data[name] = {"detection_rate": rate(r), "track_ids_on_leader": r["track_ids_on_leader"],
+                      "leader_id_switches": r["leader_id_switches"], "handovers": handovers,
+                      "targets_by_camera": by_camera, "localization": loc, "along_line_of_sight": los,
+                      "false_targets": r["false_targets"], "false_track_ids": r["false_track_ids"],
+                      "leader_targets": len(rows), "truth_frames": r["truth_frames"],
+                      "inference_p50_ms": r["inference_latency"]["p50_ms"], "detection_source": r["detection_source"]}
+        cams = ", ".join(f"{c}: {n}" for c, n in sorted(by_camera.items()))
+        rms = f"{loc['rms_m']:.3f} m" if loc["n"] else "—"
+        rows_out.append(f"| {name} | {100 * rate(r):.1f} % | {r['track_ids_on_leader']} | {r['leader_id_switches']} | "
+                        f"{handovers} | {len(rows)} of {r['truth_frames']} ({cams}) | {rms} | "
+                        f"{los['rms_m']:.3f} m | {r['false_targets']} ({r['false_track_ids']} ids) |")
+    lines = ["| flight | leader detected | track ids on the leader | id switches | hand-overs | leader's targets "
+             "(by the camera of the last detection) | RMS 3-D | RMS along the line of sight | false targets |",
+             "|---|---|---|---|---|---|---|---|---|"] + rows_out + \
+        ["", "Detected: frames where some camera boxes the leader (a box centred in its truth box of that camera). "
+         "Hand-over: the leader's track's camera changes between two of its published targets. False targets: more "
+         "than 3 m from every vehicle."]
+    write(out, "surround", data, lines)
+
+
 # Each kind: its function and how many arguments after OUT_DIR it takes (static_sweep: the third flight, from behind,
 # optional; calibration: the radius flown, then its flight).
 KINDS = {"static_sweep": (static_sweep, (2, 3)), "calibration": (calibration, (2, 2)), "distance": (distance, (4, 4)),
          "follow_1d": (follow_1d, (1, 1)), "formation_2d": (formation_2d, (3, 3)), "max_range": (max_range, (1, 1)),
-         "suite": (suite, (1, 100)), "sweeps": (sweeps, (1, 100)), "fly_away": (fly_away, (2, 2)), "approach": (approach, (1, 10))}
+         "suite": (suite, (1, 100)), "sweeps": (sweeps, (1, 100)), "fly_away": (fly_away, (2, 2)), "approach": (approach, (1, 10)),
+         "surround": (surround, (1, 10))}
 
 if __name__ == "__main__":
     if (len(sys.argv) < 3 or sys.argv[1] not in KINDS or

@@ -107,6 +107,36 @@ false_targets=$(val "$run" "r['false_targets']")
 grep -q "^| motion | $first | .* | $false_targets / $false_targets |" "$work/approach/results.md" \
   || fail "approach row, want first target $first and $false_targets false: $(cat "$work/approach/results.md")"
 
+# Surround (issue 31's several cameras): the leader's hand-overs are its track's camera changing between targets
+# (targets.csv's camera_id); the ids and RMS are the eval's.
+mkdir -p "$work/surround/rig"
+cp "$work/run/eval.json" "$work/surround/rig/eval.json"
+python3 - "$work/run/targets.csv" "$work/surround/rig/targets.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+leader = [r for r in rows if r["vehicle_id"] == "1"]
+for i, r in enumerate(leader):  # the leader's targets by camera 0, 1, 1, 2, 2, ...: one hand-over at each change
+    r["camera_id"] = str((i + 1) // 2 % 4)
+w = csv.DictWriter(open(sys.argv[2], "w", newline=""), fieldnames=list(rows[0].keys()))
+w.writeheader()
+w.writerows(rows)
+PY
+python3 "$summary" surround "$work/surround" "$work/surround/rig" > /dev/null
+want=$(python3 - "$work/run/targets.csv" <<'PY'
+import csv, sys
+leader = [r for r in csv.DictReader(open(sys.argv[1])) if r["vehicle_id"] == "1"]
+by_track = {}
+for i, r in enumerate(leader):
+    by_track.setdefault(r["track_id"], []).append((i + 1) // 2 % 4)
+print(sum(sum(1 for a, b in zip(c, c[1:]) if a != b) for c in by_track.values()))
+PY
+)
+[ "$want" -gt 0 ] || fail "the test flight has no leader targets to hand over"
+got=$(val "$work/surround/results.json" "r['rig']['handovers']")
+[ "$got" = "$want" ] || fail "surround hand-overs: $got, want $want"
+ids=$(val "$run" "r['track_ids_on_leader']")
+grep -q "^| rig | .* | $ids | " "$work/surround/results.md" || fail "surround row: $(cat "$work/surround/results.md")"
+
 # Wrong arguments: the usage, not a traceback.
 if python3 "$summary" formation_2d "$work" "$run" 2> "$work/err"; then fail "two runs accepted"; fi
 grep -q "Usage" "$work/err" || fail "no usage on bad arguments: $(cat "$work/err")"

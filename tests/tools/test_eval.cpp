@@ -360,12 +360,13 @@ TEST(Eval, CountsLeaderIdSwitchesAndFalseTracks) {
   ASSERT_EQ(lines.size(), 15u);
   EXPECT_EQ(lines[0],
             "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m,radius_m,"
-            "radius_sigma_m");
+            "radius_sigma_m,camera_id");
   // range_m: the true range of the matched vehicle; range_est_m: target_t.range (1 m in these targets); radius_m and
-  // radius_sigma_m: the track's size estimate as published (target_t.radius_m, radius_sigma_m).
-  EXPECT_EQ(lines[1], "0.000000,7,1,10.0000,0.0000,10.0000,5.0000,0.0000,10.0000,5.0000,0.0000,1.0000,0.3480,0.0125");
+  // radius_sigma_m: the track's size estimate as published (target_t.radius_m, radius_sigma_m); camera_id: the camera
+  // of the track's last detection.
+  EXPECT_EQ(lines[1], "0.000000,7,1,10.0000,0.0000,10.0000,5.0000,0.0000,10.0000,5.0000,0.0000,1.0000,0.3480,0.0125,0");
   EXPECT_NE(
-      std::find(lines.begin(), lines.end(), "0.200000,20,-1,1.0000,50.0000,50.0000,50.0000,,,,,1.0000,0.3480,0.0125"),
+      std::find(lines.begin(), lines.end(), "0.200000,20,-1,1.0000,50.0000,50.0000,50.0000,,,,,1.0000,0.3480,0.0125,0"),
       lines.end());
 }
 

@@ -268,7 +268,7 @@ void localization_metrics(const EvalLog& log, const EvalOptions& o, EvalResult* 
       ++r->false_targets;
       ids.false_tracks.insert(t.track_id);
       r->targets.push_back({t_s, t.track_id, -1, t.range, p_est, Eigen::Vector3d::Constant(kNaN), kNaN, t.range,
-                            t.radius_m, t.radius_sigma_m});
+                            t.radius_m, t.radius_sigma_m, t.camera_id});
       continue;
     }
     ++r->target_estimates;
@@ -277,8 +277,8 @@ void localization_metrics(const EvalLog& log, const EvalOptions& o, EvalResult* 
     for (int k = 0; k < 3; ++k) axis[k].add(e[k]);
     const double range = have_follower ? (m.p_truth - p_f).norm() : t.range;
     by_range.add(range, e.norm());
-    r->targets.push_back(
-        {t_s, t.track_id, m.vehicle_id, range, p_est, m.p_truth, e.norm(), t.range, t.radius_m, t.radius_sigma_m});
+    r->targets.push_back({t_s, t.track_id, m.vehicle_id, range, p_est, m.p_truth, e.norm(), t.range, t.radius_m,
+                          t.radius_sigma_m, t.camera_id});
     if (have_follower && (m.p_truth - p_f).norm() > 1e-6) {
       const Eigen::Vector3d los = (m.p_truth - p_f).normalized();
       const double along = e.dot(los);

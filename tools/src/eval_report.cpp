@@ -183,13 +183,13 @@ std::string EvalResult::json() const {
 std::string EvalResult::csv() const {
   std::string s =
       "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m,radius_m,"
-      "radius_sigma_m\n";
+      "radius_sigma_m,camera_id\n";
   const auto num = [](double v) { return std::isnan(v) ? std::string() : fmt::format("{:.4f}", v); };
   for (const auto& t : targets) {
-    s += fmt::format("{:.6f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{:.4f},{:.4f},{:.4f}\n", t.t_s, t.track_id,
-                     t.vehicle_id, t.range_m, t.p_est.x(), t.p_est.y(), t.p_est.z(), num(t.p_truth.x()),
+    s += fmt::format("{:.6f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{:.4f},{:.4f},{:.4f},{}\n", t.t_s,
+                     t.track_id, t.vehicle_id, t.range_m, t.p_est.x(), t.p_est.y(), t.p_est.z(), num(t.p_truth.x()),
                      num(t.p_truth.y()), num(t.p_truth.z()), num(t.error_m), t.range_est_m, t.radius_m,
-                     t.radius_sigma_m);
+                     t.radius_sigma_m, t.camera_id);
   }
   return s;
 }

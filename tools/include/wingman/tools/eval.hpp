@@ -25,8 +25,9 @@ struct EvalOptions {
   std::string log;  ///< LCM log with ground_truth_t and targets_t (and detections_t, image_t)
   std::string truth_channel = "GROUND_TRUTH";  ///< ground_truth_t channel
   std::string targets_channel = "TARGETS";     ///< targets_t channel
-  /// detections_t channels: a POSIX extended regular expression a whole channel name must match (recorder::ChannelPattern, as lcm subscribes); the
-  /// default takes every camera's (a rig's several cameras: each box is judged against its own camera's truth boxes).
+  /// detections_t channels: a POSIX extended regular expression a whole channel name must match
+  /// (recorder::ChannelPattern, as lcm subscribes); the default takes every camera's (a rig's several cameras: each box
+  /// is judged against its own camera's truth boxes).
   std::string detections_channel = "DETECTIONS_CAM[0-9]+";
   std::string image_channel = "IMAGE_CAM0";  ///< image_t channel (latency reference, report frames)
   /// The camera's monitoring preview (small JPEG image_t, 1 Hz: camera_driver/preview.hpp): the report's frames when
@@ -168,6 +169,7 @@ struct EvalResult {
     double range_est_m;              ///< target_t.range: the localizer's camera-to-target distance, metres
     double radius_m;                 ///< target_t.radius_m: the track's size estimate (bounding radius), metres
     double radius_sigma_m;           ///< target_t.radius_sigma_m: its standard deviation, metres (0: not estimated)
+    int camera_id;                   ///< target_t.camera_id: the camera of the track's last detection
   };
   std::vector<TargetSample> targets;
   /// One matched detection's box width (the report's scatter).
