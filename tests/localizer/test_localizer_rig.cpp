@@ -98,7 +98,7 @@ TEST(LocalizerRig, ATargetCirclingTheVehicleKeepsOneTrackThroughEveryHandOver) {
   Localizer loc(rig_options(scene.rig.source), scene.rig);
   ASSERT_TRUE(loc.is_rig());
   ASSERT_EQ(loc.cameras().size(), 4u);
-  const int frames = 30 * 26;  // one turn in 24 s (2.1 m/s), and more: every camera twice through each hand-over
+  const int frames = 30 * 26;  // one turn in 24 s (2.1 m/s) and a little more: the four hand-overs
   const std::vector<LocalizerOutput> outputs = fly_circle(loc, scene, frames, in_rig_order);
   ASSERT_EQ(static_cast<int>(outputs.size()), frames) << "one output per exposure";
   std::set<int32_t> cameras_used;
