@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// CameraDriver: frame checks, MJPEG decoding, image_t conversion and the source factory.
+// CameraDriver: frame checks, MJPEG decoding and encoding, image_t conversion and the source factory.
 #include "wingman/camera_driver/camera_driver.hpp"
 
 #include "wingman/camera_driver/file_source.hpp"
@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <chrono>
 #include <cstring>
@@ -70,6 +71,41 @@ std::string decode_mjpeg(const Frame& jpeg, Frame& bgr) {
   return "";
 }
 
+std::string encode_mjpeg(const Frame& raw, int quality, Frame& jpeg) {
+  auto* pixels = const_cast<uint8_t*>(raw.data.data());
+  const auto stride = static_cast<size_t>(raw.stride);
+  cv::Mat img;
+  switch (raw.format) {
+    case PixelFormat::kGray8:
+      img = cv::Mat(raw.height, raw.width, CV_8UC1, pixels, stride);
+      break;
+    case PixelFormat::kBgr8:
+      img = cv::Mat(raw.height, raw.width, CV_8UC3, pixels, stride);
+      break;
+    case PixelFormat::kYuyv:
+      cv::cvtColor(cv::Mat(raw.height, raw.width, CV_8UC2, pixels, stride), img, cv::COLOR_YUV2BGR_YUYV);
+      break;
+    case PixelFormat::kMjpeg:
+      return fmt::format("frame seq {}: already MJPEG", raw.seq);
+  }
+  bool ok = false;
+  try {
+    ok = cv::imencode(".jpg", img, jpeg.data, {cv::IMWRITE_JPEG_QUALITY, quality});
+  } catch (const cv::Exception& e) {
+    ok = false;
+  }
+  if (!ok || jpeg.data.empty())
+    return fmt::format("frame seq {}: {}x{} {} does not encode as JPEG", raw.seq, raw.width, raw.height,
+                       pixel_format_name(raw.format));
+  jpeg.utime = raw.utime;
+  jpeg.seq = raw.seq;
+  jpeg.width = raw.width;
+  jpeg.height = raw.height;
+  jpeg.format = PixelFormat::kMjpeg;
+  jpeg.stride = 0;
+  return "";
+}
+
 std::unique_ptr<FrameSource> make_source(const CameraDriverOptions& options, std::shared_ptr<V4l2Io> io,
                                          std::shared_ptr<Clock> clock) {
   const auto problems = options.validate();
@@ -110,6 +146,10 @@ DriverStep CameraDriver::step(int timeout_ms) {
   if (options_.decode_mjpeg && frame_.format == PixelFormat::kMjpeg) {
     if (std::string bad = decode_mjpeg(frame_, decoded_); !bad.empty()) return drop(source_->describe() + ": " + bad);
     out = &decoded_;
+  } else if (options_.encoding == "mjpeg" && frame_.format != PixelFormat::kMjpeg) {
+    if (std::string bad = encode_mjpeg(frame_, options_.jpeg_quality, encoded_); !bad.empty())
+      return drop(source_->describe() + ": " + bad);
+    out = &encoded_;
   }
   step.image = to_image_message(std::move(*out), options_.camera_id);  // the next read refills the frame
   ++frames_out_;

@@ -15,6 +15,15 @@ std::vector<std::string> OutputOptions::validate() const {
   for (unsigned char c : channel) channel_ok = channel_ok && std::isgraph(c);
   if (!channel_ok) p.push_back(problem("output.channel", channel, "must be a non-empty name without spaces"));
   if (camera_id < 0 || camera_id > 255) p.push_back(problem("output.camera_id", camera_id, "must be in [0, 255]"));
+  if (encoding != "raw" && encoding != "mjpeg")
+    p.push_back(problem("output.encoding", encoding, "must be raw or mjpeg"));
+  if (jpeg_quality < 1 || jpeg_quality > 100)
+    p.push_back(problem("output.jpeg_quality", jpeg_quality, "must be in 1..100"));
+  if (encoding == "mjpeg" && decode_mjpeg) {
+    p.push_back(problem("output.decode_mjpeg", "true",
+                        "contradicts output.encoding = mjpeg (MJPEG camera frames would be decoded, then encoded "
+                        "again); choose one"));
+  }
   if (max_frames < 0) {
     p.push_back(problem("output.max_frames", static_cast<double>(max_frames), "must be >= 0 (0 = no limit)"));
   }

@@ -7,12 +7,17 @@
 #include "wingman/camera_driver/camera_driver.hpp"
 
 #include <wingman/common/message_validation.hpp>
+#include <wingman/detector/preprocess.hpp>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include <cstdio>
+#include <cstring>
 #include <deque>
 #include <memory>
 
@@ -159,6 +164,162 @@ TEST(CameraDriver, DecodeMjpegPublishesBgr8AndDropsCorruptStreams) {
   EXPECT_THAT(step.reason, HasSubstr("does not decode"));
   EXPECT_EQ(rig.driver->driver_drops(), 1);
   EXPECT_EQ(rig.driver->frames_out(), 1);
+}
+
+/// A camera-like test image, fixed seed: seeded random colours at 1/16 of the size, upscaled smoothly (textures and
+/// gradients), with dark sharp-edged boxes (targets against the sky) on top.
+cv::Mat seeded_scene(int width, int height, uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat coarse(std::max(2, height / 16), std::max(2, width / 16), CV_8UC3);
+  rng.fill(coarse, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat scene;
+  cv::resize(coarse, scene, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
+  for (int i = 0; i < 6; ++i) {
+    const int w = rng.uniform(8, std::max(9, width / 8));
+    const int h = rng.uniform(6, std::max(7, height / 8));
+    const cv::Rect box(rng.uniform(0, width - w), rng.uniform(0, height - h), w, h);
+    cv::rectangle(scene, box, cv::Scalar(rng.uniform(0, 60), rng.uniform(0, 60), rng.uniform(0, 60)), cv::FILLED);
+  }
+  return scene;
+}
+
+/// `img` as a frame of `format` (BGR8 or GRAY8) with `padding` bytes at the end of every row.
+Frame frame_of(const cv::Mat& img, PixelFormat format, int padding, int64_t seq) {
+  Frame f;
+  f.seq = seq;
+  f.utime = 1'700'000'000'000'000 + seq * 33'333;
+  f.width = img.cols;
+  f.height = img.rows;
+  f.format = format;
+  f.stride = img.cols * bytes_per_pixel(format) + padding;
+  f.data.assign(static_cast<size_t>(f.stride) * static_cast<size_t>(f.height), 0xAB);  // padding that must not show
+  for (int r = 0; r < img.rows; ++r)
+    std::memcpy(f.data.data() + static_cast<size_t>(r) * static_cast<size_t>(f.stride), img.ptr(r),
+                static_cast<size_t>(img.cols) * static_cast<size_t>(bytes_per_pixel(format)));
+  return f;
+}
+
+/// One frame through a CameraDriver with output.encoding mjpeg at `quality`.
+DriverStep encode_through_driver(Frame frame, int quality) {
+  auto src = std::make_unique<ScriptedSource>();
+  src->items.push_back({ReadResult{ReadStatus::kFrame, 0, "", false}, std::move(frame)});
+  OutputOptions out;
+  out.camera_id = 3;
+  out.encoding = "mjpeg";
+  out.jpeg_quality = quality;
+  CameraDriver driver(out, std::move(src));
+  return driver.step(0);
+}
+
+// The load test's transport (output.encoding mjpeg, quality 90): the driver's MJPEG frame is what the detector's
+// preprocessing (detector::image_to_bgr, the only image_t -> pixels path) turns back into the same size and close
+// pixels. Tolerances: baseline JPEG at quality 90 with 4:2:0 chroma on this scene measured mean |difference| 1.6-1.7
+// levels and PSNR 38.5-40.4 dB (1280x720 and 333x187); the bounds (mean <= 2.5, PSNR >= 34 dB) leave room for another
+// libjpeg's rounding while a wrong channel order, a lost stride or a half-size image misses them by far.
+TEST(CameraDriver, MjpegEncodingDecodesInTheDetectorToTheSameSizeAndClosePixels) {
+  struct Case {
+    int width, height, padding;
+  };
+  for (const Case c : {Case{1280, 720, 0}, Case{333, 187, 7}}) {
+    SCOPED_TRACE(::testing::Message() << c.width << "x" << c.height << " BGR8, " << c.padding << " bytes of padding");
+    const cv::Mat scene = seeded_scene(c.width, c.height, 31);
+    const DriverStep step = encode_through_driver(frame_of(scene, PixelFormat::kBgr8, c.padding, 7), 90);
+    ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+    EXPECT_EQ(step.image.pixel_format, int8_t{wingman::image_t::MJPEG});
+    EXPECT_EQ(step.image.stride, 0);
+    EXPECT_EQ(step.image.width, c.width);
+    EXPECT_EQ(step.image.height, c.height);
+    EXPECT_EQ(step.image.seq, 7);
+    EXPECT_EQ(step.image.utime, 1'700'000'000'000'000 + 7 * 33'333);
+    EXPECT_EQ(step.image.camera_id, 3);
+    EXPECT_EQ(step.image.size, static_cast<int32_t>(step.image.data.size()));
+    EXPECT_LT(step.image.data.size(), scene.total() * 3 / 4) << "compressed";
+    EXPECT_EQ(common::validate_message(step.image), "");
+    std::string error;
+    const cv::Mat decoded = detector::image_to_bgr(step.image, &error);
+    ASSERT_EQ(error, "");
+    ASSERT_EQ(decoded.size(), scene.size());
+    ASSERT_EQ(decoded.type(), CV_8UC3);
+    const double mean_abs = cv::norm(decoded, scene, cv::NORM_L1) / static_cast<double>(scene.total() * 3);
+    const double psnr = cv::PSNR(decoded, scene);
+    EXPECT_LE(mean_abs, 2.5);
+    EXPECT_GE(psnr, 34.0);
+    std::printf("[ measured ] %dx%d q90: %zu bytes (%.1f %% of BGR8), mean |difference| %.2f levels, PSNR %.1f dB\n",
+                c.width, c.height, step.image.data.size(), 100.0 * step.image.data.size() / (scene.total() * 3.0),
+                mean_abs, psnr);
+  }
+}
+
+// GRAY8 and YUYV are encoded from what the detector reads of them (the same conversion). The 320x240 scene has more
+// edges per pixel than the 720p one: measured mean |difference| 0.5 (GRAY8) and 3.1 (YUYV, whose subsampled chroma
+// JPEG subsamples again) levels; bound 4.5.
+TEST(CameraDriver, MjpegEncodingTakesGrayAndYuyvFrames) {
+  const cv::Mat scene = seeded_scene(320, 240, 32);
+  cv::Mat gray;
+  cv::cvtColor(scene, gray, cv::COLOR_BGR2GRAY);
+  DriverStep step = encode_through_driver(frame_of(gray, PixelFormat::kGray8, 3, 1), 90);
+  ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+  std::string error;
+  cv::Mat decoded = detector::image_to_bgr(step.image, &error);
+  ASSERT_EQ(error, "");
+  ASSERT_EQ(decoded.size(), gray.size());
+  cv::Mat gray_expected;
+  cv::cvtColor(gray, gray_expected, cv::COLOR_GRAY2BGR);
+  const double gray_mean_abs = cv::norm(decoded, gray_expected, cv::NORM_L1) / static_cast<double>(gray.total() * 3);
+  EXPECT_LE(gray_mean_abs, 4.5);
+
+  // YUYV: the camera's own layout, made from the scene (Y per pixel, U and V per pair), then what the detector reads
+  // from the raw YUYV frame is what it reads from the encoded one, within the JPEG bound.
+  Frame yuyv;
+  yuyv.width = 320;
+  yuyv.height = 240;
+  yuyv.stride = 640;
+  yuyv.format = PixelFormat::kYuyv;
+  cv::Mat yuv;
+  cv::cvtColor(scene, yuv, cv::COLOR_BGR2YUV);
+  yuyv.data.resize(640 * 240);
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; x += 2) {
+      const cv::Vec3b a = yuv.at<cv::Vec3b>(y, x), b = yuv.at<cv::Vec3b>(y, x + 1);
+      uint8_t* d = yuyv.data.data() + y * 640 + x * 2;
+      d[0] = a[0];
+      d[1] = static_cast<uint8_t>((a[1] + b[1]) / 2);
+      d[2] = b[0];
+      d[3] = static_cast<uint8_t>((a[2] + b[2]) / 2);
+    }
+  }
+  const cv::Mat raw_in_detector = detector::image_to_bgr(to_image_message(yuyv, 0), &error);
+  ASSERT_EQ(error, "");
+  step = encode_through_driver(yuyv, 90);
+  ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+  decoded = detector::image_to_bgr(step.image, &error);
+  ASSERT_EQ(error, "");
+  ASSERT_EQ(decoded.size(), raw_in_detector.size());
+  const double yuyv_mean_abs =
+      cv::norm(decoded, raw_in_detector, cv::NORM_L1) / static_cast<double>(decoded.total() * 3);
+  EXPECT_LE(yuyv_mean_abs, 4.5);
+  std::printf("[ measured ] 320x240 q90: mean |difference| GRAY8 %.2f, YUYV %.2f levels\n", gray_mean_abs,
+              yuyv_mean_abs);
+}
+
+TEST(CameraDriver, MjpegEncodingPassesAnMjpegCamerasStreamThroughUntouched) {
+  V4l2SourceOptions v4l2;
+  v4l2.pixel_format = "MJPEG";
+  v4l2.width = 64;
+  v4l2.height = 48;
+  OutputOptions out;
+  out.encoding = "mjpeg";
+  out.jpeg_quality = 20;  // would change the bytes, were the stream re-encoded
+  V4l2Rig rig(v4l2, out);
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", testing::pattern_image(64, 48, 5), jpeg, {cv::IMWRITE_JPEG_QUALITY, 95});
+  FakeEvent e;
+  e.payload = jpeg;
+  rig.device->push_event(e);
+  const DriverStep step = rig.driver->step(100);
+  ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+  EXPECT_EQ(step.image.pixel_format, int8_t{wingman::image_t::MJPEG});
+  EXPECT_EQ(step.image.data, jpeg);
 }
 
 TEST(CameraDriver, ZeroSizeFramesAreCountedDrops) {

@@ -50,6 +50,15 @@ TEST(CameraDriverOptions, EveryBadValueIsReportedNamingItsKey) {
   EXPECT_THAT(err, HasSubstr("7 problems"));
 }
 
+TEST(CameraDriverOptions, EncodingIsRawOrMjpegAtAQualityAndNotWithDecodeMjpeg) {
+  EXPECT_EQ(load_error("output: {encoding: mjpeg, jpeg_quality: 75}\n"), "");
+  const std::string err = load_error("output: {encoding: h264, jpeg_quality: 0}\n");
+  EXPECT_THAT(err, HasSubstr("output.encoding = 'h264': must be raw or mjpeg"));
+  EXPECT_THAT(err, HasSubstr("output.jpeg_quality = 0: must be in 1..100"));
+  EXPECT_THAT(load_error("output: {encoding: mjpeg, decode_mjpeg: true}\n"), HasSubstr("output.decode_mjpeg"));
+  EXPECT_EQ(load_error("output: {encoding: raw, decode_mjpeg: true}\n"), "");
+}
+
 TEST(CameraDriverOptions, FileSourceNeedsAPathButTheCameraDoesNot) {
   EXPECT_EQ(load_error("source: {kind: v4l2}\n"), "");
   EXPECT_THAT(load_error("source: {kind: file}\n"), HasSubstr("file.path"));

@@ -27,7 +27,7 @@ struct DriverStep {
   std::string reason;
   /// True on the first step after the camera came back.
   bool reconnected = false;
-  /// Time spent converting the frame (MJPEG decode, copy into the message), milliseconds.
+  /// Time spent converting the frame (MJPEG decode or encode, copy into the message), milliseconds.
   double convert_ms = 0.0;
 };
 
@@ -40,6 +40,11 @@ wingman::image_t to_image_message(Frame&& frame, int32_t camera_id);
 /// Decodes an MJPEG frame into a BGR8 frame with the same utime and seq. Returns "" or one line on
 /// why it does not decode (corrupt stream, or a size other than the frame says).
 std::string decode_mjpeg(const Frame& jpeg, Frame& bgr);
+
+/// JPEG-encodes a raw frame (GRAY8, BGR8, or YUYV converted to BGR first) with OpenCV at `quality` (1..100) into an
+/// MJPEG frame (stride 0) with the same utime, seq and size: output.encoding mjpeg. Returns "" or one line on why it
+/// could not. Precondition: check_frame(raw) is "" and raw.format is not MJPEG.
+std::string encode_mjpeg(const Frame& raw, int quality, Frame& jpeg);
 
 /// Builds the source options.source_kind selects (not opened). `io` is used for v4l2 only.
 /// Throws std::invalid_argument naming the key when the options are invalid.
@@ -64,7 +69,7 @@ class CameraDriver {
   std::string describe() const { return source_->describe(); }
   /// Frames converted for publishing.
   int64_t frames_out() const { return frames_out_; }
-  /// Frames dropped by the driver itself (failed checks or MJPEG decode), on top of the source's.
+  /// Frames dropped by the driver itself (failed checks, MJPEG decode or encode), on top of the source's.
   int64_t driver_drops() const { return driver_drops_; }
 
  private:
@@ -72,6 +77,7 @@ class CameraDriver {
   std::unique_ptr<FrameSource> source_;
   Frame frame_;    // the source fills it; its data moves into the published message
   Frame decoded_;  // MJPEG decoded to BGR8 (output.decode_mjpeg)
+  Frame encoded_;  // a raw frame JPEG-encoded (output.encoding mjpeg)
   int64_t frames_out_ = 0;
   int64_t driver_drops_ = 0;
   bool ended_ = false;

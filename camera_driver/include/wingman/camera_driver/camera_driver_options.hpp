@@ -20,6 +20,14 @@ struct OutputOptions {
   int camera_id = 0;
   /// true: decode MJPEG frames and publish BGR8; false: publish the JPEG stream undecoded (MJPEG).
   bool decode_mjpeg = false;
+  /// Pixels on the bus: "raw" publishes frames as the source gives them (GRAY8, BGR8 or YUYV uncompressed; a V4L2
+  /// MJPEG camera's stream undecoded unless decode_mjpeg); "mjpeg" JPEG-encodes raw frames with OpenCV at
+  /// jpeg_quality (image_t pixel_format MJPEG, stride 0; the detector decodes it), while a V4L2 MJPEG camera's
+  /// stream passes through as captured, never decoded and re-encoded. Four 1280x720 cameras on one bus need mjpeg
+  /// (docs/reliability.md, "Load and soak").
+  std::string encoding = "raw";
+  /// JPEG quality of output.encoding mjpeg, 1..100 (OpenCV's IMWRITE_JPEG_QUALITY).
+  int jpeg_quality = 90;
   /// Stop after publishing this many frames (exit 0); 0 = no limit.
   int64_t max_frames = 0;
 
@@ -68,6 +76,10 @@ struct CameraDriverOptions {
     v("output.camera_id", output.camera_id, "image_t.camera_id: which camera on the vehicle (0..n-1)");
     v("output.decode_mjpeg", output.decode_mjpeg,
       "decode MJPEG frames and publish BGR8 (true) or publish them undecoded (false)");
+    v("output.encoding", output.encoding,
+      "pixels on the bus: raw (as the source gives them) or mjpeg (raw frames JPEG-encoded; MJPEG cameras pass "
+      "through)");
+    v("output.jpeg_quality", output.jpeg_quality, "JPEG quality of output.encoding mjpeg, 1..100");
     v("output.max_frames", output.max_frames, "exit 0 after publishing this many frames; 0 = no limit");
     preview.visit(v);
   }
