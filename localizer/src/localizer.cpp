@@ -46,8 +46,13 @@ Localizer::Localizer(const LocalizerOptions& options, const geometry::CameraRig&
       clock_(options.time),
       own_pose_input_(clock_.add_input("own_pose_t.utime", "own pose", true)) {
   if (rig.cameras.empty()) throw std::invalid_argument("cameras.rig = '" + rig.source + "': no cameras");
-  if (!(options.cameras.silent_after_s > 0) || options.cameras.max_pending < 1)
-    throw std::invalid_argument("invalid cameras.silent_after_s or cameras.max_pending");
+  CameraRigOptions keys = options.cameras;
+  keys.rig.clear();  // read already: `rig`
+  if (const std::vector<std::string> bad = keys.validate(); !bad.empty()) {
+    std::string all = "invalid cameras.*:";
+    for (const std::string& b : bad) all += " " + b + ";";
+    throw std::invalid_argument(all);
+  }
   for (const geometry::RigCamera& c : rig.cameras) {
     cameras_.emplace_back(c.camera.camera_id, geometry::make_camera(c.camera),
                           geometry::Extrinsics::from_options(c.extrinsics), c.detections_channel, c.windows_channel);

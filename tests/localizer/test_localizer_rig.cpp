@@ -429,6 +429,12 @@ TEST(LocalizerRig, TheKeysAreValidatedAndABadRigFileIsOneErrorNamingTheKeyAndThe
   EXPECT_NE(all.find("camera_id"), std::string::npos) << all;
   EXPECT_THROW((void)Localizer::from_options(rig_options(dir.file("missing.yaml"))), wingman::common::ConfigError);
   EXPECT_TRUE(rig_options(wingman::testing::source_path("config/rigs/surround4.yaml")).validate().empty());
+  try {
+    Localizer loc(o, surround4());
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cameras.max_pending = 0"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
