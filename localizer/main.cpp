@@ -28,12 +28,13 @@ int run(common::Runtime& rt, const localizer::LocalizerOptions& o) {
   for (const localizer::LocalizerCamera& camera : loc.cameras()) {
     const std::string channel = camera.detections_channel;
     // A message that cannot be used throws: the runtime drops and counts it on its channel, never fatal.
-    rt.subscribe<detections_t>(channel, [&, channel](const detections_t& d) {
+    rt.subscribe<detections_t>(channel, [&](const detections_t& d) {
       const std::vector<localizer::LocalizerOutput> outputs = loc.add_detections(d);
       log_notes();
       rt.status().set_last_processed_seq(d.seq);
       for (const localizer::LocalizerOutput& out : outputs) {
-        for (const auto& why : out.rejections) rt.status().item_dropped(channel, why);
+        for (size_t i = 0; i < out.rejections.size(); ++i)  // on the channel of the camera it belongs to
+          rt.status().item_dropped(out.rejection_channels[i], out.rejections[i]);
         camera_frame_only = out.camera_frame_only;
       }
       // Boxes of other classes than drone are expected, not drops: their counts since start are in the detail.

@@ -266,6 +266,7 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
         result.rejections.push_back(
             rig_ ? fmt::format("camera {}: detections_t.detections[{}]: {}", d->camera_id, i, r.reason)
                  : fmt::format("detections_t.detections[{}]: {}", i, r.reason));
+        result.rejection_channels.push_back(cameras_[c].detections_channel);
         continue;
       }
       // Decided per track: the tracker's evidence is the box's drone score (the same as its confidence for a drone
@@ -283,6 +284,11 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
   if (!pose) {
     result.camera_frame_only = true;
     result.rejections.push_back("no own pose at detections_t.utime = " + std::to_string(utime) + ": " + why);
+    for (size_t c = 0; c < per_camera.size(); ++c)
+      if (per_camera[c] != nullptr) {
+        result.rejection_channels.push_back(cameras_[c].detections_channel);
+        break;
+      }
     if (options_.publish_camera_frame_only) {
       wingman::targets_t out{};
       out.utime = utime;

@@ -364,6 +364,22 @@ TEST(LocalizerRig, AMessageOfACameraNotInTheRigOrOfAnotherSizeIsDroppedNamingThe
   EXPECT_EQ(loc2.cameras()[2].camera.width(), 640);
 }
 
+TEST(LocalizerRig, ABoxThatCannotBeLocalizedIsDroppedOnItsCamerasChannel) {
+  const RigScene scene(surround4());
+  Localizer loc(rig_options(scene.rig.source), scene.rig);
+  loc.on_own_pose(own_pose(kT0));
+  std::vector<LocalizerOutput> out;
+  for (size_t i = 0; i < 4; ++i) {
+    wingman::detections_t d = scene.detections(i, kT0, {});
+    if (i == 2) d.detections.push_back(wingman::detection_t{}), d.num_detections = 1;  // w = h = 0
+    out = loc.add_detections(d);
+  }
+  ASSERT_EQ(out.size(), 1u);
+  ASSERT_EQ(out[0].rejections.size(), 1u);
+  EXPECT_EQ(out[0].rejections[0].rfind("camera 2: detections_t.detections[0]: ", 0), 0u) << out[0].rejections[0];
+  EXPECT_EQ(out[0].rejection_channels, (std::vector<std::string>{"DETECTIONS_CAM2"}));
+}
+
 TEST(LocalizerRig, WithoutAnOwnPoseEachCamerasBoxesAreCameraFrameTargetsNamingTheCamera) {
   const RigScene scene(surround4());
   Localizer loc(rig_options(scene.rig.source), scene.rig);

@@ -79,6 +79,9 @@ struct LocalizerOutput {
   /// One line per box that could not be used and per missing own pose, naming the field and why;
   /// the process counts each as a drop.
   std::vector<std::string> rejections;
+  /// The detections channel each rejection belongs to (same order): the box's camera's; for a missing own pose the
+  /// exposure's first camera's.
+  std::vector<std::string> rejection_channels;
   bool camera_frame_only = false;  ///< no own pose fresh enough at the image's exposure time
   /// The message's boxes with class_id != 0, left out before localization (not rejections).
   NonDroneCounts non_drone;
