@@ -253,6 +253,19 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     if (!via_mavlink) simulator.on_setpoint(sp);
     newest_setpoint_utime = std::max(newest_setpoint_utime, sp.utime);
   });
+  // sync.image_by_image: the newest detections_t utime back from each camera's detector (by output index).
+  const bool image_by_image =
+      lockstep && o.sync.image_by_image && o.render && !o.detections.from_ground_truth && outputs.size() > 1;
+  std::vector<int64_t> newest_detections_utime(outputs.size(), -1);
+  int64_t image_by_image_timeouts = 0;
+  if (image_by_image) {
+    for (size_t i = 0; i + 1 < outputs.size(); ++i) {
+      const int camera_id = outputs[i].camera.camera_id;
+      rt.subscribe<detections_t>(outputs[i].detections_channel, [&, i, camera_id](const detections_t& d) {
+        if (d.camera_id == camera_id) newest_detections_utime[i] = std::max(newest_detections_utime[i], d.utime);
+      });
+    }
+  }
   int64_t newest_own_pose_utime = -1;
   if (via_mavlink) {
     rt.subscribe<own_pose_t>(o.own_pose_channel, [&](const own_pose_t& p) {
@@ -364,6 +377,18 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
                    sim::truth_detections(frame.truth, frame.index, out.camera.model, view.T_cam_to_world,
                                          view.camera_id, o.detections, static_cast<int>(i)));
       }
+      if (image_by_image && i + 1 < outputs.size() && !view.bgr.empty() && !input_ended) {
+        // One image on the bus at a time: the next camera's waits for this one's detections.
+        if (!wait_until([&] { return newest_detections_utime[i] >= frame.utime; }, o.sync.timeout_s) &&
+            !rt.stop_requested()) {
+          ++image_by_image_timeouts;
+          spdlog::warn("frame {} (utime {}): no detections_t from camera {} on {} within {} s ({} so far); going on",
+                       frame.index, frame.utime, out.camera.camera_id, out.detections_channel, o.sync.timeout_s,
+                       image_by_image_timeouts);
+          status.set_error(fmt::format("sync.image_by_image: no detections from camera {} for frame {} within {} s",
+                                       out.camera.camera_id, frame.index, o.sync.timeout_s));
+        }
+      }
     }
     status.set_last_processed_seq(frame.index);
     status.record_latency_ms(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
@@ -412,7 +437,9 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
         scenario.name, frame.index + 1, simulator.frame_count(), simulator.clock().seconds_since_start(frame.utime),
         cameras_note, lockstep_timeouts, c.queued, c.late, c.ignored, gt_note);
     if (mav) detail += "; " + mavlink_detail(*mav, own_pose_timeouts, barrier_timeouts);
-    const bool degraded = lockstep_timeouts > 0 || own_pose_timeouts > 0 || barrier_timeouts > 0;
+    if (image_by_image) detail += fmt::format("; {} image-by-image timeouts", image_by_image_timeouts);
+    const bool degraded =
+        lockstep_timeouts > 0 || own_pose_timeouts > 0 || barrier_timeouts > 0 || image_by_image_timeouts > 0;
     status.set_state(degraded ? status_t::STATE_DEGRADED : status_t::STATE_OK, detail);
     rt.heartbeat_if_due();
   }
@@ -426,6 +453,8 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
       wall_s > 0 ? simulator.clock().seconds_since_start(simulator.now_utime()) / wall_s : 0.0, lockstep_timeouts,
       simulator.setpoint_counts().queued, simulator.setpoint_counts().late, simulator.setpoint_counts().ignored);
   if (mav) spdlog::info("{}", mavlink_detail(*mav, own_pose_timeouts, barrier_timeouts));
+  if (image_by_image)
+    spdlog::info("image by image: {} timeouts waiting for a camera's detections", image_by_image_timeouts);
   return rt.shutdown(stop_reason);
 }
 

@@ -197,8 +197,8 @@ FlightPlan plan_flight(const FlyOptions& o) {
       "scenario.file=" + plan.scenario_file,
       "--set",
       fmt::format("sync={{mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: {}, startup_timeout_s: 60.0, "
-                  "scripted_lockstep: {}}}",
-                  wait_for, bool_text(o.windows || !plan.rig_file.empty())),
+                  "scripted_lockstep: {}, image_by_image: {}}}",
+                  wait_for, bool_text(o.windows || !plan.rig_file.empty()), bool_text(!plan.rig_file.empty())),
       "--set",
       fmt::format("detections={{from_ground_truth: {}, box: {}, noise_px: 1.0, seed: {}}}", bool_text(!cnn),
                   o.truth_box, scenario_seed),

@@ -78,6 +78,12 @@ struct SyncOptions {
   /// follower publishes one per targets_t), so that a scripted flight through a live pipeline is deterministic too
   /// (the tracker-driven windows of the next frame come from this frame's tracks). false: nothing to wait for.
   bool scripted_lockstep = false;
+  /// lockstep with several cameras rendered: publish the next camera's image only once the detections_t of the one
+  /// before (its camera_id and the frame's utime, on its detections channel) has come back, at most timeout_s each, so
+  /// that one image at a time is on the bus. Four raw 1280x720 images at once (11 MB) overflow the receive buffers of
+  /// the sockets that are busy detecting, and a lost image costs a lockstep timeout. No effect with
+  /// detections.from_ground_truth (the simulator publishes those itself), without rendering, or with one camera.
+  bool image_by_image = false;
 
   template <class V>
   void visit(V& v) {
@@ -89,6 +95,9 @@ struct SyncOptions {
     v("sync.startup_timeout_s", startup_timeout_s, "longest wait for sync.wait_for, s (then exit 1 naming them)");
     v("sync.scripted_lockstep", scripted_lockstep,
       "lockstep: wait for each frame's SETPOINT even when the camera vehicle is scripted (deterministic replays)");
+    v("sync.image_by_image", image_by_image,
+      "lockstep, several cameras: publish a camera's image once the camera before it has its detections back (one "
+      "image on the bus at a time)");
   }
   std::vector<std::string> validate() const;
 };
