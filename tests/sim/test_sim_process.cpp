@@ -508,6 +508,72 @@ TEST(SimProcess, ARigInLockstepPublishesEveryCamerasDetectionsThenWaitsOncePerFr
     EXPECT_EQ(fake.seen[n], "DETECTIONS_CAM" + std::to_string(n % 4) + "@" + std::to_string(n / 4));
 }
 
+TEST(SimProcess, ImageByImageSendsACamerasImageOnceTheCameraBeforeItHasItsDetectionsBack) {
+  // Four small rendered cameras in lockstep with sync.image_by_image. A fake detector answers each image of cameras
+  // 0-2 with that camera's detections_t, except camera 1 of frame 2 (never answered: the simulator waits timeout_s
+  // for it, counts it and goes on), and camera 3's image with the frame's SETPOINT.
+  TempDir dir;
+  const std::string rig = dir.file("rig.yaml");
+  {
+    std::ofstream r(rig);
+    r << "cameras:\n";
+    for (int i = 0; i < 4; ++i)
+      r << "  - camera: {camera_id: " << i
+        << ", width: 160, height: 120, focal_px: 80}\n    mount: {yaw_deg: " << 90 * i << "}\n";
+  }
+  Files f("cameras:\n  rig: " + rig +
+              "\nsync:\n  mode: lockstep\n  timeout_s: 1\n  image_by_image: true\n  wait_for: [fake_detector]\n"
+              "  startup_timeout_s: 20\npreview:\n  enabled: false\n",
+          std::string(kTinyScenario).replace(kTinyScenario.find("duration_s: 1"), 13, "duration_s: 0.2"));
+  const std::string url = wingman::testing::netns_lcm_url();
+  lcm::LCM bus(url);
+  ASSERT_TRUE(bus.good()) << url;
+  struct Fake {
+    lcm::LCM* bus;
+    std::vector<std::string> seen;  // "<camera>@<seq>" of the images in arrival order
+    void on_image(const lcm::ReceiveBuffer*, const std::string&, const wingman::image_t* image) {
+      seen.push_back(std::to_string(image->camera_id) + "@" + std::to_string(image->seq));
+      if (image->camera_id == 3) {
+        const wingman::setpoint_t sp = velocity_setpoint(image->utime, 0.0);
+        bus->publish("SETPOINT", &sp);
+        return;
+      }
+      if (image->camera_id == 1 && image->seq == 2) return;  // never answered
+      wingman::detections_t d{};
+      d.utime = image->utime;
+      d.seq = image->seq;
+      d.camera_id = image->camera_id;
+      d.image_width = image->width;
+      d.image_height = image->height;
+      bus->publish("DETECTIONS_CAM" + std::to_string(image->camera_id), &d);
+    }
+  } fake{&bus, {}};
+  for (int i = 0; i < 4; ++i) bus.subscribe("IMAGE_CAM" + std::to_string(i), &Fake::on_image, &fake);
+  Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
+  wingman::status_t hb{};
+  hb.process = "fake_detector";
+  hb.state = wingman::status_t::STATE_OK;
+  int exit_code = -1;
+  const auto deadline = std::chrono::steady_clock::now() + 90s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fake.seen.empty()) bus.publish("STATUS_FAKE_DETECTOR", &hb);  // until the simulator starts
+    bus.handleTimeout(50);
+    if (!sim.running()) {
+      exit_code = sim.wait(1s);
+      break;
+    }
+  }
+  while (bus.handleTimeout(100) > 0) {
+  }
+  ASSERT_EQ(exit_code, 0) << sim.err();
+  EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
+  EXPECT_NE(sim.err().find("image by image: 1 timeouts"), std::string::npos) << sim.err();
+  EXPECT_NE(sim.err().find("no detections_t from camera 1 on DETECTIONS_CAM1"), std::string::npos) << sim.err();
+  ASSERT_EQ(fake.seen.size(), 4u * 6);  // every image of the six frames, camera by camera
+  for (size_t n = 0; n < fake.seen.size(); ++n)
+    EXPECT_EQ(fake.seen[n], std::to_string(n % 4) + "@" + std::to_string(n / 4));
+}
+
 TEST(SimProcess, ABadRigFileIsAConfigurationErrorNamingTheKeyAndTheFile) {
   Files f("render:\n  enabled: false\n");
   const std::string rig = f.dir.file("rig.yaml");
