@@ -111,9 +111,7 @@ void Localizer::admit(LocalizerCamera& c, int clock_input, const wingman::detect
       processed_utime_ = -1;
       first_utime_ = -1;
       for (LocalizerCamera& other : cameras_) other.last_utime = -1;
-      notes_.push_back(admission.problem +
-                       "; the tracker restarts (new track ids) and the waiting exposures are "
-                       "dropped");
+      notes_.push_back(admission.problem + "; the tracker restarts (new track ids), the waiting exposures are dropped");
     } else {
       notes_.push_back(admission.problem + "; the tracker restarts (new track ids)");
     }
@@ -170,15 +168,16 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
     }
     const bool overflow = static_cast<int>(pending_.size()) > options_.cameras.max_pending;
     if (!ready && !overflow) break;
+    const std::vector<std::optional<wingman::detections_t>> messages = std::move(oldest->second);
+    pending_.erase(oldest);  // gone whatever process() does
     std::vector<const wingman::detections_t*> per_camera(cameras_.size(), nullptr);
     for (size_t c = 0; c < cameras_.size(); ++c)
-      if (oldest->second[c]) per_camera[c] = &*oldest->second[c];
+      if (messages[c]) per_camera[c] = &*messages[c];
     ++exposure_stats_.processed;
     if (missing) ++exposure_stats_.incomplete;
     if (!ready) ++exposure_stats_.overflowed;
     processed_utime_ = utime;
     out.push_back(process(utime, per_camera));
-    pending_.erase(oldest);
   }
   return out;
 }
