@@ -140,7 +140,23 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
     throw std::invalid_argument(fmt::format("detections_t.camera_id = {}: not a camera of the rig {} (cameras.rig: {})",
                                             d.camera_id, options_.cameras.rig, ids));
   }
+  // A resync of another input (the own pose) makes the clock forget a camera whose times lie far after it: time went
+  // back for everyone (a restarted source). The exposures and tracks of the old times go, as after a resync.
+  const bool forgotten = cameras_[i].last_utime >= 0 && !clock_.previous(camera_inputs_[i]).has_value();
   admit(cameras_[i], camera_inputs_[i], d);
+  if (forgotten && d.utime <= processed_utime_) {
+    tracker_ = Tracker(options_.tracker);
+    previous_detections_utime_ = -1;
+    pending_.clear();
+    processed_utime_ = -1;
+    first_utime_ = -1;
+    for (LocalizerCamera& other : cameras_)
+      if (&other != &cameras_[i]) other.last_utime = -1;
+    notes_.push_back(fmt::format(
+        "detections_t.utime = {}: camera {}'s time went back with a resync of another input; the tracker restarts "
+        "(new track ids), the waiting exposures are dropped",
+        d.utime, d.camera_id));
+  }
   if (first_utime_ < 0) first_utime_ = d.utime;
   if (d.utime <= processed_utime_) {  // a sign of life all the same (admit() counted it)
     ++exposure_stats_.late;

@@ -337,6 +337,43 @@ TEST(LocalizerRig, ALateMessageIsDroppedNamingItsCameraAndThePendingExposuresAre
   EXPECT_EQ(loc.exposure_stats().late, 1);
 }
 
+TEST(LocalizerRig, WhenTimeGoesBackForEveryInputTheRigRestartsWithinTheResyncTime) {
+  // A restarted source: own poses and every camera jump 100 s back. Refused (out of order) for time.resync_after_s of
+  // their own time, then the own pose re-anchors the clock, and the rig starts again: new tracks, one per exposure.
+  const RigScene scene(surround4());
+  Localizer loc(rig_options(scene.rig.source), scene.rig);
+  const Eigen::Vector3d p(9.0, 1.0, 0.5);
+  const int64_t back = kT0 - 100000000;
+  int refused = 0;
+  std::vector<LocalizerOutput> outputs;
+  for (int k = 0; k < 120; ++k) {
+    const int64_t t = k < 30 ? kT0 + kFrameUs * k : back + kFrameUs * k;
+    try {
+      loc.on_own_pose(own_pose(t));
+    } catch (const std::invalid_argument&) {
+      ++refused;
+    }
+    for (size_t i = 0; i < 4; ++i) {
+      try {
+        for (LocalizerOutput& o : loc.add_detections(scene.detections(i, t, {p}))) outputs.push_back(std::move(o));
+      } catch (const std::invalid_argument&) {
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0);
+  ASSERT_GT(outputs.size(), 60u);
+  EXPECT_EQ(outputs.back().utime, back + kFrameUs * 119) << "one output per exposure again";
+  for (size_t k = outputs.size() - 40; k < outputs.size(); ++k) {
+    EXPECT_EQ(outputs[k].utime - outputs[k - 1].utime, kFrameUs);
+    ASSERT_EQ(outputs[k].targets->num_targets, 1) << k;
+    EXPECT_EQ(outputs[k].targets->targets[0].track_id, 1) << "a new tracker";
+  }
+  bool noted = false;
+  for (const std::string& n : loc.take_notes()) noted = noted || n.find("the tracker restarts") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
 TEST(LocalizerRig, AMessageOfACameraNotInTheRigOrOfAnotherSizeIsDroppedNamingTheField) {
   const RigScene scene(surround4());
   Localizer loc(rig_options(scene.rig.source), scene.rig);
