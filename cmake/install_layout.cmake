@@ -36,6 +36,9 @@ set(dest "$ENV{DESTDIR}")
 foreach(name camera_driver detector localizer follower_ctrl mavlink_bridge recorder)
   file(INSTALL "${WINGMAN_SOURCE_DIR}/config/${name}.yaml" DESTINATION "${confdir}")  # DESTDIR: added by file(INSTALL)
 endforeach()
+# The camera rigs (several cameras on one vehicle: the localizer's and the simulator's cameras.rig), unchanged.
+file(GLOB rigs "${WINGMAN_SOURCE_DIR}/config/rigs/*.yaml")
+file(INSTALL ${rigs} DESTINATION "${confdir}/rigs")
 
 # The shipped files with the prefix's paths (cmake/wingman_render.cmake, also tools/supervise.sh's renderer).
 include("${CMAKE_CURRENT_LIST_DIR}/wingman_render.cmake")

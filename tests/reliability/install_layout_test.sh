@@ -41,6 +41,10 @@ check_prefix() {  # check_prefix PREFIX CONFDIR
     cmp -s "$src/config/$cfg.yaml" "$dest$confdir/$cfg.yaml" ||
       fail "$prefix: $confdir/$cfg.yaml is not the shipped config/$cfg.yaml"
   done
+  for rig in "$src"/config/rigs/*.yaml; do
+    cmp -s "$rig" "$dest$confdir/rigs/$(basename "$rig")" ||
+      fail "$prefix: $confdir/rigs/$(basename "$rig") is not the shipped config/rigs/$(basename "$rig")"
+  done
   # `wingman train` starts the wingman-train installed beside wingman (tools/src/forwarded_verbs.cpp).
   local train_help
   if [ ! -x "$dest$prefix/bin/wingman-train" ]; then
