@@ -10,7 +10,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -106,6 +108,30 @@ std::string encode_mjpeg(const Frame& raw, int quality, Frame& jpeg) {
   return "";
 }
 
+void downscale_frame(const Frame& raw, int max_width, Frame& small) {
+  auto* pixels = const_cast<uint8_t*>(raw.data.data());
+  const auto stride = static_cast<size_t>(raw.stride);
+  cv::Mat img;
+  if (raw.format == PixelFormat::kGray8) {
+    img = cv::Mat(raw.height, raw.width, CV_8UC1, pixels, stride);
+  } else if (raw.format == PixelFormat::kBgr8) {
+    img = cv::Mat(raw.height, raw.width, CV_8UC3, pixels, stride);
+  } else {  // YUYV
+    cv::cvtColor(cv::Mat(raw.height, raw.width, CV_8UC2, pixels, stride), img, cv::COLOR_YUV2BGR_YUYV);
+  }
+  const int height =
+      std::max(1, static_cast<int>(std::lround(static_cast<double>(raw.height) * max_width / raw.width)));
+  small.format = img.channels() == 1 ? PixelFormat::kGray8 : PixelFormat::kBgr8;
+  small.width = max_width;
+  small.height = height;
+  small.stride = max_width * img.channels();
+  small.data.resize(static_cast<size_t>(small.stride) * static_cast<size_t>(height));
+  cv::Mat dst(height, max_width, img.type(), small.data.data(), static_cast<size_t>(small.stride));
+  cv::resize(img, dst, dst.size(), 0, 0, cv::INTER_AREA);
+  small.utime = raw.utime;
+  small.seq = raw.seq;
+}
+
 std::unique_ptr<FrameSource> make_source(const CameraDriverOptions& options, std::shared_ptr<V4l2Io> io,
                                          std::shared_ptr<Clock> clock) {
   const auto problems = options.validate();
@@ -146,8 +172,13 @@ DriverStep CameraDriver::step(int timeout_ms) {
   if (options_.decode_mjpeg && frame_.format == PixelFormat::kMjpeg) {
     if (std::string bad = decode_mjpeg(frame_, decoded_); !bad.empty()) return drop(source_->describe() + ": " + bad);
     out = &decoded_;
-  } else if (options_.encoding == "mjpeg" && frame_.format != PixelFormat::kMjpeg) {
-    if (std::string bad = encode_mjpeg(frame_, options_.jpeg_quality, encoded_); !bad.empty())
+  }
+  if (options_.max_width > 0 && out->format != PixelFormat::kMjpeg && out->width > options_.max_width) {
+    downscale_frame(*out, options_.max_width, scaled_);
+    out = &scaled_;
+  }
+  if (options_.encoding == "mjpeg" && out->format != PixelFormat::kMjpeg) {
+    if (std::string bad = encode_mjpeg(*out, options_.jpeg_quality, encoded_); !bad.empty())
       return drop(source_->describe() + ": " + bad);
     out = &encoded_;
   }

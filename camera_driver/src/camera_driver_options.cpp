@@ -19,6 +19,8 @@ std::vector<std::string> OutputOptions::validate() const {
     p.push_back(problem("output.encoding", encoding, "must be raw or mjpeg"));
   if (jpeg_quality < 1 || jpeg_quality > 100)
     p.push_back(problem("output.jpeg_quality", jpeg_quality, "must be in 1..100"));
+  if (max_width != 0 && (max_width < 16 || max_width > 8192))
+    p.push_back(problem("output.max_width", max_width, "must be 0 (as captured) or in 16..8192"));
   if (encoding == "mjpeg" && decode_mjpeg) {
     p.push_back(problem("output.decode_mjpeg", "true",
                         "contradicts output.encoding = mjpeg (MJPEG camera frames would be decoded, then encoded "

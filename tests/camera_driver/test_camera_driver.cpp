@@ -166,23 +166,6 @@ TEST(CameraDriver, DecodeMjpegPublishesBgr8AndDropsCorruptStreams) {
   EXPECT_EQ(rig.driver->frames_out(), 1);
 }
 
-/// A camera-like test image, fixed seed: seeded random colours at 1/16 of the size, upscaled smoothly (textures and
-/// gradients), with dark sharp-edged boxes (targets against the sky) on top.
-cv::Mat seeded_scene(int width, int height, uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat coarse(std::max(2, height / 16), std::max(2, width / 16), CV_8UC3);
-  rng.fill(coarse, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat scene;
-  cv::resize(coarse, scene, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
-  for (int i = 0; i < 6; ++i) {
-    const int w = rng.uniform(8, std::max(9, width / 8));
-    const int h = rng.uniform(6, std::max(7, height / 8));
-    const cv::Rect box(rng.uniform(0, width - w), rng.uniform(0, height - h), w, h);
-    cv::rectangle(scene, box, cv::Scalar(rng.uniform(0, 60), rng.uniform(0, 60), rng.uniform(0, 60)), cv::FILLED);
-  }
-  return scene;
-}
-
 /// `img` as a frame of `format` (BGR8 or GRAY8) with `padding` bytes at the end of every row.
 Frame frame_of(const cv::Mat& img, PixelFormat format, int padding, int64_t seq) {
   Frame f;
@@ -222,7 +205,7 @@ TEST(CameraDriver, MjpegEncodingDecodesInTheDetectorToTheSameSizeAndClosePixels)
   };
   for (const Case c : {Case{1280, 720, 0}, Case{333, 187, 7}}) {
     SCOPED_TRACE(::testing::Message() << c.width << "x" << c.height << " BGR8, " << c.padding << " bytes of padding");
-    const cv::Mat scene = seeded_scene(c.width, c.height, 31);
+    const cv::Mat scene = testing::seeded_scene(c.width, c.height, 31);
     const DriverStep step = encode_through_driver(frame_of(scene, PixelFormat::kBgr8, c.padding, 7), 90);
     ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
     EXPECT_EQ(step.image.pixel_format, int8_t{wingman::image_t::MJPEG});
@@ -254,7 +237,7 @@ TEST(CameraDriver, MjpegEncodingDecodesInTheDetectorToTheSameSizeAndClosePixels)
 // edges per pixel than the 720p one: measured mean |difference| 0.5 (GRAY8) and 3.1 (YUYV, whose subsampled chroma
 // JPEG subsamples again) levels; bound 4.5.
 TEST(CameraDriver, MjpegEncodingTakesGrayAndYuyvFrames) {
-  const cv::Mat scene = seeded_scene(320, 240, 32);
+  const cv::Mat scene = testing::seeded_scene(320, 240, 32);
   cv::Mat gray;
   cv::cvtColor(scene, gray, cv::COLOR_BGR2GRAY);
   DriverStep step = encode_through_driver(frame_of(gray, PixelFormat::kGray8, 3, 1), 90);
@@ -300,6 +283,39 @@ TEST(CameraDriver, MjpegEncodingTakesGrayAndYuyvFrames) {
   EXPECT_LE(yuyv_mean_abs, 4.5);
   std::printf("[ measured ] 320x240 q90: mean |difference| GRAY8 %.2f, YUYV %.2f levels\n", gray_mean_abs,
               yuyv_mean_abs);
+}
+
+TEST(CameraDriver, MaxWidthDownscalesRawFramesKeepingTheAspectBeforeEncoding) {
+  const cv::Mat scene = testing::seeded_scene(1280, 720, 33);
+  auto src = std::make_unique<ScriptedSource>();
+  src->items.push_back({ReadResult{ReadStatus::kFrame, 0, "", false}, frame_of(scene, PixelFormat::kBgr8, 4, 1)});
+  src->items.push_back({ReadResult{ReadStatus::kFrame, 0, "", false}, frame_of(scene, PixelFormat::kBgr8, 0, 2)});
+  OutputOptions out;
+  out.max_width = 640;
+  CameraDriver raw_driver(out, std::move(src));
+  DriverStep step = raw_driver.step(0);
+  ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+  EXPECT_EQ(step.image.pixel_format, int8_t{wingman::image_t::BGR8});
+  EXPECT_EQ(step.image.width, 640);
+  EXPECT_EQ(step.image.height, 360);
+  EXPECT_EQ(step.image.stride, 640 * 3);
+  EXPECT_EQ(step.image.seq, 1);
+  cv::Mat expected;
+  cv::resize(scene, expected, cv::Size(640, 360), 0, 0, cv::INTER_AREA);
+  std::string error;
+  EXPECT_EQ(cv::norm(detector::image_to_bgr(step.image, &error), expected, cv::NORM_INF), 0.0) << error;
+
+  Frame small = frame_of(scene, PixelFormat::kBgr8, 0, 3);
+  auto src2 = std::make_unique<ScriptedSource>();
+  src2->items.push_back({ReadResult{ReadStatus::kFrame, 0, "", false}, small});
+  out.encoding = "mjpeg";
+  CameraDriver jpeg_driver(out, std::move(src2));
+  step = jpeg_driver.step(0);
+  ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+  EXPECT_EQ(step.image.pixel_format, int8_t{wingman::image_t::MJPEG});
+  const cv::Mat decoded = detector::image_to_bgr(step.image, &error);
+  ASSERT_EQ(decoded.size(), cv::Size(640, 360)) << error;
+  EXPECT_LE(cv::norm(decoded, expected, cv::NORM_L1) / static_cast<double>(expected.total() * 3), 4.5);
 }
 
 TEST(CameraDriver, MjpegEncodingPassesAnMjpegCamerasStreamThroughUntouched) {

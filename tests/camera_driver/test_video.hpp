@@ -5,8 +5,11 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <algorithm>
+#include <cstdint>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -37,6 +40,23 @@ inline cv::Mat pattern_image(int width, int height, int seed) {
     }
   }
   return img;
+}
+
+/// A camera-like test image, fixed seed: seeded random colours at 1/16 of the size, upscaled smoothly (textures and
+/// gradients), with dark sharp-edged boxes (targets against the sky) on top.
+inline cv::Mat seeded_scene(int width, int height, uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat coarse(std::max(2, height / 16), std::max(2, width / 16), CV_8UC3);
+  rng.fill(coarse, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat scene;
+  cv::resize(coarse, scene, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
+  for (int i = 0; i < 6; ++i) {
+    const int w = rng.uniform(8, std::max(9, width / 8));
+    const int h = rng.uniform(6, std::max(7, height / 8));
+    const cv::Rect box(rng.uniform(0, width - w), rng.uniform(0, height - h), w, h);
+    cv::rectangle(scene, box, cv::Scalar(rng.uniform(0, 60), rng.uniform(0, 60), rng.uniform(0, 60)), cv::FILLED);
+  }
+  return scene;
 }
 
 /// Writes `text` to `path` (garbage "media" for error tests).

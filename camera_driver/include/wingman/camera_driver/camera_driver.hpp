@@ -46,6 +46,11 @@ std::string decode_mjpeg(const Frame& jpeg, Frame& bgr);
 /// could not. Precondition: check_frame(raw) is "" and raw.format is not MJPEG.
 std::string encode_mjpeg(const Frame& raw, int quality, Frame& jpeg);
 
+/// Downscales a raw frame to `max_width` pixels wide (cv::INTER_AREA, aspect kept, height at least 1): GRAY8 stays
+/// GRAY8, BGR8 and YUYV become BGR8, rows unpadded; same utime and seq: output.max_width. Precondition:
+/// check_frame(raw) is "", raw.format is not MJPEG and raw.width > max_width > 0.
+void downscale_frame(const Frame& raw, int max_width, Frame& small);
+
 /// Builds the source options.source_kind selects (not opened). `io` is used for v4l2 only.
 /// Throws std::invalid_argument naming the key when the options are invalid.
 std::unique_ptr<FrameSource> make_source(const CameraDriverOptions& options, std::shared_ptr<V4l2Io> io,
@@ -77,6 +82,7 @@ class CameraDriver {
   std::unique_ptr<FrameSource> source_;
   Frame frame_;    // the source fills it; its data moves into the published message
   Frame decoded_;  // MJPEG decoded to BGR8 (output.decode_mjpeg)
+  Frame scaled_;   // a raw frame downscaled (output.max_width)
   Frame encoded_;  // a raw frame JPEG-encoded (output.encoding mjpeg)
   int64_t frames_out_ = 0;
   int64_t driver_drops_ = 0;

@@ -28,6 +28,10 @@ struct OutputOptions {
   std::string encoding = "raw";
   /// JPEG quality of output.encoding mjpeg, 1..100 (OpenCV's IMWRITE_JPEG_QUALITY).
   int jpeg_quality = 90;
+  /// Raw frames wider than this are downscaled to it before publishing (cv::INTER_AREA, aspect kept; YUYV becomes
+  /// BGR8), pixels; 0 = as captured. A V4L2 MJPEG camera's stream is not downscaled unless decode_mjpeg. Consumers
+  /// with a calibration of the full size need it scaled (the localizer's camera.scale_to_image).
+  int max_width = 0;
   /// Stop after publishing this many frames (exit 0); 0 = no limit.
   int64_t max_frames = 0;
 
@@ -80,6 +84,8 @@ struct CameraDriverOptions {
       "pixels on the bus: raw (as the source gives them) or mjpeg (raw frames JPEG-encoded; MJPEG cameras pass "
       "through)");
     v("output.jpeg_quality", output.jpeg_quality, "JPEG quality of output.encoding mjpeg, 1..100");
+    v("output.max_width", output.max_width,
+      "raw frames wider than this are downscaled to it (aspect kept; YUYV becomes BGR8), pixels; 0 = as captured");
     v("output.max_frames", output.max_frames, "exit 0 after publishing this many frames; 0 = no limit");
     preview.visit(v);
   }
