@@ -81,6 +81,11 @@ def decode_image(data):
     return {"utime": m.utime, "seq": m.seq, "camera_id": m.camera_id}
 
 
+def decode_targets(data):
+    m = wingman.targets_t.decode(data)
+    return {"utime": m.utime, "n": m.num_targets}
+
+
 def pct(values, p):
     """Nearest-rank percentile, None for no values."""
     if not values:
@@ -197,12 +202,15 @@ def realtime(a):
                             "(lost on the bus)")
     lost_total = sum(c["lost_in_transport"] for c in result["cameras"])
     result["lost_in_transport"] = lost_total
+    detections_lost = fused(a, st, failures, result)
     if a.udp_rcvbuf_errors is not None:
         result["udp_rcvbuf_errors"] = a.udp_rcvbuf_errors
-        print(f"load: {lost_total} frames lost on the bus in all; the kernel dropped {a.udp_rcvbuf_errors} datagrams "
-              "on full socket receive buffers in this namespace (every socket on the bus receives every image)")
-        if lost_total > 0 and a.udp_rcvbuf_errors == 0:
-            failures.append(f"{lost_total} frames lost on the bus without any kernel receive-buffer drop")
+        print(f"load: {lost_total} frames and {detections_lost} detections_t or targets_t lost on the bus in all; the "
+              f"kernel dropped {a.udp_rcvbuf_errors} datagrams on full socket receive buffers in this namespace (every "
+              "socket on the bus receives every image)")
+        if lost_total + detections_lost > 0 and a.udp_rcvbuf_errors == 0:
+            failures.append(f"{lost_total} frames and {detections_lost} detections_t or targets_t lost on the bus "
+                            "without any kernel receive-buffer drop")
     # Latencies, overall and per half of the run (by arrival time).
     e2e = [s[2] for s in series]
     inf = [s[3] for s in series]
@@ -252,6 +260,77 @@ def realtime(a):
         note = "  (the detection's time, on its worker thread)" if p.startswith("detector") else ""
         print(f"  {p:16s} p50 {last['p50']:8.2f} ms  p99 {last['p99']:8.2f} ms  CPU {c:>4} %{note}")
     return finish(a, result, failures)
+
+
+def fused(a, st, failures, result):
+    """The one localizer fusing every camera (cameras.rig) and the follower on its one TARGETS stream: every
+    detections_t a detector published reaches the localizer or is lost on the bus (under 20 %, explained by the
+    kernel's receive-buffer drops, as the images); the localizer publishes at most one targets_t per detections_t it
+    received (one per exposure; an exposure is one or more cameras' detections_t), the rest being exposures it
+    processed without a late camera's message or still waiting at the stop (reported: its channel drops also count
+    the boxes it could not localize, so they do not split that rest); the targets go out on TARGETS alone (no
+    per-camera targets channel) and reach the follower. Returns the detections_t and targets_t lost on the bus."""
+    loc = st.get("localizer")
+    targets_logged = {}
+    fused_latency = []
+    for recv, ch, data in read_log(a.log, lambda c: c.startswith("TARGETS")):
+        t = decode_targets(data)
+        targets_logged.setdefault(ch, []).append(t)
+        fused_latency.append((recv - t["utime"]) / 1e6)
+    result["targets_channels"] = sorted(targets_logged)
+    if sorted(targets_logged) != ["TARGETS"]:
+        failures.append(f"targets channels in the log: {sorted(targets_logged) or 'none'}; expected one fused stream, "
+                        "TARGETS")
+    if not loc:
+        failures.append("no status from localizer (the one fusing localizer)")
+        return 0
+    last = loc[-1]
+    final = last["state"] == STATE_STOPPING
+    if not final:
+        failures.append("localizer published no final STOPPING status")
+    print("load: the fusing localizer (cameras.rig), per camera: detections_t published by the detector / received by "
+          "the localizer / lost on the bus")
+    received_total, lost_total = 0, 0
+    result["localizer"] = {"cameras": []}
+    for i in range(a.cameras):
+        det = st.get(f"detector_{i}")
+        ch = f"DETECTIONS_CAM{i}"
+        published = det[-1]["channels"].get((ch, "out"), {}).get("count", 0) if det else 0
+        received = last["channels"].get((ch, "in"), {}).get("count", 0)
+        lost = published - received
+        received_total += received
+        lost_total += max(0, lost)
+        print(f"  camera {i}: {published:6d} {received:6d} {lost:6d}")
+        result["localizer"]["cameras"].append({"camera": i, "published": published, "received": received,
+                                               "lost_in_transport": lost})
+        if received == 0:
+            failures.append(f"camera {i}: the localizer heard no {ch}")
+        if lost < 0 or lost > max(2, 0.20 * published):
+            failures.append(f"camera {i}: {lost} of {published} {ch} never reached the localizer (lost on the bus)")
+    targets = last["channels"].get(("TARGETS", "out"), {}).get("count", 0)
+    logged = len(targets_logged.get("TARGETS", []))
+    fol = st.get("follower_ctrl")
+    followed = fol[-1]["channels"].get(("TARGETS", "in"), {}).get("count", 0) if fol else 0
+    print(f"load: the localizer fused {received_total} detections_t into {targets} targets_t on TARGETS ({logged} in "
+          f"the log; {received_total - targets} detections_t went into no targets_t of their own: late for their "
+          f"exposure, or waiting at the stop); the follower received {followed}")
+    print(f"  localizer detail: {(loc[-2] if len(loc) > 1 else last)['detail']}")
+    result["localizer"] |= {"received": received_total, "targets": targets, "targets_logged": logged,
+                            "follower_received": followed, "final_status": final}
+    if fused_latency:
+        q = {p: pct(fused_latency, p) for p in (50, 99)}
+        result["targets_latency_s"] = q
+        print(f"load: fused latency = arrival of TARGETS at lcm-logger minus targets_t.utime (its exposure's capture "
+              f"time): p50 {q[50] * 1e3:.0f} ms, p99 {q[99] * 1e3:.0f} ms")
+    if targets == 0:
+        failures.append("the localizer published no targets_t on TARGETS")
+    if targets > received_total:
+        failures.append(f"the localizer published {targets} targets_t for {received_total} detections_t received: "
+                        "more fused outputs than inputs")
+    followed_lost = targets - followed
+    if followed == 0 or followed_lost < 0 or followed_lost > max(2, 0.20 * targets):
+        failures.append(f"the follower received {followed} of the {targets} targets_t on TARGETS")
+    return lost_total + max(0, followed_lost)
 
 
 def replay(a):

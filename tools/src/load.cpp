@@ -21,6 +21,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 namespace wingman::tools {
 
@@ -34,10 +35,6 @@ using Clock = std::chrono::steady_clock;
 constexpr double kGraceS = 10.0;                    // seconds a process gets to end after SIGTERM before it is killed
 constexpr double kStartTimeoutS = 180.0;            // every process's first heartbeat (each detector loads the model)
 const char* kFixedStartUtime = "1700000000000000";  // fast cameras: frames stamped from here (deterministic)
-
-/// Camera i looks along body x yawed by 90 degrees * i (FLU): camera optical frame -> body, row-major.
-const char* const kExtrinsics[4] = {"0, 0, 1, -1, 0, 0, 0, -1, 0", "1, 0, 0, 0, 0, 1, 0, -1, 0",
-                                    "0, 0, -1, 1, 0, 0, 0, -1, 0", "-1, 0, 0, 0, 0, -1, 0, -1, 0"};
 
 void append(std::vector<std::string>& to, const std::vector<std::string>& more) {
   to.insert(to.end(), more.begin(), more.end());
@@ -105,6 +102,12 @@ std::vector<std::string> LoadOptions::validate() const {
   if (!(warmup_s >= 0.0)) p.push_back(problem("load.warmup_s", warmup_s, "must be >= 0 seconds"));
   if (!(sample_period_s > 0.0)) p.push_back(problem("load.sample_period_s", sample_period_s, "must be > 0 seconds"));
   if (replay_frames < 1) p.push_back(problem("load.replay_frames", replay_frames, "must be at least 1"));
+  if (encoding != "raw" && encoding != "mjpeg") p.push_back(problem("load.encoding", encoding, "must be raw or mjpeg"));
+  if (jpeg_quality < 1 || jpeg_quality > 100)
+    p.push_back(problem("load.jpeg_quality", jpeg_quality, "must be in 1..100"));
+  if (max_width != 0 && (max_width < 16 || max_width > 1280))
+    p.push_back(problem("load.max_width", max_width, "must be 0 (1280, full size) or in 16..1280"));
+  if (rig.empty()) p.push_back(problem("load.rig", rig, "must name a camera rig file (config/rigs/surround4.yaml)"));
   if (!(max_p99_s > 0.0)) p.push_back(problem("checks.max_p99_s", max_p99_s, "must be > 0 seconds"));
   if (!(max_rss_growth_pct >= 0.0))
     p.push_back(problem("checks.max_rss_growth_pct", max_rss_growth_pct, "must be a percentage >= 0"));
@@ -116,7 +119,7 @@ std::vector<std::string> LoadOptions::validate() const {
 }
 
 std::vector<std::string> load_process_sets(const std::string& exe, int camera, const std::string& clip, bool realtime,
-                                           int max_frames, bool detector_realtime) {
+                                           int max_frames, bool detector_realtime, const LoadOptions& o) {
   if (exe == "wingman-detector") {
     return {"--set",
             fmt::format("input={{channel: IMAGE_CAM{}, mode: {}}}", camera, detector_realtime ? "realtime" : "replay"),
@@ -125,18 +128,17 @@ std::vector<std::string> load_process_sets(const std::string& exe, int camera, c
             "--set",
             "model={cfg: \"builtin:wingman-small\", weights: \"builtin:wingman-small\"}"};
   }
-  if (exe == "wingman-localizer") {  // one camera id per localizer, with its camera's extrinsics
-    return {"--set", fmt::format("input.detections_channel=DETECTIONS_CAM{}", camera),
-            "--set", fmt::format("output.channel=TARGETS_CAM{}", camera),
-            "--set", fmt::format("camera.camera_id={}", camera),
-            "--set", fmt::format("extrinsics.R_cam_to_body=[{}]", kExtrinsics[camera])};
+  if (exe == "wingman-localizer") {  // one localizer fuses every camera of the rig (DETECTIONS_CAM<n>) on TARGETS
+    return {"--set", fmt::format("cameras.rig=\"{}\"", fs::absolute(o.rig).string()), "--set", "output.channel=TARGETS",
+            "--set", fmt::format("camera.scale_to_image={}", o.max_width > 0)};
   }
   if (exe == "wingman-camera-driver") {  // the clip in a loop at 30 fps
     std::vector<std::string> sets = {
         "--set",
         "source.kind=file",
         "--set",
-        fmt::format("output={{channel: IMAGE_CAM{}, camera_id: {}}}", camera, camera),
+        fmt::format("output={{channel: IMAGE_CAM{}, camera_id: {}, encoding: {}, jpeg_quality: {}, max_width: {}}}",
+                    camera, camera, o.encoding, o.jpeg_quality, o.max_width),
         "--set",
         fmt::format("file={{path: \"{}\", mode: {}, fps: 30.0, loop: true}}", clip, realtime ? "realtime" : "fast")};
     // fast: the replay log's frames, stamped from a fixed start time (deterministic); realtime: by the wall clock.
@@ -146,8 +148,8 @@ std::vector<std::string> load_process_sets(const std::string& exe, int camera, c
     }
     return sets;
   }
-  if (exe == "wingman-follower-ctrl") {  // it follows camera 0's targets (it reads one targets channel)
-    return {"--set", "input={targets_channel: TARGETS_CAM0, detections_channel: DETECTIONS_CAM0}"};
+  if (exe == "wingman-follower-ctrl") {  // it follows the fused targets
+    return {"--set", "input={targets_channel: TARGETS, detections_channel: DETECTIONS_CAM0}"};
   }
   throw std::invalid_argument("load_process_sets: no load settings for " + exe);
 }
@@ -202,28 +204,20 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
 
   // Every process's merged configuration, as its loader read it (a record of the run).
   const bool fast_cameras = replay;
+  std::vector<std::tuple<std::string, int, std::string>> printed;  // (executable, camera, file)
   for (int i = 0; i < o.cameras; ++i) {
-    for (const auto& [name, file] : std::vector<std::pair<std::string, std::string>>{
-             {"wingman-detector", fmt::format("detector_{}.yaml", i)},
-             {"wingman-localizer", fmt::format("localizer_{}.yaml", i)},
-             {"wingman-camera-driver", fmt::format("camera_{}.yaml", i)}}) {
-      launcher::ProcessSpec print = process(name, {exe(name)});
-      append(print.argv, load_process_sets(name, i, clip, !fast_cameras, o.replay_frames, !replay));
-      print.argv.push_back("--print-config");
-      print.stdout_path = (out_dir / file).string();
-      if (group.run(print) != 0) {
-        err << "load_test: FAILED: " << name << " rejects its settings (above)" << std::endl;
-        return 1;
-      }
-    }
+    printed.emplace_back("wingman-detector", i, fmt::format("detector_{}.yaml", i));
+    printed.emplace_back("wingman-camera-driver", i, fmt::format("camera_{}.yaml", i));
   }
-  {
-    launcher::ProcessSpec print = process("wingman-follower-ctrl", {exe("wingman-follower-ctrl")});
-    append(print.argv, load_process_sets("wingman-follower-ctrl", 0, clip, true, 0, true));
+  printed.emplace_back("wingman-localizer", 0, "localizer.yaml");  // checks the rig file too
+  printed.emplace_back("wingman-follower-ctrl", 0, "follower_ctrl.yaml");
+  for (const auto& [name, i, file] : printed) {
+    launcher::ProcessSpec print = process(name, {exe(name)});
+    append(print.argv, load_process_sets(name, i, clip, !fast_cameras, o.replay_frames, !replay, o));
     print.argv.push_back("--print-config");
-    print.stdout_path = (out_dir / "follower_ctrl.yaml").string();
+    print.stdout_path = (out_dir / file).string();
     if (group.run(print) != 0) {
-      err << "load_test: FAILED: wingman-follower-ctrl rejects its settings (above)" << std::endl;
+      err << "load_test: FAILED: " << name << " rejects its settings (above)" << std::endl;
       return 1;
     }
   }
@@ -239,7 +233,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
     for (int i = 0; i < o.cameras; ++i) {
       launcher::ProcessSpec cam =
           process(fmt::format("camera_{}", i), {exe("wingman-camera-driver"), "--name", fmt::format("camera_{}", i)});
-      append(cam.argv, load_process_sets("wingman-camera-driver", i, clip, false, o.replay_frames, false));
+      append(cam.argv, load_process_sets("wingman-camera-driver", i, clip, false, o.replay_frames, false, o));
       append(cam.argv,
              {"--log-level", "warn", "--lcm-out", fmt::format("file://{}?mode={}", images, i == 0 ? "w" : "a")});
       if (const int rc = group.run(cam); rc != 0) {
@@ -249,9 +243,11 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
     }
     const auto mib = static_cast<int64_t>(std::ceil(static_cast<double>(fs::file_size(images)) / (1024.0 * 1024.0)));
     out << fmt::format(
-               "load_test: replay: {} cameras x {} frames of 1280x720 BGR in {} ({} MiB); {} detectors read it "
+               "load_test: replay: {} cameras x {} frames of 1280x720 {} in {} ({} MiB); {} detectors read it "
                "file to file, in parallel",
-               o.cameras, o.replay_frames, images, mib, o.cameras)
+               o.cameras, o.replay_frames,
+               o.encoding == "mjpeg" ? fmt::format("MJPEG (quality {})", o.jpeg_quality) : std::string("BGR8"), images,
+               mib, o.cameras)
         << std::endl;
     const auto t0 = Clock::now();
     std::vector<size_t> detectors;
@@ -260,7 +256,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
       detection_logs.push_back((out_dir / fmt::format("detections_{}.lcmlog", i)).string());
       launcher::ProcessSpec det =
           process(fmt::format("detector_{}", i), {exe("wingman-detector"), "--name", fmt::format("detector_{}", i)});
-      append(det.argv, load_process_sets("wingman-detector", i, clip, false, 0, false));
+      append(det.argv, load_process_sets("wingman-detector", i, clip, false, 0, false, o));
       append(det.argv, {"--log-level", "warn", "--lcm-in", fmt::format("file://{}?speed=0", images), "--lcm-out",
                         fmt::format("file://{}?mode=w", detection_logs.back())});
       detectors.push_back(group.start(det));
@@ -287,9 +283,12 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   fs::remove(log, ec);
   fs::remove(proc_csv, ec);
   out << fmt::format(
-             "load_test: {} cameras x 1280x720 x 30 fps for {} s on {} (private network namespace), output in "
-             "{}",
-             o.cameras, duration_s, url, out_dir.string())
+             "load_test: {} cameras x 1280x720 x 30 fps ({} on the bus) for {} s on {} (private network namespace), "
+             "one localizer fusing the rig {}, output in {}",
+             o.cameras,
+             fmt::format("{}{}", o.encoding == "mjpeg" ? fmt::format("MJPEG, quality {}", o.jpeg_quality) : "raw BGR8",
+                         o.max_width > 0 ? fmt::format(", downscaled to {} px wide", o.max_width) : ""),
+             duration_s, url, fs::absolute(o.rig).string(), out_dir.string())
       << std::endl;
   const size_t logger = group.start(process("lcm-logger", {"lcm-logger", "--lcm-url=" + url, "--force", "--quiet",
                                                            "--channel=IMAGE_.*", "--invert-channels", log}));
@@ -306,12 +305,12 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   };
   for (int i = 0; i < o.cameras; ++i) {
     rest.push_back(start(fmt::format("detector_{}", i), "wingman-detector",
-                         load_process_sets("wingman-detector", i, clip, true, 0, true)));
-    rest.push_back(start(fmt::format("localizer_{}", i), "wingman-localizer",
-                         load_process_sets("wingman-localizer", i, clip, true, 0, true)));
+                         load_process_sets("wingman-detector", i, clip, true, 0, true, o)));
   }
+  rest.push_back(
+      start("localizer", "wingman-localizer", load_process_sets("wingman-localizer", 0, clip, true, 0, true, o)));
   rest.push_back(start("follower_ctrl", "wingman-follower-ctrl",
-                       load_process_sets("wingman-follower-ctrl", 0, clip, true, 0, true)));
+                       load_process_sets("wingman-follower-ctrl", 0, clip, true, 0, true, o)));
 
   int rc = 0;
   // Ends the run: the sources first, the detectors' frame in hand given time, then the rest (each publishes a final
@@ -354,7 +353,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   }
   for (int i = 0; i < o.cameras; ++i) {
     cams.push_back(start(fmt::format("camera_{}", i), "wingman-camera-driver",
-                         load_process_sets("wingman-camera-driver", i, clip, true, 0, true)));
+                         load_process_sets("wingman-camera-driver", i, clip, true, 0, true, o)));
   }
   out << "load_test: pipeline up; cameras playing" << std::endl;
   // Every process's RSS and CPU time from /proc into the CSV, every sample_period_s, until the end of the run.
