@@ -517,17 +517,22 @@ def surround(out, *flights):
                       "false_targets": r["false_targets"], "false_track_ids": r["false_track_ids"],
                       "leader_targets": len(rows), "truth_frames": r["truth_frames"],
                       "inference_p50_ms": r["inference_latency"]["p50_ms"], "detection_source": r["detection_source"]}
+        others = {v: x for v, x in r.get("ids_by_vehicle", {}).items() if v not in ("0", "1")}
+        data[name]["other_vehicles"] = others
+        others_txt = "; ".join(f"vehicle {v}: {x['track_ids']} / {x['id_switches']}" for v, x in sorted(others.items()))
         cams = ", ".join(f"{c}: {n}" for c, n in sorted(by_camera.items()))
         rms = f"{loc['rms_m']:.3f} m" if loc["n"] else "—"
         rows_out.append(f"| {name} | {100 * rate(r):.1f} % | {r['track_ids_on_leader']} | {r['leader_id_switches']} | "
                         f"{handovers} | {len(rows)} of {r['truth_frames']} ({cams}) | {rms} | "
-                        f"{los['rms_m']:.3f} m | {r['false_targets']} ({r['false_track_ids']} ids) |")
+                        f"{los['rms_m']:.3f} m | {r['false_targets']} ({r['false_track_ids']} ids) | "
+                        f"{others_txt or '—'} |")
     lines = ["| flight | leader detected | track ids on the leader | id switches | hand-overs | leader's targets "
-             "(by the camera of the last detection) | RMS 3-D | RMS along the line of sight | false targets |",
-             "|---|---|---|---|---|---|---|---|---|"] + rows_out + \
+             "(by the camera of the last detection) | RMS 3-D | RMS along the line of sight | false targets | "
+             "other drones: track ids / id switches |",
+             "|---|---|---|---|---|---|---|---|---|---|"] + rows_out + \
         ["", "Detected: frames where some camera boxes the leader (a box centred in its truth box of that camera). "
          "Hand-over: the leader's track's camera changes between two of its published targets. False targets: more "
-         "than 3 m from every vehicle."]
+         "than 3 m from every vehicle. The hand-overs, the targets by camera and the RMS are the leader's."]
     write(out, "surround", data, lines)
 
 
