@@ -521,13 +521,17 @@ def surround(out, *flights):
         data[name]["other_vehicles"] = others
         others_txt = "; ".join(f"vehicle {v}: {x['track_ids']} / {x['id_switches']}" for v, x in sorted(others.items()))
         cams = ", ".join(f"{c}: {n}" for c, n in sorted(by_camera.items()))
-        rms = f"{loc['rms_m']:.3f} m" if loc["n"] else "—"
+        errors = [float(row["error_m"]) for row in rows]
+        leader_rms = (sum(e * e for e in errors) / len(errors)) ** 0.5 if errors else None
+        data[name]["leader_rms_m"] = leader_rms
+        rms = f"{leader_rms:.3f} m" if leader_rms is not None else "—"
         rows_out.append(f"| {name} | {100 * rate(r):.1f} % | {r['track_ids_on_leader']} | {r['leader_id_switches']} | "
                         f"{handovers} | {len(rows)} of {r['truth_frames']} ({cams}) | {rms} | "
                         f"{los['rms_m']:.3f} m | {r['false_targets']} ({r['false_track_ids']} ids) | "
                         f"{others_txt or '—'} |")
     lines = ["| flight | leader detected | track ids on the leader | id switches | hand-overs | leader's targets "
-             "(by the camera of the last detection) | RMS 3-D | RMS along the line of sight | false targets | "
+             "(by the camera of the last detection) | leader's RMS 3-D | every drone's RMS along the line of sight | "
+             "false targets | "
              "other drones: track ids / id switches |",
              "|---|---|---|---|---|---|---|---|---|---|"] + rows_out + \
         ["", "Detected: frames where some camera boxes the leader (a box centred in its truth box of that camera). "
