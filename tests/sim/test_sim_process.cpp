@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
+#include <wingman/common/runtime.hpp>
 #include <wingman/detections_t.hpp>
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
@@ -17,6 +18,7 @@
 
 #include <csignal>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <thread>
 
@@ -452,6 +454,30 @@ TEST(SimProcess, ARigsCamerasArePublishedEachOnItsChannelWithItsIdAfterPoseAndTr
   }
 }
 
+/// Runs the simulator `sim` on `bus` against a fake process: publishes the fake's heartbeat as `name` (a process
+/// instance of sync.wait_for) until `started()` says the simulator has begun, handles the bus until the simulator
+/// exits (at most `limit`), then what is left on the bus. Returns its exit code (-1: still running at the limit).
+int run_against_fake(Child& sim, lcm::LCM& bus, const std::string& name, const std::function<bool()>& started,
+                     std::chrono::seconds limit) {
+  wingman::status_t hb{};
+  hb.process = name;
+  hb.state = wingman::status_t::STATE_OK;
+  const std::string channel = wingman::common::status_channel(name);
+  int exit_code = -1;
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (!started()) bus.publish(channel, &hb);
+    bus.handleTimeout(50);
+    if (!sim.running()) {
+      exit_code = sim.wait(1s);
+      break;
+    }
+  }
+  while (bus.handleTimeout(100) > 0) {
+  }
+  return exit_code;
+}
+
 TEST(SimProcess, ARigInLockstepPublishesEveryCamerasDetectionsThenWaitsOncePerFrame) {
   // The fake follower answers only the last camera's DETECTIONS_CAM3: a simulator that waited after each camera would
   // time out at camera 0 of every frame. Without images (render off), on the namespace's bus.
@@ -478,21 +504,8 @@ TEST(SimProcess, ARigInLockstepPublishesEveryCamerasDetectionsThenWaitsOncePerFr
   bus.subscribe("STATUS_SIM", &Fake::on_status, &fake);
   for (int i = 0; i < 4; ++i) bus.subscribe("DETECTIONS_CAM" + std::to_string(i), &Fake::on_detections, &fake);
   Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
-  wingman::status_t hb{};
-  hb.process = "fake_follower";
-  hb.state = wingman::status_t::STATE_OK;
-  int exit_code = -1;
-  const auto deadline = std::chrono::steady_clock::now() + 60s;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (fake.seen.empty()) bus.publish("STATUS_FAKE_FOLLOWER", &hb);  // until the simulator starts
-    bus.handleTimeout(50);
-    if (!sim.running()) {
-      exit_code = sim.wait(1s);
-      break;
-    }
-  }
-  while (bus.handleTimeout(100) > 0) {
-  }
+  const int exit_code = run_against_fake(
+      sim, bus, "fake_follower", [&] { return !fake.seen.empty(); }, 60s);
   ASSERT_EQ(exit_code, 0) << sim.err();
   EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
   // The status says how many cameras it renders.
@@ -550,21 +563,8 @@ TEST(SimProcess, ImageByImageSendsACamerasImageOnceTheCameraBeforeItHasItsDetect
   } fake{&bus, {}};
   for (int i = 0; i < 4; ++i) bus.subscribe("IMAGE_CAM" + std::to_string(i), &Fake::on_image, &fake);
   Child sim({bin_path("wingman-sim"), "--scenario", f.scenario, "--config", f.config, "--lcm-url", url});
-  wingman::status_t hb{};
-  hb.process = "fake_detector";
-  hb.state = wingman::status_t::STATE_OK;
-  int exit_code = -1;
-  const auto deadline = std::chrono::steady_clock::now() + 90s;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (fake.seen.empty()) bus.publish("STATUS_FAKE_DETECTOR", &hb);  // until the simulator starts
-    bus.handleTimeout(50);
-    if (!sim.running()) {
-      exit_code = sim.wait(1s);
-      break;
-    }
-  }
-  while (bus.handleTimeout(100) > 0) {
-  }
+  const int exit_code = run_against_fake(
+      sim, bus, "fake_detector", [&] { return !fake.seen.empty(); }, 90s);
   ASSERT_EQ(exit_code, 0) << sim.err();
   EXPECT_NE(sim.err().find("0 lockstep timeouts"), std::string::npos) << sim.err();
   EXPECT_NE(sim.err().find("image by image: 1 timeouts"), std::string::npos) << sim.err();
