@@ -74,8 +74,9 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   auto* ld = s_->load = app.add_subcommand(
       "load",
       "The four-camera load test (the thesis's 360-degree case) through the real processes on the LCM bus: camera N "
-      "plays a 1280x720 30-fps clip in a loop, detector N (the shipped model) and localizer N (camera N's extrinsics) "
-      "work on it, one follower follows camera 0; lcm-logger records all but the images; tools/load_summary.py "
+      "plays a 1280x720 30-fps clip in a loop (MJPEG on the bus by default: load.encoding), detector N (the shipped "
+      "model) works on it, one localizer fuses the cameras (load.rig), one follower follows its targets; lcm-logger "
+      "records all but the images; tools/load_summary.py "
       "computes the figures and checks. Run it in a private network namespace (tools/load_test.sh and tools/soak.sh "
       "do)");
   ld->add_option("--mode", l.mode,
