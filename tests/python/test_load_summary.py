@@ -21,6 +21,7 @@ failures = []
 T0 = 1767225600000000  # the first heartbeat, microseconds
 CAM = {0: dict(published=300, received=290, dropped=100, processed=198),  # 2 unaccounted, 10 lost on the bus
        1: dict(published=300, received=300, dropped=0, processed=299)}  # 1 unaccounted (the frame in hand)
+TARGETS_N = 400  # targets_t the fusing localizer published (of the 497 detections_t it heard)
 
 
 def check(ok, what):
@@ -64,11 +65,13 @@ def image(utime, seq, camera_id):
     return m.encode()
 
 
-def write_flight(path, final=True, seconds=20):
+def write_flight(path, final=True, seconds=20, per_camera_targets=False):
     """Two camera chains over `seconds` s: a heartbeat per process per second (counts growing linearly to CAM's,
     then STOPPING with the final counts unless final is False for camera 1), and the detections: detector i's k-th
     arrives at T0 + 0.5 s + k * (seconds - 1) / n s, 100 ms + (k % 10) ms after its image's utime (plus 100 ms in
-    the second half for camera 1), inference 20 + k % 5 ms. Other channels beside them (TARGETS, an image)."""
+    the second half for camera 1), inference 20 + k % 5 ms. The one localizer fusing them (it hears every
+    detections_t) publishes TARGETS_N targets_t, logged 50 ms after their exposure, which the follower all hears; an
+    image beside them."""
     events = []
     for i, c in CAM.items():
         n = c["processed"]
@@ -87,7 +90,23 @@ def write_flight(path, final=True, seconds=20):
             p99 = 40.0 + s  # grows: first vs last third differ
             events.append((u + 1, f"STATUS_camera_{i}", status(f"camera_{i}", u, state, cam_ch, 1.5, 3.0)))
             events.append((u + 2, f"STATUS_detector_{i}", status(f"detector_{i}", u, state, det_ch, 25.0 + i, p99)))
-    events.append((T0 + 3, "TARGETS", wingman.targets_t().encode()))
+    # The one localizer fusing the cameras (every detections_t heard) into TARGETS_N targets_t, and the follower on
+    # them; each targets_t is logged 50 ms after its exposure.
+    for s in range(seconds + 1):
+        f = 1.0 if s == seconds else s / seconds
+        state = 4 if s == seconds else 1
+        u = T0 + s * 1_000_000
+        loc_ch = [(f"DETECTIONS_CAM{i}", 0, round(c["processed"] * f), 0) for i, c in CAM.items()]
+        loc_ch.append(("TARGETS", 1, round(TARGETS_N * f), 0))
+        events.append((u + 3, "STATUS_localizer", status("localizer", u, state, loc_ch, 0.5, 1.0)))
+        events.append((u + 4, "STATUS_follower_ctrl",
+                       status("follower_ctrl", u, state, [("TARGETS", 0, round(TARGETS_N * f), 0)], 0.1, 0.2)))
+    for k in range(TARGETS_N):
+        t = wingman.targets_t()
+        t.utime = T0 + 500_000 + k * (seconds - 1) * 1_000_000 // TARGETS_N
+        events.append((t.utime + 50_000, "TARGETS", t.encode()))
+    if per_camera_targets:  # a localizer per camera, as before the rig: not one fused stream
+        events.append((T0 + 5, "TARGETS_CAM0", wingman.targets_t().encode()))
     events.append((T0 + 4, "IMAGE_CAM0", image(T0, 0, 0)))  # skipped by realtime (not a status or detections)
     events.sort(key=lambda e: e[0])
     with LogWriter(path) as log:
@@ -126,8 +145,13 @@ check(lines_with(r.stdout, "       1 ") == [
     "       1        300       300        299        0            1                  0      14.3     14.24",
     "       1    299      200      208      209      209   22/24"],
     "realtime: camera 1's accounting and latencies (+100 ms in the second half)")
-check("load: 10 frames lost on the bus in all; the kernel dropped 12 datagrams on full socket receive buffers "
-      "in this namespace (every socket on the bus receives every image)" in r.stdout, "realtime: the bus-loss line")
+check("load: 10 frames and 0 detections_t or targets_t lost on the bus in all; the kernel dropped 12 datagrams on "
+      "full socket receive buffers in this namespace (every socket on the bus receives every image)" in r.stdout,
+      "realtime: the bus-loss line")
+check("load: the localizer fused 497 detections_t into 400 targets_t on TARGETS (400 in the log; 97 detections_t went "
+      "into no targets_t of their own: late for their exposure, or waiting at the stop); the follower received 400"
+      in r.stdout and "fused latency = arrival of TARGETS at lcm-logger minus targets_t.utime (its exposure's capture "
+      "time): p50 50 ms, p99 50 ms" in r.stdout, "realtime: the fusing localizer's line and its latency")
 check("load: end-to-end p50/p99 first half 104/109 ms, second half 201/209 ms" in r.stdout,
       "realtime: end-to-end p50/p99 per half")
 check("  detector_0       p50    25.00 ms  p99    59.00 ms  CPU   90 %  (the detection's time, on its worker thread)"
@@ -149,10 +173,17 @@ r = run("realtime", bad, "--cameras", "2", "--udp-rcvbuf-errors", "0", "--max-p9
 print(r.stdout + r.stderr)
 check(r.returncode == 1 and lines_with(r.stdout, "load_summary: FAILED: ") == [
     "load_summary: FAILED: camera 1: camera_1 or detector_1 published no final STOPPING status",
-    "load_summary: FAILED: 10 frames lost on the bus without any kernel receive-buffer drop",
+    "load_summary: FAILED: 10 frames and 0 detections_t or targets_t lost on the bus without any kernel receive-buffer "
+    "drop",
     "load_summary: FAILED: end-to-end p99 0.21 s above the bound 0.15 s"],
     "realtime: failed checks are one line each, exit 1")
 check("  (no final STOPPING status)" in lines_with(r.stdout, "       1 ")[0], "realtime: the table marks it")
+per_camera = os.path.join(work, "per_camera_targets.lcmlog")
+write_flight(per_camera, per_camera_targets=True)
+r = run("realtime", per_camera, "--cameras", "2", "--udp-rcvbuf-errors", "12")
+check(r.returncode == 1 and lines_with(r.stdout, "load_summary: FAILED: ") == [
+    "load_summary: FAILED: targets channels in the log: ['TARGETS', 'TARGETS_CAM0']; expected one fused stream, "
+    "TARGETS"], "realtime: a targets channel beside the fused TARGETS fails, named")
 r = run("realtime", bad, "--cameras", "2", "--udp-rcvbuf-errors", "0", "--max-p99-s", "0.15", "--report-only")
 check(r.returncode == 1 and "load_summary: beyond the bound (reported only): end-to-end p99 0.21 s above the bound "
       "0.15 s" in r.stdout and len(lines_with(r.stdout, "load_summary: FAILED: ")) == 2,
