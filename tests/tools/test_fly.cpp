@@ -72,7 +72,7 @@ TEST(FlyPlan, TheDefaultFlightRunsTheShippedCnnOnRenderedImagesInLockstep) {
   const auto& sim = plan.sim.argv;
   EXPECT_EQ(value_of(sim, "--set", "sync="),
             "sync={mode: lockstep, timeout_s: 10.0, max_speed: 5.0, wait_for: [detector, localizer, follower_ctrl], "
-            "startup_timeout_s: 60.0, scripted_lockstep: false}");
+            "startup_timeout_s: 60.0, scripted_lockstep: false, image_by_image: false}");
   // The box noise's seed is the scenario's (formation_2d.yaml: seed 2).
   EXPECT_EQ(value_of(sim, "--set", "detections="),
             "detections={from_ground_truth: false, box: sphere, noise_px: 1.0, seed: 2}");
