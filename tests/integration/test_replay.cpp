@@ -133,10 +133,13 @@ std::vector<wingman::testing::LogEvent> lockstep_run(const TempDir& dir, const s
                                                                     "--lockstep", "--config", detector_cfg}));
   // The clip is 160x120: the localizer's built-in pinhole camera is told so. The test detector's boxes are the
   // square's own, not the shipped model's: ratio 1 (target.box_relation sphere). The 3-of-5 birth rule without a
-  // confidence bar: the track born at the square's jump (frame 21) is confirmed before the 24 frames end.
+  // confidence bar: the track born at the square's jump (frame 21) is confirmed before the 24 frames end. The blob
+  // stage's boxes are exact, and the square jumps to within 4 px of the left edge of the 160-px clip: a 1-px border
+  // margin (the default, 4 px, is for a CNN's boxes at 1280x720) keeps its left edge.
   const std::string localizer_cfg = dir.file("localizer.yaml");
   std::ofstream(localizer_cfg) << "camera: {width: 160, height: 120, focal_px: 100.0}\ntarget: {box_relation: sphere}\n"
-                                  "tracker: {birth_hits: 3, birth_window: 5, confirm_min_confidence: 0.0}\n";
+                                  "tracker: {birth_hits: 3, birth_window: 5, confirm_min_confidence: 0.0}\n"
+                                  "border: {margin_px: 1.0}\n";
   stages.push_back(std::make_unique<Child>(std::vector<std::string>{bin_path("wingman-localizer"), "--lcm-url", url,
                                                                     "--lockstep", "--config", localizer_cfg}));
   // The follower with its default configuration (it watches the localizer's heartbeat; issue 33, finding 7).
