@@ -241,21 +241,20 @@ FlightPlan plan_flight(const FlyOptions& o) {
     append(detector.argv, {"--set", "model.weights=\"\""});
   }
   for (const auto& kv : o.detector_sets) append(detector.argv, {"--set", kv});
-  append(detector.argv, {"--log-level", "warn"});
-  // With a rig: one detector per camera, on that camera's channels, named detector<camera_id> (its status channel).
+  // With a rig: one detector per camera, on that camera's channels (over the flight's sets), named detector<camera_id>
+  // (its status channel).
   std::vector<launcher::ProcessSpec> detectors;
   if (rig_cameras.empty()) detectors.push_back(detector);
   for (const auto& c : rig_cameras) {
     launcher::ProcessSpec d = detector;
-    const std::string name = fmt::format("detector{}", c.camera.camera_id);
     d.name = fmt::format("wingman-detector-cam{}", c.camera.camera_id);
-    d.argv.pop_back();  // the log level: the camera's keys go before it, over the flight's sets
-    d.argv.pop_back();
-    append(d.argv, {"--name", name, "--set", fmt::format("input.channel=\"{}\"", c.image_channel), "--set",
+    append(d.argv, {"--name", fmt::format("detector{}", c.camera.camera_id), "--set",
+                    fmt::format("input.channel=\"{}\"", c.image_channel), "--set",
                     fmt::format("output.channel=\"{}\"", c.detections_channel), "--set",
-                    fmt::format("windows.channel=\"{}\"", c.windows_channel), "--log-level", "warn"});
+                    fmt::format("windows.channel=\"{}\"", c.windows_channel)});
     detectors.push_back(d);
   }
+  for (auto& d : detectors) append(d.argv, {"--log-level", "warn"});
   launcher::ProcessSpec localizer = process("wingman-localizer", {exe("wingman-localizer"), "--lcm-url", url});
   if (!localizer_config.empty()) append(localizer.argv, {"--config", localizer_config});
   if (o.windows) append(localizer.argv, {"--set", "windows.publish=true"});
@@ -300,16 +299,21 @@ FlightPlan plan_flight(const FlyOptions& o) {
   return plan;
 }
 
-std::string rig_file(const std::string& rig, const std::string& config_dir) {
+namespace {
+/// `name_or_file` when it is a file, else `config_dir`/`folder`/NAME.yaml (not checked to exist).
+std::string file_or_named(const std::string& name_or_file, const std::string& config_dir, const char* folder) {
   std::error_code ec;
-  if (fs::is_regular_file(rig, ec)) return rig;
-  return (fs::path(config_dir) / "rigs" / (rig + ".yaml")).string();
+  if (fs::is_regular_file(name_or_file, ec)) return name_or_file;
+  return (fs::path(config_dir) / folder / (name_or_file + ".yaml")).string();
+}
+}  // namespace
+
+std::string rig_file(const std::string& rig, const std::string& config_dir) {
+  return file_or_named(rig, config_dir, "rigs");
 }
 
 std::string scenario_file(const std::string& scenario, const std::string& config_dir) {
-  std::error_code ec;
-  if (fs::is_regular_file(scenario, ec)) return scenario;
-  return (fs::path(config_dir) / "scenarios" / (scenario + ".yaml")).string();
+  return file_or_named(scenario, config_dir, "scenarios");
 }
 
 int fly(const FlightPlan& plan, std::ostream& out, std::ostream& err) {
