@@ -104,17 +104,10 @@ void Localizer::admit(LocalizerCamera& c, int clock_input, const wingman::detect
   const common::TimeAdmission admission = clock_.admit(clock_input, d.utime);
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);
   if (admission.resynced()) {  // its tracks live in the old times
-    tracker_ = Tracker(options_.tracker);
-    previous_detections_utime_ = -1;
-    if (rig_) {  // so do the waiting exposures and what each camera sent
-      pending_.clear();
-      processed_utime_ = -1;
-      first_utime_ = -1;
-      for (LocalizerCamera& other : cameras_) other.last_utime = -1;
-      notes_.push_back(admission.problem + "; the tracker restarts (new track ids), the waiting exposures are dropped");
-    } else {
-      notes_.push_back(admission.problem + "; the tracker restarts (new track ids)");
-    }
+    restart(nullptr);  // its tracks live in the old times; so do the waiting exposures and what each camera sent
+    notes_.push_back(admission.problem +
+                     (rig_ ? "; the tracker restarts (new track ids), the waiting exposures are dropped"
+                           : "; the tracker restarts (new track ids)"));
   }
   ++c.messages;
   c.last_utime = d.utime;
@@ -145,13 +138,7 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
   const bool forgotten = cameras_[i].last_utime >= 0 && !clock_.previous(camera_inputs_[i]).has_value();
   admit(cameras_[i], camera_inputs_[i], d);
   if (forgotten && d.utime <= processed_utime_) {
-    tracker_ = Tracker(options_.tracker);
-    previous_detections_utime_ = -1;
-    pending_.clear();
-    processed_utime_ = -1;
-    first_utime_ = -1;
-    for (LocalizerCamera& other : cameras_)
-      if (&other != &cameras_[i]) other.last_utime = -1;
+    restart(&cameras_[i]);
     notes_.push_back(fmt::format(
         "detections_t.utime = {}: camera {}'s time went back with a resync of another input; the tracker restarts "
         "(new track ids), the waiting exposures are dropped",
@@ -198,18 +185,32 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
   return out;
 }
 
-bool Localizer::silent(size_t i) const {
-  if (first_utime_ < 0) return false;
+void Localizer::restart(const LocalizerCamera* keep) {
+  tracker_ = Tracker(options_.tracker);
+  previous_detections_utime_ = -1;
+  pending_.clear();
+  processed_utime_ = -1;
+  first_utime_ = -1;
+  for (LocalizerCamera& c : cameras_)
+    if (&c != keep) c.last_utime = -1;
+}
+
+int64_t Localizer::newest_camera_utime() const {
   int64_t newest = first_utime_;
   for (const LocalizerCamera& c : cameras_) newest = std::max(newest, c.last_utime);
+  return newest;
+}
+
+bool Localizer::silent(size_t i) const {
+  if (first_utime_ < 0) return false;
+  const int64_t newest = newest_camera_utime();
   const int64_t since = cameras_[i].last_utime >= 0 ? cameras_[i].last_utime : first_utime_;
   return static_cast<double>(newest - since) > options_.cameras.silent_after_s * 1e6;
 }
 
 std::string Localizer::silent_summary() const {
   if (!rig_ || first_utime_ < 0) return "";
-  int64_t newest = first_utime_;
-  for (const LocalizerCamera& c : cameras_) newest = std::max(newest, c.last_utime);
+  const int64_t newest = newest_camera_utime();
   std::string out;
   for (size_t i = 0; i < cameras_.size(); ++i) {
     if (!silent(i)) continue;

@@ -179,6 +179,11 @@ class Localizer {
   LocalizerOutput process(int64_t utime, const std::vector<const wingman::detections_t*>& per_camera);
   /// Whether rig camera `i` is silent at the newest message time.
   bool silent(size_t i) const;
+  /// The newest accepted detections_t utime of any camera (first_utime_ before any camera has one).
+  int64_t newest_camera_utime() const;
+  /// A new start (time went back): a new tracker, no waiting exposures, every camera but `keep` (may be null) as if
+  /// it had sent nothing. For one camera the same (its bookkeeping is unused).
+  void restart(const LocalizerCamera* keep);
   /// The windows of the tracks after the exposure at `utime`, camera `c` at `pose` (the own pose at utime).
   wingman::track_windows_t track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
                                          const PoseSample& pose) const;
