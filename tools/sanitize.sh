@@ -39,7 +39,12 @@ stage() {  # stage NAME CMD...: runs CMD, prints its wall time, keeps its exit s
   return $rc
 }
 
+# Line tables only (-gline-tables-only, not -g): the sanitizers' reports need functions, files and lines, not
+# variables and types; a translation unit compiles about a quarter faster (tools/src/replay.cpp under ASan: 21 -> 16 s)
+# and its object is a third smaller, which shortens CI's two sanitizer builds.
 common_cmake=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG"
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG"
   -DWINGMAN_WITH_TRAINING=OFF -DWINGMAN_BUILD_BENCHMARKS=OFF)
 # ccache where installed (developers); CI builds without it.
 if command -v ccache > /dev/null; then

@@ -3,7 +3,8 @@
 // shipped model (builtin:wingman-small at its cfg size, 640x352) on both backends.
 //
 // Run with POCL_AFFINITY=1 (docs/pocl-performance.md). Counters: GFLOP/s from DarknetModel::flops()
-// (convolutions only), per image. Report the median aggregates.
+// (convolutions only), per image. Report the median aggregates of --benchmark_repetitions=5
+// --benchmark_min_time=0.5 (the figures' flags; CTest runs it once, briefly).
 // --per-layer (this program's own flag, taken out before Google Benchmark's): after the benchmarks, the OpenCL
 // device time of every command of one forward (median of 10 profiled forwards) for the thesis network at 416 and
 // 256 and the shipped model, one line each, to stdout.
@@ -140,7 +141,7 @@ void BM_BareOpenCvDnn(benchmark::State& state) {
 void sizes(benchmark::internal::Benchmark* b) {
   for (int s : {416, 320, 256}) b->Args({s, 1});
   b->Args({416, 4});  // zoom-in crops as one batch
-  b->Unit(benchmark::kMillisecond)->UseRealTime()->Repetitions(5)->ReportAggregatesOnly(true)->MinTime(0.5);
+  b->Unit(benchmark::kMillisecond)->UseRealTime()->ReportAggregatesOnly(true);
 }
 
 BENCHMARK(BM_OpenCl)->Apply(sizes);
@@ -151,21 +152,15 @@ BENCHMARK(BM_BareOpenCvDnn)
     ->Args({256, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Repetitions(5)
-    ->ReportAggregatesOnly(true)
-    ->MinTime(0.5);
+    ->ReportAggregatesOnly(true);
 BENCHMARK(BM_OpenClShipped)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Repetitions(5)
-    ->ReportAggregatesOnly(true)
-    ->MinTime(0.5);
+    ->ReportAggregatesOnly(true);
 BENCHMARK(BM_CpuBackendShipped)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Repetitions(5)
-    ->ReportAggregatesOnly(true)
-    ->MinTime(0.5);
+    ->ReportAggregatesOnly(true);
 
 /// One line per command of an OpenCL forward: median device time of 10 profiled forwards, share, GFLOP/s.
 void print_per_layer(const std::string& label, const DarknetModel& m) {
