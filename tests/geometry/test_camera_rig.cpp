@@ -21,8 +21,11 @@ using wingman::geometry::CameraRig;
 using wingman::geometry::Extrinsics;
 using wingman::geometry::load_camera_rig;
 
-/// A fixture of tests/geometry/data (fixed camchains and rigs; their headers say how they were made).
-std::string data_path(const std::string& name) { return wingman::testing::source_path("tests/geometry/data/" + name); }
+/// A fixture of tests/geometry/data (fixed camchains and rigs; their headers say how they were made), as an absolute
+/// path: the rig files written in a temporary folder name it.
+std::string data_path(const std::string& name) {
+  return fs::absolute(wingman::testing::source_path("tests/geometry/data/" + name)).string();
+}
 
 /// Checks that two rigs mount their cameras alike, camera by camera: R_cam_to_body and p_cam_in_body to 1e-9 (the
 /// camchains print 17 digits; a composed chain of four transforms rounds to ~1e-15).
@@ -294,7 +297,9 @@ TEST_F(CameraRigFile, TheCamchainKeysOwnMistakesAreNamed) {
 
 TEST_F(CameraRigFile, TheVswarmKalibrFileGivesIntrinsicsButIsNoCameraChain) {
   const std::string kalibr =
-      wingman::testing::source_path("../shared/calibrations/vswarm_firefly_s_720x540_kalibr.yaml");
+      fs::absolute(wingman::testing::source_path("../shared/calibrations/vswarm_firefly_s_720x540_kalibr.yaml"))
+          .lexically_normal()
+          .string();
   struct stat st {};
   if (stat(kalibr.c_str(), &st) != 0)
     GTEST_SKIP() << "real calibrations not available: " << kalibr
