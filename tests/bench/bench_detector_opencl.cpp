@@ -153,14 +153,8 @@ BENCHMARK(BM_BareOpenCvDnn)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->ReportAggregatesOnly(true);
-BENCHMARK(BM_OpenClShipped)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->ReportAggregatesOnly(true);
-BENCHMARK(BM_CpuBackendShipped)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_OpenClShipped)->Unit(benchmark::kMillisecond)->UseRealTime()->ReportAggregatesOnly(true);
+BENCHMARK(BM_CpuBackendShipped)->Unit(benchmark::kMillisecond)->UseRealTime()->ReportAggregatesOnly(true);
 
 /// One line per command of an OpenCL forward: median device time of 10 profiled forwards, share, GFLOP/s.
 void print_per_layer(const std::string& label, const DarknetModel& m) {

@@ -90,10 +90,7 @@ void BM_MotionCue1280x720(benchmark::State& state) {
       static_cast<double>(cue.stats().compared) / static_cast<double>(std::max<int64_t>(1, cue.stats().frames));
 }
 
-BENCHMARK(BM_MotionCue1280x720)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_MotionCue1280x720)->Unit(benchmark::kMillisecond)->UseRealTime()->ReportAggregatesOnly(true);
 
 }  // namespace
 
