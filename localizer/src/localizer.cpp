@@ -10,6 +10,7 @@
 #include <wingman/geometry/message_eigen.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <stdexcept>
 
 namespace wingman::localizer {
@@ -187,12 +188,13 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
 
 void Localizer::restart(const LocalizerCamera* keep) {
   tracker_ = Tracker(options_.tracker);
-  previous_detections_utime_ = -1;
   pending_.clear();
   processed_utime_ = -1;
   first_utime_ = -1;
-  for (LocalizerCamera& c : cameras_)
+  for (LocalizerCamera& c : cameras_) {
+    c.processed_utime = -1;
     if (&c != keep) c.last_utime = -1;
+  }
 }
 
 int64_t Localizer::newest_camera_utime() const {
@@ -325,18 +327,39 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
       world[c].push_back(to_world(m, cameras_[c].extrinsics, *pose, utime, per_camera[c]->camera_id));
     }
   }
-  if (!tracker_.update_cameras(utime, world, &why)) {
+  // A rig: a track none of this exposure's cameras could see is not missed by it (cameras not triggered together make
+  // every exposure one camera's; a track in another camera's view would otherwise miss three frames of four).
+  std::function<bool(const Eigen::Vector3d&)> could_see;
+  if (rig_) {
+    could_see = [&](const Eigen::Vector3d& p_target_in_world) {
+      for (size_t c = 0; c < per_camera.size(); ++c) {
+        if (per_camera[c] == nullptr) continue;
+        const CameraPoseInWorld cam = camera_pose_in_world(cameras_[c].extrinsics, *pose);
+        const Eigen::Vector3d p_in_cam = cam.R_cam_to_world.transpose() * (p_target_in_world - cam.p_cam_in_world);
+        if (!(p_in_cam.z() > 1e-3 * p_in_cam.norm())) continue;  // behind the camera or beside it
+        const Eigen::Vector2d uv = cameras_[c].camera.project(p_in_cam);
+        if (uv.x() >= 0 && uv.y() >= 0 && uv.x() <= cameras_[c].camera.width() && uv.y() <= cameras_[c].camera.height())
+          return true;
+      }
+      return false;
+    };
+  }
+  if (!tracker_.update_cameras(utime, world, &why, could_see)) {
     throw std::invalid_argument("detections_t.utime = " + std::to_string(utime) + ": " + why);
   }
-  if (options_.windows.publish) {
-    if (rig_) {
-      for (const LocalizerCamera& c : cameras_)
-        result.camera_windows.push_back({c.windows_channel, track_windows(utime, c, first->source, *pose)});
-    } else {
-      result.windows = track_windows(utime, cameras_[0], first->source, *pose);
+  // Windows for the cameras of this exposure, each for its own next exposure.
+  for (size_t c = 0; c < per_camera.size(); ++c) {
+    if (per_camera[c] == nullptr) continue;
+    if (options_.windows.publish) {
+      wingman::track_windows_t w = track_windows(utime, cameras_[c], first->source, *pose);
+      if (rig_) {
+        result.camera_windows.push_back({cameras_[c].windows_channel, std::move(w)});
+      } else {
+        result.windows = std::move(w);
+      }
     }
+    cameras_[c].processed_utime = utime;
   }
-  previous_detections_utime_ = utime;
 
   // Lag compensation: predict to the newest time we know of (own poses arrive with little delay).
   const int64_t predict_to = std::max(utime, newest_pose_utime_);
@@ -370,11 +393,10 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
 
 wingman::track_windows_t Localizer::track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
                                                   const PoseSample& pose) const {
-  // The next exposure: one frame interval (the last one seen, at most 0.5 s) after this one.
+  // The camera's next exposure: one of its frame intervals (the last one seen, at most 0.5 s) after this one.
   constexpr int64_t kMaxInterval_us = 500000;
-  const int64_t interval_us = previous_detections_utime_ >= 0 && utime - previous_detections_utime_ <= kMaxInterval_us
-                                  ? utime - previous_detections_utime_
-                                  : 0;
+  const int64_t interval_us =
+      c.processed_utime >= 0 && utime - c.processed_utime <= kMaxInterval_us ? utime - c.processed_utime : 0;
   wingman::track_windows_t out{};
   out.utime = utime;
   out.utime_predicted = utime + interval_us;

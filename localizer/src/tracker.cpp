@@ -170,7 +170,7 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
 }
 
 bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldMeasurement>>& per_camera,
-                             std::string* why) {
+                             std::string* why, const std::function<bool(const Eigen::Vector3d&)>& could_see) {
   if (have_frame_ && utime <= last_frame_utime_) {
     ++stats_.frames_rejected;
     if (why)
@@ -314,10 +314,14 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
   kept.reserve(tracks_.size() + born.size());
   for (size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
-    ++t.frames;
-    if (track_hit[i]) ++t.hits;
-    t.recent.push_back(track_hit[i]);
-    while (static_cast<int>(t.recent.size()) > options_.birth_window) t.recent.pop_front();
+    if (track_hit[i] || !could_see || could_see(t.sc.x.head<3>())) {  // else: out of every camera's view
+      ++t.frames;
+      if (track_hit[i]) ++t.hits;
+      t.recent.push_back(track_hit[i]);
+      while (static_cast<int>(t.recent.size()) > options_.birth_window) t.recent.pop_front();
+    } else {
+      ++stats_.out_of_view;
+    }
     const bool timed_out = utime - t.last_hit_utime > death_timeout_us;
     if (t.id == 0 && (timed_out || t.hits + (options_.birth_window - t.frames) < options_.birth_hits)) {
       ++stats_.tentative_dropped;

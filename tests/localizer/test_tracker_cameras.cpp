@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -56,6 +57,39 @@ TEST(TrackerCameras, ATargetTwoCamerasSeeStartsOneTrackAndCountsOneHitPerFrame) 
   EXPECT_EQ(t.num_tentative(), 0u);
   // 20 detections of 0.2 m per axis, but the velocity is still nearly free after 0.3 s: a sanity bound.
   EXPECT_LT((out[0].p_target_in_world - p).norm(), 0.5);
+}
+
+TEST(TrackerCameras, AFrameOfACameraThatCouldNotSeeTheTrackIsNoMiss) {
+  // Frames alternate between a camera that sees the target (east) and one that looks west: with could_see the west
+  // camera's frames leave the track's count alone, so 10 hits in the east camera's 10 frames confirm it; without,
+  // they are misses, and 10 hits never fall within 15 frames.
+  const Eigen::Vector3d p(8.0, 0.0, 0.5);
+  const auto east_only = [](const Eigen::Vector3d& q) { return q.x() > 0; };
+  const auto west_only = [](const Eigen::Vector3d& q) { return q.x() < 0; };
+  for (const bool with_view : {true, false}) {
+    Tracker t;  // birth_hits 10 of birth_window 15
+    for (int k = 0; k < 40; ++k) {
+      const bool east = k % 2 == 0;
+      std::vector<std::vector<WorldMeasurement>> frame(1);
+      if (east) frame[0].push_back(meas(p, 0));
+      std::function<bool(const Eigen::Vector3d&)> view;
+      if (with_view) view = east ? std::function<bool(const Eigen::Vector3d&)>(east_only) : west_only;
+      ASSERT_TRUE(t.update_cameras(frame_utime(k), frame, nullptr, view));
+      if (with_view && k == 18) {
+        ASSERT_EQ(t.confirmed(frame_utime(k)).size(), 1u) << "the 10th hit, the east camera's 10th frame";
+      } else if (with_view && k < 18) {
+        EXPECT_TRUE(t.confirmed(frame_utime(k)).empty()) << k;
+      }
+    }
+    if (with_view) {
+      EXPECT_EQ(t.confirmed(frame_utime(39)).size(), 1u);
+      EXPECT_EQ(t.stats().out_of_view, 20) << "the west camera's 20 frames";
+      EXPECT_EQ(t.stats().births, 1);
+    } else {
+      EXPECT_TRUE(t.confirmed(frame_utime(39)).empty()) << "every other frame a miss: 8 hits of 15 at most";
+      EXPECT_EQ(t.stats().out_of_view, 0);
+    }
+  }
 }
 
 TEST(TrackerCameras, ATrackOneCameraLosesAndTheNextTakesLivesOn) {

@@ -61,6 +61,7 @@ struct LocalizerCamera {
   std::string windows_channel;     ///< track_windows_t output (windows.publish)
   int64_t messages = 0;            ///< detections_t accepted (in order, of the right size)
   int64_t last_utime = -1;         ///< utime of the newest accepted detections_t; -1 before the first
+  int64_t processed_utime = -1;    ///< utime of the newest exposure processed with this camera (its frame interval)
 };
 
 /// What a camera rig's exposures have been through (cameras.rig).
@@ -203,7 +204,6 @@ class Localizer {
   int64_t first_utime_ = -1;      ///< a rig: the first accepted detections_t's utime (a silent camera's start)
   ExposureStats exposure_stats_;
   int64_t newest_pose_utime_ = -1;
-  int64_t previous_detections_utime_ = -1;  ///< the last accepted detections_t's utime (frame interval for windows)
   NonDroneCounts non_drone_boxes_;
   std::vector<std::string> notes_;  ///< take_notes()
 };

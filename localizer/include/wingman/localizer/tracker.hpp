@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -156,6 +157,8 @@ struct TrackerStats {
   int64_t deaths = 0;             ///< confirmed tracks deleted after death_timeout_s
   int64_t merges = 0;             ///< duplicates merged into an older confirmed track (or not confirmed)
   int64_t ambiguous = 0;          ///< confirmed-track updates skipped as a coin toss between two tracks (coasted)
+  /// track-frames left out of the hit-and-miss count: the track out of the view of every camera of the frame
+  int64_t out_of_view = 0;
 };
 
 /// Tracks targets from world-frame detections, one frame (image) at a time.
@@ -187,8 +190,13 @@ class Tracker {
   /// took starts a track. Hits and misses count once per frame: a frame is a hit for a track when any camera hit it.
   /// most_confident keeps the one most confident measurement of the whole frame. With one camera this is
   /// update(utime, per_camera[0], why). Returns false (and sets `why`) for a frame that is not later.
+  /// `could_see` (optional): whether one of this frame's cameras could see a target at a world position (ENU, m;
+  /// each track's position predicted to `utime`). A track it says no to, and that no camera hit, is left out of
+  /// this frame's hit-and-miss count (the M of N of its birth): the frame of a camera that looks elsewhere is no
+  /// miss. Its death timeout runs all the same. Empty: every frame counts for every track (one camera; a rig's
+  /// cameras triggered together that see all around).
   bool update_cameras(int64_t utime, const std::vector<std::vector<WorldMeasurement>>& per_camera,
-                      std::string* why = nullptr);
+                      std::string* why = nullptr, const std::function<bool(const Eigen::Vector3d&)>& could_see = {});
 
   /// The confirmed tracks, ordered by track_id, with their state predicted to `predict_to_utime`
   /// (the publish time; lag compensation). The prediction is limited to [state time, state time +
