@@ -102,13 +102,21 @@ void Localizer::admit(LocalizerCamera& c, int clock_input, const wingman::detect
   if (!ground_truth) {
     if (const std::string bad = cnn_relation_.check_model(d.model_id); !bad.empty()) throw std::invalid_argument(bad);
   }
+  // A resync of another input (the own pose) makes the clock forget this camera when its times lie far after it: time
+  // went back for everyone (a restarted source). The tracks (and a rig's waiting exposures) of the old times go, as
+  // after a resync of this input; otherwise the tracker would refuse every frame as not after its last one.
+  const bool forgotten = c.last_utime >= 0 && !clock_.previous(clock_input).has_value();
   const common::TimeAdmission admission = clock_.admit(clock_input, d.utime);
   if (!admission.accepted()) throw std::invalid_argument(admission.problem);
-  if (admission.resynced()) {  // its tracks live in the old times
+  const char* const restarts = rig_ ? "the tracker restarts (new track ids), the waiting exposures are dropped"
+                                    : "the tracker restarts (new track ids)";
+  if (admission.resynced()) {
     restart(nullptr);  // its tracks live in the old times; so do the waiting exposures and what each camera sent
-    notes_.push_back(admission.problem +
-                     (rig_ ? "; the tracker restarts (new track ids), the waiting exposures are dropped"
-                           : "; the tracker restarts (new track ids)"));
+    notes_.push_back(admission.problem + "; " + restarts);
+  } else if (forgotten && d.utime <= std::max(c.last_utime, processed_utime_)) {
+    restart(&c);
+    notes_.push_back(fmt::format("detections_t.utime = {}: {}time went back with a resync of another input; {}",
+                                 d.utime, rig_ ? fmt::format("camera {}'s ", d.camera_id) : std::string(), restarts));
   }
   ++c.messages;
   c.last_utime = d.utime;
@@ -134,17 +142,7 @@ std::vector<LocalizerOutput> Localizer::add_detections(const wingman::detections
     throw std::invalid_argument(fmt::format("detections_t.camera_id = {}: not a camera of the rig {} (cameras.rig: {})",
                                             d.camera_id, options_.cameras.rig, ids));
   }
-  // A resync of another input (the own pose) makes the clock forget a camera whose times lie far after it: time went
-  // back for everyone (a restarted source). The exposures and tracks of the old times go, as after a resync.
-  const bool forgotten = cameras_[i].last_utime >= 0 && !clock_.previous(camera_inputs_[i]).has_value();
   admit(cameras_[i], camera_inputs_[i], d);
-  if (forgotten && d.utime <= processed_utime_) {
-    restart(&cameras_[i]);
-    notes_.push_back(fmt::format(
-        "detections_t.utime = {}: camera {}'s time went back with a resync of another input; the tracker restarts "
-        "(new track ids), the waiting exposures are dropped",
-        d.utime, d.camera_id));
-  }
   if (first_utime_ < 0) first_utime_ = d.utime;
   if (d.utime <= processed_utime_) {  // a sign of life all the same (admit() counted it)
     ++exposure_stats_.late;

@@ -140,6 +140,45 @@ TEST(LocalizerTime, AFutureFirstMessageIsForgottenWithinTheResyncTime) {
                              << r.blind_after << "): still refused after time.resync_after_s";
 }
 
+TEST(LocalizerTime, WhenTimeGoesBackForEveryInputTheLocalizerStartsAgainWithinTheResyncTime) {
+  // A restarted source (a replayed log, a restarted simulator): own poses and detections both jump 100 s back. They
+  // are refused for time.resync_after_s of their own time, then the clock re-anchors and the localizer works again:
+  // detections find own poses and the tracker takes frames (a new tracker: the old tracks live in the old times).
+  Localizer loc(LocalizerOptions{}, camera());
+  const int64_t back = -100 * kS;
+  int refused = 0, blind_late = 0, taken_late = 0;
+  int64_t next_detections = 0;
+  for (int64_t t = 0; t <= 5 * kS; t += 20000) {
+    const int64_t shift = t < 2 * kS ? 0 : back;
+    try {
+      loc.on_own_pose(pose_at(kT0 + shift + t));
+    } catch (const std::invalid_argument&) {
+      ++refused;
+    }
+    while (next_detections + 40000 <= t) {  // the detections of images up to 40 ms ago
+      const int64_t image = next_detections;
+      next_detections += 33333;
+      const int64_t image_shift = image < 2 * kS ? 0 : back;
+      const bool late = image > 3 * kS + 100000;  // after the jump (2 s) + time.resync_after_s (1 s) + 0.1 s
+      try {
+        const LocalizerOutput out = loc.on_detections(detections_at(kT0 + image_shift + image));
+        if (late) out.camera_frame_only ? ++blind_late : ++taken_late;
+      } catch (const std::invalid_argument&) {
+        ++refused;
+        if (late) ++blind_late;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0) << "refused until the resync";
+  EXPECT_EQ(blind_late, 0) << "still refused or without an own pose after time.resync_after_s (" << taken_late
+                           << " taken)";
+  EXPECT_GT(taken_late, 50);
+  bool noted = false;
+  for (const std::string& n : loc.take_notes())
+    noted = noted || n.find("time went back with a resync of another input; the tracker restarts") != std::string::npos;
+  EXPECT_TRUE(noted) << "the restart is a note for the log";
+}
+
 }  // namespace
 
 namespace {
