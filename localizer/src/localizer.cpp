@@ -327,9 +327,9 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
   }
   // A rig: a track none of this exposure's cameras could see is not missed by it (cameras not triggered together make
   // every exposure one camera's; a track in another camera's view would otherwise miss three frames of four).
-  std::function<bool(const Eigen::Vector3d&)> could_see;
+  FrameViews views;
   if (rig_) {
-    could_see = [&](const Eigen::Vector3d& p_target_in_world) {
+    views.could_see = [&](const Eigen::Vector3d& p_target_in_world) {
       for (size_t c = 0; c < per_camera.size(); ++c) {
         if (per_camera[c] == nullptr) continue;
         const CameraPoseInWorld cam = camera_pose_in_world(cameras_[c].extrinsics, *pose);
@@ -342,7 +342,8 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
       return false;
     };
   }
-  if (!tracker_.update_cameras(utime, world, &why, could_see)) {
+  if (options_.tracker.occlusion_coast) views.occluded = occluded_tracks(utime, per_camera, *pose);
+  if (!tracker_.update_cameras(utime, world, &why, views)) {
     throw std::invalid_argument("detections_t.utime = " + std::to_string(utime) + ": " + why);
   }
   // Windows for the cameras of this exposure, each for its own next exposure.
@@ -387,6 +388,43 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
   out.num_targets = static_cast<int32_t>(out.targets.size());
   if (out.num_targets > 0 || options_.publish_empty) result.targets = std::move(out);
   return result;
+}
+
+std::vector<std::vector<int32_t>> Localizer::occluded_tracks(
+    int64_t utime, const std::vector<const wingman::detections_t*>& per_camera, const PoseSample& pose) const {
+  std::vector<std::vector<int32_t>> out(per_camera.size());
+  if (tracker_.num_confirmed() < 2) return out;
+  std::vector<TrackOutput> tracks = tracker_.predicted_tracks(utime);
+  tracks.erase(std::remove_if(tracks.begin(), tracks.end(), [](const TrackOutput& t) { return !t.confirmed; }),
+               tracks.end());
+  static const BoxRelation sphere = BoxRelation::sphere();
+  const double m = options_.tracker.occlusion_margin;
+  for (size_t c = 0; c < per_camera.size(); ++c) {
+    if (per_camera[c] == nullptr) continue;
+    const bool ground_truth = per_camera[c]->source == wingman::detections_t::SOURCE_GROUND_TRUTH;
+    const CameraPoseInWorld now = camera_pose_in_world(cameras_[c].extrinsics, pose);
+    CameraAtExposure cam;
+    cam.R_cam_to_world = now.R_cam_to_world;
+    cam.p_cam_in_world = now.p_cam_in_world;
+    // Each track's predicted box, grown by the margin on every side: left, top, right, bottom.
+    std::vector<std::pair<int32_t, Eigen::Vector4d>> boxes;
+    for (const TrackOutput& t : tracks) {
+      const auto w = predict_track_window(t, options_.sphere.radius_m, cameras_[c].camera, cam,
+                                          ground_truth ? sphere : cnn_relation_);
+      if (!w) continue;
+      const double hw = (0.5 + m) * w->w, hh = (0.5 + m) * w->h;
+      boxes.push_back({t.track_id, Eigen::Vector4d(w->cx - hw, w->cy - hh, w->cx + hw, w->cy + hh)});
+    }
+    for (size_t a = 0; a < boxes.size(); ++a)
+      for (size_t b = a + 1; b < boxes.size(); ++b) {
+        const Eigen::Vector4d& p = boxes[a].second;
+        const Eigen::Vector4d& q = boxes[b].second;
+        if (p[0] >= q[2] || q[0] >= p[2] || p[1] >= q[3] || q[1] >= p[3]) continue;  // apart
+        for (const int32_t id : {boxes[a].first, boxes[b].first})
+          if (std::find(out[c].begin(), out[c].end(), id) == out[c].end()) out[c].push_back(id);
+      }
+  }
+  return out;
 }
 
 wingman::track_windows_t Localizer::track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,

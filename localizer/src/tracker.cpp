@@ -36,6 +36,8 @@ std::vector<std::string> TrackerOptions::validate() const {
     p.push_back(problem("tracker.gate_chi2", gate_chi2, "must be finite and > 0"));
   if (!(ambiguity_chi2 >= 0) || !std::isfinite(ambiguity_chi2))
     p.push_back(problem("tracker.ambiguity_chi2", ambiguity_chi2, "must be finite and >= 0"));
+  if (!(occlusion_margin >= 0) || !std::isfinite(occlusion_margin))
+    p.push_back(problem("tracker.occlusion_margin", occlusion_margin, "must be finite and >= 0"));
   if (!(merge_after_s >= 0) || !std::isfinite(merge_after_s))
     p.push_back(problem("tracker.merge_after_s", merge_after_s, "must be finite and >= 0"));
   if (birth_hits < 1) p.push_back(problem("tracker.birth_hits", birth_hits, "must be >= 1"));
@@ -170,7 +172,7 @@ bool Tracker::update(int64_t utime, const std::vector<WorldMeasurement>& measure
 }
 
 bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldMeasurement>>& per_camera,
-                             std::string* why, const std::function<bool(const Eigen::Vector3d&)>& could_see) {
+                             std::string* why, const FrameViews& views) {
   if (have_frame_ && utime <= last_frame_utime_) {
     ++stats_.frames_rejected;
     if (why)
@@ -249,7 +251,14 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
       // Two confirmed tracks that could as well have each other's detections (targets crossing): a coin toss, which
       // would swap their identities half the time; both coast instead (the frame counts for their life), at most
       // max_prediction_s in a row (two targets flying together: the optimal assignment again).
-      std::vector<bool> coast(group.size(), false);
+      std::vector<bool> coast(group.size(), false), occluded(group.size(), false);
+      // Occluding each other in this camera (FrameViews::occluded): what it gives them may be either, or both as one.
+      if (confirmed_pass && cam < views.occluded.size() && !views.occluded[cam].empty()) {
+        const std::vector<int32_t>& ids = views.occluded[cam];
+        for (size_t k = 0; k < group.size(); ++k)
+          if (track_to_z[k] >= 0 && std::find(ids.begin(), ids.end(), group[k]->id) != ids.end())
+            coast[k] = occluded[k] = true;
+      }
       if (confirmed_pass && options_.ambiguity_chi2 > 0) {
         const auto c = [&](size_t track, int det) { return cost(static_cast<Eigen::Index>(track), det); };
         for (size_t a = 0; a < group.size(); ++a)
@@ -258,19 +267,19 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
             if (i < 0 || j < 0 || is_forbidden(c(a, j)) || is_forbidden(c(b, i))) continue;
             if ((c(a, j) + c(b, i)) - (c(a, i) + c(b, j)) < options_.ambiguity_chi2) coast[a] = coast[b] = true;
           }
-        for (size_t k = 0; k < group.size(); ++k) {
-          if (!coast[k]) continue;
-          ambiguous[index[k]] = true;
-          const Track& t = *group[k];
-          if (t.coasting_since_utime >= 0 && utime - t.coasting_since_utime > max_coast_us) coast[k] = false;
-        }
+      }
+      for (size_t k = 0; k < group.size(); ++k) {
+        if (!coast[k]) continue;
+        ambiguous[index[k]] = true;
+        const Track& t = *group[k];
+        if (t.coasting_since_utime >= 0 && utime - t.coasting_since_utime > max_coast_us) coast[k] = false;
       }
       for (size_t k = 0; k < group.size(); ++k) {
         if (track_to_z[k] < 0) continue;
         if (index[k] < tracks_.size()) track_hit[index[k]] = true;
         if (coast[k]) {
           group[k]->last_hit_utime = utime;
-          ++stats_.ambiguous;
+          ++(occluded[k] ? stats_.occluded : stats_.ambiguous);
           continue;
         }
         hit(*group[k], z[static_cast<size_t>(track_to_z[k])]);
@@ -314,7 +323,7 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
   kept.reserve(tracks_.size() + born.size());
   for (size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
-    if (track_hit[i] || !could_see || could_see(t.sc.x.head<3>())) {  // else: out of every camera's view
+    if (track_hit[i] || !views.could_see || views.could_see(t.sc.x.head<3>())) {  // else: out of every view
       ++t.frames;
       if (track_hit[i]) ++t.hits;
       t.recent.push_back(track_hit[i]);

@@ -13,6 +13,7 @@
 
 namespace {
 
+using wingman::localizer::FrameViews;
 using wingman::localizer::Tracker;
 using wingman::localizer::TrackerOptions;
 using wingman::localizer::TrackOutput;
@@ -72,9 +73,9 @@ TEST(TrackerCameras, AFrameOfACameraThatCouldNotSeeTheTrackIsNoMiss) {
       const bool east = k % 2 == 0;
       std::vector<std::vector<WorldMeasurement>> frame(1);
       if (east) frame[0].push_back(meas(p, 0));
-      std::function<bool(const Eigen::Vector3d&)> view;
-      if (with_view) view = east ? std::function<bool(const Eigen::Vector3d&)>(east_only) : west_only;
-      ASSERT_TRUE(t.update_cameras(frame_utime(k), frame, nullptr, view));
+      FrameViews views;
+      if (with_view) views.could_see = east ? std::function<bool(const Eigen::Vector3d&)>(east_only) : west_only;
+      ASSERT_TRUE(t.update_cameras(frame_utime(k), frame, nullptr, views));
       if (with_view && k == 18) {
         ASSERT_EQ(t.confirmed(frame_utime(k)).size(), 1u) << "the 10th hit, the east camera's 10th frame";
       } else if (with_view && k < 18) {

@@ -185,6 +185,11 @@ class Localizer {
   /// A new start (time went back): a new tracker, no waiting exposures, every camera but `keep` (may be null) as if
   /// it had sent nothing. For one camera the same (its bookkeeping is unused).
   void restart(const LocalizerCamera* keep);
+  /// Per camera of the exposure (null: none), the confirmed tracks occluding each other there
+  /// (tracker.occlusion_margin; FrameViews::occluded), their states predicted to `utime`, camera `c` at `pose`.
+  std::vector<std::vector<int32_t>> occluded_tracks(int64_t utime,
+                                                    const std::vector<const wingman::detections_t*>& per_camera,
+                                                    const PoseSample& pose) const;
   /// The windows of the tracks after the exposure at `utime`, camera `c` at `pose` (the own pose at utime).
   wingman::track_windows_t track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
                                          const PoseSample& pose) const;

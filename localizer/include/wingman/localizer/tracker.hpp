@@ -82,6 +82,13 @@ struct TrackerOptions {
   /// takes one; both coast on their constant-velocity prediction (the frame counts as a hit for their life) for at
   /// most max_prediction_s in a row, and the two detections start no track. 0 = always the optimal assignment. >= 0.
   double ambiguity_chi2 = 2.0;
+  /// Occlusion: two confirmed tracks whose predicted image boxes in a camera, each grown by this fraction of its size
+  /// on every side, touch are occluding each other there (the Localizer decides, FrameViews::occluded): a detector
+  /// may then box either drone, or both as one box, so what that camera's association gives them updates neither;
+  /// both coast as for ambiguity_chi2 (at most max_prediction_s in a row). Fraction of the box size, >= 0 (0: the
+  /// boxes themselves must overlap); occlusion_coast false = off.
+  double occlusion_margin = 0.5;
+  bool occlusion_coast = true;  ///< the occlusion rule above on (Localizer only: Tracker::update() has no images)
   /// Online size estimation (tracker.size_*): each track's range scale from the camera's motion relative to it.
   SizeEstimatorOptions size;
 
@@ -107,6 +114,11 @@ struct TrackerOptions {
     v("tracker.ambiguity_chi2", ambiguity_chi2,
       "two confirmed tracks whose detections could be swapped within this much squared Mahalanobis distance coast "
       "instead (crossing targets); 0 = off");
+    v("tracker.occlusion_coast", occlusion_coast,
+      "two confirmed tracks whose predicted image boxes touch (a detector may box either, or both as one) are not "
+      "updated by that camera's detections: they coast");
+    v("tracker.occlusion_margin", occlusion_margin,
+      "the predicted boxes are grown by this fraction of their size on every side before the touch test, >= 0");
     v("tracker.merge_after_s", merge_after_s,
       "confirmed tracks are merged once they have agreed in state for this long, s (0 = at once)");
     size.visit(v);
@@ -157,8 +169,23 @@ struct TrackerStats {
   int64_t deaths = 0;             ///< confirmed tracks deleted after death_timeout_s
   int64_t merges = 0;             ///< duplicates merged into an older confirmed track (or not confirmed)
   int64_t ambiguous = 0;          ///< confirmed-track updates skipped as a coin toss between two tracks (coasted)
+  int64_t occluded = 0;           ///< confirmed-track updates skipped: occluding another track there (coasted)
   /// track-frames left out of the hit-and-miss count: the track out of the view of every camera of the frame
   int64_t out_of_view = 0;
+};
+
+/// What one frame's cameras tell the tracker beyond their measurements (Tracker::update_cameras; the Localizer knows
+/// the cameras, the tracker works in the world frame). Empty: nothing (every track counts every frame, no occlusion).
+struct FrameViews {
+  /// Whether one of the frame's cameras could see a target at a world position (ENU, m; each track's position
+  /// predicted to the frame). A track it says no to, and that no camera hit, is left out of the frame's hit-and-miss
+  /// count (the M of N of its birth): the frame of a camera that looks elsewhere is no miss. Its death timeout runs
+  /// all the same. Empty: every frame counts for every track.
+  std::function<bool(const Eigen::Vector3d&)> could_see;
+  /// Per camera (per_camera's order; empty or shorter: none): the ids of the confirmed tracks occluding each other in
+  /// that camera (TrackerOptions::occlusion_margin). The detections that camera's association gives them update
+  /// neither: they coast, at most max_prediction_s in a row (then the association's choice holds again).
+  std::vector<std::vector<int32_t>> occluded;
 };
 
 /// Tracks targets from world-frame detections, one frame (image) at a time.
@@ -190,13 +217,9 @@ class Tracker {
   /// took starts a track. Hits and misses count once per frame: a frame is a hit for a track when any camera hit it.
   /// most_confident keeps the one most confident measurement of the whole frame. With one camera this is
   /// update(utime, per_camera[0], why). Returns false (and sets `why`) for a frame that is not later.
-  /// `could_see` (optional): whether one of this frame's cameras could see a target at a world position (ENU, m;
-  /// each track's position predicted to `utime`). A track it says no to, and that no camera hit, is left out of
-  /// this frame's hit-and-miss count (the M of N of its birth): the frame of a camera that looks elsewhere is no
-  /// miss. Its death timeout runs all the same. Empty: every frame counts for every track (one camera; a rig's
-  /// cameras triggered together that see all around).
+  /// `views`: what the frame's cameras tell beyond their measurements (FrameViews; the Localizer fills it).
   bool update_cameras(int64_t utime, const std::vector<std::vector<WorldMeasurement>>& per_camera,
-                      std::string* why = nullptr, const std::function<bool(const Eigen::Vector3d&)>& could_see = {});
+                      std::string* why = nullptr, const FrameViews& views = {});
 
   /// The confirmed tracks, ordered by track_id, with their state predicted to `predict_to_utime`
   /// (the publish time; lag compensation). The prediction is limited to [state time, state time +
