@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <stdexcept>
@@ -274,6 +275,32 @@ TEST(Detector, InvalidOptionsAreNamed) {
   o.backend = "gpu";
   const std::string e = error_of([&] { Detector det(o); });
   EXPECT_NE(e.find("model.backend"), std::string::npos) << e;
+}
+
+TEST(Detector, AutoTimesBothBackendsInTurnAndRunsTheOneItSaysWasFaster) {
+  // model.backend auto on PoCL: both backends timed in turn, each one's fastest forward compared; the backend it
+  // returns is the one its line says was faster (by the numbers it prints), and it says how many forwards it timed.
+  const DetectorOptions o = cpu_options();
+  const DarknetModel model = load_model(o.cfg, o.weights);
+  std::string why;
+  const auto backend = make_backend("auto", model, o.opencl, 1, &why);
+  ASSERT_NE(backend, nullptr);
+  if (why.find("no usable OpenCL device") != std::string::npos) GTEST_SKIP() << "no OpenCL device here: " << why;
+  double ms_ocl = 0, ms_cpu = 0;
+  int runs = 0;
+  const size_t at = why.find("fastest of ");
+  ASSERT_NE(at, std::string::npos) << why;
+  ASSERT_EQ(std::sscanf(why.c_str() + at, "fastest of %d forward(s) each, in turn: %lf ms opencl", &runs, &ms_ocl), 2)
+      << why;
+  const size_t vs = why.find(" vs ");
+  ASSERT_NE(vs, std::string::npos) << why;
+  ASSERT_EQ(std::sscanf(why.c_str() + vs, " vs %lf ms cpu", &ms_cpu), 1) << why;
+  EXPECT_TRUE(runs == 1 || runs == 3) << why;  // 1: the CPU lost the first turn by 1.5x or more
+  EXPECT_GT(ms_ocl, 0.0);
+  EXPECT_GT(ms_cpu, 0.0);
+  const bool opencl_chosen = backend->name().rfind("opencl", 0) == 0;
+  EXPECT_EQ(opencl_chosen, ms_ocl <= ms_cpu) << why << " -> " << backend->name();
+  EXPECT_EQ(why.rfind("backend " + backend->name() + " (auto: ", 0), 0u) << why;
 }
 
 }  // namespace
