@@ -265,8 +265,8 @@ TEST(Eval, RangeBinsMustIncrease) {
 }
 
 /// Leader fixed at (0, 10, 5), ten frames. Leader track ids by frame: 7 7 7 9 9 7 7 7 7 7 (two switches); frame 4
-/// also has track 12 on the leader, 1 m off (farther than 9, so not a switch). False targets: track 20 on frames 2
-/// and 3, track 21 on frame 6.
+/// also has track 12 on the leader, 1 m off (the leader is track 9's there: a duplicate, not a switch, not an id).
+/// False targets: track 20 on frames 2 and 3, track 21 on frame 6.
 std::string write_switches(const testing::TempDir& dir) {
   std::vector<testing::LogEvent> events;
   for (int k = 0; k < 10; ++k) {
@@ -281,6 +281,35 @@ std::string write_switches(const testing::TempDir& dir) {
   const std::string path = dir.file("switches.lcmlog");
   testing::write_log(path, events);
   return path;
+}
+
+TEST(Eval, ANeighboursTrackPassingNearerTheLeaderIsNotTheLeadersIdentity) {
+  // The leader (1) at (0, 10, 5) is track 3 throughout, 0.6 m off; vehicle 2 stands 2 m east of it, track 4, 0.5 m
+  // off, except in frames 4-6, where track 4 (a neighbour's track coasting through a crossing with a range error) lies
+  // 0.5 m from the leader, nearer than track 3. One to one, each track keeps its vehicle: no switch and one id each
+  // (matched to the nearest vehicle independently, the leader had two ids and two switches).
+  testing::TempDir dir;
+  std::vector<testing::LogEvent> events;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t u = kT0 + k * 100000;
+    events.push_back(make_event(
+        "GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5), vehicle(2, 2, 10, 5)}), u));
+    const double x4 = k >= 4 && k <= 6 ? 0.5 : 2.5;
+    events.push_back(
+        make_event("TARGETS", targets_msg(u, {world_target(3, -0.6, 10, 5, u), world_target(4, x4, 10, 5, u)}), u));
+  }
+  EvalOptions o;
+  o.log = dir.file("neighbour.lcmlog");
+  testing::write_log(o.log, events);
+  const EvalResult r = evaluate_log(o);
+  EXPECT_EQ(r.track_ids_on_leader, 1);
+  EXPECT_EQ(r.leader_id_switches, 0);
+  ASSERT_EQ(r.ids_by_vehicle.size(), 2u);
+  EXPECT_EQ(r.ids_by_vehicle.at(2).track_ids, 1);
+  EXPECT_EQ(r.ids_by_vehicle.at(2).id_switches, 0);
+  EXPECT_EQ(r.target_estimates, 20);
+  EXPECT_EQ(r.duplicate_targets, 0);
+  EXPECT_EQ(r.false_targets, 0);
 }
 
 TEST(Eval, CountsTrackIdsAndSwitchesOfEveryVehicleNotOnlyTheLeaders) {
@@ -347,17 +376,20 @@ TEST(Eval, CountsLeaderIdSwitchesAndFalseTracks) {
   o.csv_path = dir.file("targets.csv");
   const EvalResult r = evaluate_log(o);
   EXPECT_EQ(r.leader_id_switches, 2);
-  EXPECT_EQ(r.track_ids_on_leader, 3);  // 7, 9, 12
+  EXPECT_EQ(r.track_ids_on_leader, 2);  // 7, 9 (12 is a duplicate: one target per vehicle and message)
+  EXPECT_EQ(r.duplicate_targets, 1);
+  EXPECT_EQ(r.target_estimates, 10);
   EXPECT_EQ(r.false_targets, 3);
   EXPECT_EQ(r.false_track_ids, 2);
   EXPECT_NEAR(r.duration_s, 0.9, 1e-12);
   EXPECT_NEAR(r.false_targets_per_s, 3 / 0.9, 1e-9);
   EXPECT_NE(r.report().find("2 id switch(es)"), std::string::npos) << r.report();
-  // CSV: a header and one row per world target (10 + 1 + 3); a false target has no truth.
+  EXPECT_NE(r.report().find("10 matched, 3 false, 1 duplicate"), std::string::npos) << r.report();
+  // CSV: a header and one row per matched or false world target (10 + 3); a false target has no truth.
   std::ifstream csv(o.csv_path);
   std::vector<std::string> lines;
   for (std::string line; std::getline(csv, line);) lines.push_back(line);
-  ASSERT_EQ(lines.size(), 15u);
+  ASSERT_EQ(lines.size(), 14u);
   EXPECT_EQ(lines[0],
             "t_s,track_id,vehicle_id,range_m,est_x,est_y,est_z,truth_x,truth_y,truth_z,error_m,range_est_m,radius_m,"
             "radius_sigma_m,camera_id");

@@ -153,24 +153,67 @@ struct Match {
   Eigen::Vector3d p_truth = Eigen::Vector3d::Zero();
 };
 
-/// The truth vehicle (not the follower) nearest `p_est` (world frame, metres) at utime `u` within
-/// options.match_radius_m (a tie goes to the higher vehicle id).
-Match nearest_vehicle(const std::map<int, TruthTrack>& truth, const EvalOptions& o, int64_t u,
-                      const Eigen::Vector3d& p_est) {
-  Match m;
-  m.distance_m = o.match_radius_m;
-  for (const auto& [id, tr] : truth) {
-    if (id == o.follower_id) continue;
-    Eigen::Vector3d p;
-    if (!tr.at(u, &p)) continue;
-    const double d = (p - p_est).norm();
-    if (d <= m.distance_m) {
-      m.distance_m = d;
-      m.vehicle_id = id;
-      m.p_truth = p;
+/// The matches of every world target (log.estimates' order), one to one in each targets_t (the CLEAR MOT rule): a
+/// vehicle gets at most one target of a message and a target at most one vehicle. A track keeps the vehicle it was
+/// matched to in the last message it was matched in while it is still within the match radius of it and no other
+/// target took it; the rest go by increasing distance. A target within the radius of vehicles that other targets of
+/// the message took is a duplicate (`duplicate` true, vehicle_id -1): not a false target, not in the errors.
+/// So two tracks near one drone (a coasting neighbour at a crossing, a duplicate before its merge) give it one id,
+/// not two, and a neighbour's track that passes nearer to it is not counted as its identity.
+struct OneToOne {
+  std::vector<Match> match;
+  std::vector<bool> duplicate;
+};
+
+OneToOne match_one_to_one(const EvalLog& log, const EvalOptions& o) {
+  OneToOne out;
+  out.match.resize(log.estimates.size());
+  out.duplicate.assign(log.estimates.size(), false);
+  std::map<int, int> vehicle_of_track;  // the vehicle each track was last matched to
+  size_t begin = 0;
+  while (begin < log.estimates.size()) {
+    size_t end = begin;
+    while (end < log.estimates.size() && log.estimates[end].message == log.estimates[begin].message) ++end;
+    // Every (target, vehicle) pair within the radius.
+    struct Pair {
+      size_t target;
+      Match m;
+    };
+    std::vector<Pair> pairs;
+    for (size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d p_est = geometry::to_vector3(log.estimates[i].target.p_target_in_world);
+      for (const auto& [id, tr] : log.truth) {
+        if (id == o.follower_id) continue;
+        Eigen::Vector3d p;
+        if (!tr.at(log.estimates[i].utime, &p)) continue;
+        const double d = (p - p_est).norm();
+        if (d <= o.match_radius_m) pairs.push_back({i, Match{id, d, p}});
+      }
     }
+    std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+      return a.m.distance_m < b.m.distance_m || (a.m.distance_m == b.m.distance_m && a.m.vehicle_id > b.m.vehicle_id);
+    });
+    std::set<size_t> targets_taken;
+    std::set<int> vehicles_taken;
+    const auto take = [&](const Pair& x) {
+      out.match[x.target] = x.m;
+      targets_taken.insert(x.target);
+      vehicles_taken.insert(x.m.vehicle_id);
+      vehicle_of_track[log.estimates[x.target].target.track_id] = x.m.vehicle_id;
+    };
+    for (const Pair& x : pairs) {  // the correspondences of the previous match first
+      const auto it = vehicle_of_track.find(log.estimates[x.target].target.track_id);
+      if (it != vehicle_of_track.end() && it->second == x.m.vehicle_id && !targets_taken.count(x.target) &&
+          !vehicles_taken.count(x.m.vehicle_id))
+        take(x);
+    }
+    for (const Pair& x : pairs)
+      if (!targets_taken.count(x.target) && !vehicles_taken.count(x.m.vehicle_id)) take(x);
+    for (const Pair& x : pairs)
+      if (!targets_taken.count(x.target)) out.duplicate[x.target] = true;
+    begin = end;
   }
-  return m;
+  return out;
 }
 
 /// Track ids of the matched and false targets, and per targets_t the match nearest each vehicle.
@@ -258,9 +301,15 @@ void localization_metrics(const EvalLog& log, const EvalOptions& o, EvalResult* 
   BinnedAcc by_range(o.range_bins_m);
   TrackIds ids;
   const TruthTrack* follower = log.truth.count(o.follower_id) ? &log.truth.at(o.follower_id) : nullptr;
-  for (const auto& [u, message, t] : log.estimates) {
+  const OneToOne matches = match_one_to_one(log, o);
+  for (size_t i = 0; i < log.estimates.size(); ++i) {
+    const auto& [u, message, t] = log.estimates[i];
     const Eigen::Vector3d p_est = geometry::to_vector3(t.p_target_in_world);
-    const Match m = nearest_vehicle(log.truth, o, u, p_est);
+    if (matches.duplicate[i]) {
+      ++r->duplicate_targets;
+      continue;
+    }
+    const Match& m = matches.match[i];
     const double t_s = seconds_since(t0, u);
     Eigen::Vector3d p_f;
     const bool have_follower = follower && follower->at(u, &p_f);

@@ -86,8 +86,12 @@ std::string EvalResult::report() const {
                      bin_name(RangeBin{b.lo_m, b.hi_m, {}}), percent(b.detected, b.visible), b.visible, b.detected,
                      b.false_boxes, b.frames_with_false_box);
   }
-  s += fmt::format("world targets: {} matched, {} false; {} track id(s) on the leader, {} id switch(es)\n",
-                   target_estimates, false_targets, track_ids_on_leader, leader_id_switches);
+  s += fmt::format("world targets: {} matched, {} false{}; {} track id(s) on the leader, {} id switch(es)\n",
+                   target_estimates, false_targets,
+                   duplicate_targets > 0
+                       ? fmt::format(", {} duplicate (near a vehicle another target took)", duplicate_targets)
+                       : "",
+                   track_ids_on_leader, leader_id_switches);
   s += fmt::format("false tracks: {:.3f} false targets per second, {} distinct false track id(s)\n",
                    false_targets_per_s, false_track_ids);
   if (ids_by_vehicle.size() > 1) {  // several targets: each one's identities
@@ -150,6 +154,7 @@ std::string EvalResult::json() const {
   j["frames_leader_visible_with_false_box"] = frames_leader_visible_with_false_box;
   j["target_estimates"] = target_estimates;
   j["false_targets"] = false_targets;
+  j["duplicate_targets"] = duplicate_targets;
   j["false_targets_per_s"] = false_targets_per_s;
   j["false_track_ids"] = false_track_ids;
   j["track_ids_on_leader"] = track_ids_on_leader;

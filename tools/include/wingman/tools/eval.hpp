@@ -100,14 +100,19 @@ struct EvalResult {
   /// have at least one. The sums of detection_by_range's false_boxes and frames_with_false_box.
   int64_t false_boxes_leader_visible = 0;
   int64_t frames_leader_visible_with_false_box = 0;
-  int64_t target_estimates = 0;  ///< world-valid targets matched to a truth vehicle
+  /// World-valid targets matched to a truth vehicle: one to one in each targets_t (a vehicle at most one target; a
+  /// track keeps its vehicle while it stays within match_radius_m of it, the rest by increasing distance).
+  int64_t target_estimates = 0;
   /// World-valid targets farther than match_radius_m from every truth vehicle but the follower (target samples).
   int64_t false_targets = 0;
+  /// World-valid targets within match_radius_m of vehicles only that other targets of the same targets_t took (a
+  /// second track on one drone, a neighbour's track passing near it): neither matched nor false.
+  int64_t duplicate_targets = 0;
   double false_targets_per_s = 0.0;  ///< false_targets / duration_s
   int64_t false_track_ids = 0;       ///< distinct track ids among the false targets
   int64_t track_ids_on_leader = 0;   ///< distinct track ids matched to the leader
-  /// Changes of the leader's track id: in each targets_t (log order) the target matched to the leader nearest to
-  /// it gives the id; every change from one message with a leader target to the next one with one counts.
+  /// Changes of the leader's track id: in each targets_t (log order) the target matched to the leader gives the id;
+  /// every change from one message with a leader target to the next one with one counts.
   int64_t leader_id_switches = 0;
   /// Every truth vehicle but the follower that a world target was matched to, the leader included: distinct track
   /// ids and id switches, counted as for the leader (several targets: crossings keep or swap identities).
