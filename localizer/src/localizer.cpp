@@ -420,6 +420,9 @@ std::vector<std::vector<int32_t>> Localizer::occluded_tracks(
         const Eigen::Vector4d& p = boxes[a].second;
         const Eigen::Vector4d& q = boxes[b].second;
         if (p[0] >= q[2] || q[0] >= p[2] || p[1] >= q[3] || q[1] >= p[3]) continue;  // apart
+        // One drone followed twice (their states agree: the merge rule will join them) is no occlusion: coasting would
+        // only leave the drone's track without updates until the merge.
+        if (tracker_.agree(boxes[a].first, boxes[b].first)) continue;
         for (const int32_t id : {boxes[a].first, boxes[b].first})
           if (std::find(out[c].begin(), out[c].end(), id) == out[c].end()) out[c].push_back(id);
       }

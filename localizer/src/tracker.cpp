@@ -398,6 +398,17 @@ bool Tracker::same_target(const Track& a, const Track& b) const {
   return d.dot((a.sc.P + b.sc.P).ldlt().solve(d)) < options_.merge_chi2;
 }
 
+bool Tracker::agree(int32_t id_a, int32_t id_b) const {
+  const auto find = [this](int32_t id) -> const Track* {
+    for (const Track& t : tracks_)
+      if (t.id == id && id > 0) return &t;
+    return nullptr;
+  };
+  const Track* a = find(id_a);
+  const Track* b = find(id_b);
+  return a != nullptr && b != nullptr && a != b && same_target(*a, *b);
+}
+
 bool Tracker::duplicates_a_confirmed_track(const Track& t) const {
   for (const Track& c : tracks_)
     if (c.id > 0 && &c != &t && same_target(c, t)) return true;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -91,6 +92,42 @@ TEST(TrackerCameras, AFrameOfACameraThatCouldNotSeeTheTrackIsNoMiss) {
       EXPECT_EQ(t.stats().out_of_view, 0);
     }
   }
+}
+
+TEST(TrackerCameras, TwoConfirmedTracksAgreeOnlyWhenTheirStatesDo) {
+  // agree(): one target followed twice (merge_chi2), which the Localizer's occlusion rule leaves alone. Two drones
+  // 3 m apart are confirmed; then the second flies onto the first at 1 m/s and stays there (merges kept off): their
+  // tracks come to agree; a third drone 20 m away agrees with neither.
+  TrackerOptions o;
+  o.merge_after_s = 100.0;  // no merge within the test
+  Tracker t(o);
+  const Eigen::Vector3d a(8.0, 0.0, 0.5), far(8.0, 20.0, 0.5);
+  const auto b = [&](int k) {  // 3 m north of a until frame 15, then onto it in 3 s (1 m/s)
+    const double along = std::clamp((k - 15) / 90.0, 0.0, 1.0);
+    return Eigen::Vector3d(a + Eigen::Vector3d(0.0, 3.0 * (1.0 - along), 0.0));
+  };
+  std::vector<int32_t> ids;  // the tracks on a and b once both are confirmed (frame 12), and the far one's
+  const auto nearest = [&](const std::vector<TrackOutput>& out, const Eigen::Vector3d& p) {
+    int32_t id = 0;
+    double best = 1e9;
+    for (const TrackOutput& x : out)
+      if ((x.p_target_in_world - p).norm() < best) best = (x.p_target_in_world - p).norm(), id = x.track_id;
+    return id;
+  };
+  for (int k = 0; k < 200; ++k) {
+    const int64_t u = frame_utime(k);
+    ASSERT_TRUE(t.update_cameras(u, {{meas(a, 0, 0.1), meas(b(k), 0, 0.1), meas(far, 0, 0.1)}}));
+    if (k == 12) {
+      const std::vector<TrackOutput> out = t.confirmed(u);
+      ASSERT_EQ(out.size(), 3u);
+      ids = {nearest(out, a), nearest(out, b(k)), nearest(out, far)};
+      EXPECT_FALSE(t.agree(ids[0], ids[1])) << "3 m apart";
+    }
+  }
+  EXPECT_TRUE(t.agree(ids[0], ids[1])) << "one drone followed twice for 3 s";
+  EXPECT_FALSE(t.agree(ids[0], ids[2]));
+  EXPECT_FALSE(t.agree(ids[0], ids[0])) << "a track with itself";
+  EXPECT_FALSE(t.agree(ids[0], 99)) << "an unknown id";
 }
 
 TEST(TrackerCameras, ATrackOneCameraLosesAndTheNextTakesLivesOn) {

@@ -233,6 +233,9 @@ class Tracker {
   /// max_prediction_s past the state): where each will be at the next exposure (tracker-driven windows).
   std::vector<TrackOutput> predicted_tracks(int64_t predict_to_utime) const;
 
+  /// Whether confirmed tracks `id_a` and `id_b` agree in state (merge_chi2, their last frame's states): one target
+  /// followed twice, which the merge rule will join. False for an unknown id or with merge_chi2 0.
+  bool agree(int32_t id_a, int32_t id_b) const;
   /// Tentative tracks that have their M hits but are held back by confirm_min_confidence right now.
   size_t num_held() const;
   /// Tentative (not yet confirmed) tracks held.
