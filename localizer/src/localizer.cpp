@@ -235,6 +235,12 @@ std::string Localizer::cameras_summary() const {
 
 namespace {
 
+/// Ratio 1: ground-truth detections are the sphere's boxes (built once, not per frame).
+const BoxRelation& sphere_relation() {
+  static const BoxRelation sphere = BoxRelation::sphere();
+  return sphere;
+}
+
 /// The camera-frame targets of `measurements` (no own pose: untracked), of camera `d.camera_id`, appended to `out`.
 void append_camera_frame_targets(const wingman::detections_t& d, const std::vector<CameraMeasurement>& measurements,
                                  wingman::targets_t& out) {
@@ -327,12 +333,16 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
   }
   // A rig: a track none of this exposure's cameras could see is not missed by it (cameras not triggered together make
   // every exposure one camera's; a track in another camera's view would otherwise miss three frames of four).
+  // Each camera of the exposure in the world at its time, once (the view test, the occlusion rule and the windows).
+  std::vector<CameraPoseInWorld> cam_in_world(per_camera.size());
+  for (size_t c = 0; c < per_camera.size(); ++c)
+    if (per_camera[c] != nullptr) cam_in_world[c] = camera_pose_in_world(cameras_[c].extrinsics, *pose);
   FrameViews views;
   if (rig_) {
     views.could_see = [&](const Eigen::Vector3d& p_target_in_world) {
       for (size_t c = 0; c < per_camera.size(); ++c) {
         if (per_camera[c] == nullptr) continue;
-        const CameraPoseInWorld cam = camera_pose_in_world(cameras_[c].extrinsics, *pose);
+        const CameraPoseInWorld& cam = cam_in_world[c];
         const Eigen::Vector3d p_in_cam = cam.R_cam_to_world.transpose() * (p_target_in_world - cam.p_cam_in_world);
         if (!(p_in_cam.z() > 1e-3 * p_in_cam.norm())) continue;  // behind the camera or beside it
         const Eigen::Vector2d uv = cameras_[c].camera.project(p_in_cam);
@@ -342,7 +352,7 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
       return false;
     };
   }
-  if (options_.tracker.occlusion_coast) views.occluded = occluded_tracks(utime, per_camera, *pose);
+  if (options_.tracker.occlusion_coast) views.occluded = occluded_tracks(utime, per_camera, cam_in_world);
   if (!tracker_.update_cameras(utime, world, &why, views)) {
     throw std::invalid_argument("detections_t.utime = " + std::to_string(utime) + ": " + why);
   }
@@ -350,7 +360,7 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
   for (size_t c = 0; c < per_camera.size(); ++c) {
     if (per_camera[c] == nullptr) continue;
     if (options_.windows.publish) {
-      wingman::track_windows_t w = track_windows(utime, cameras_[c], first->source, *pose);
+      wingman::track_windows_t w = track_windows(utime, cameras_[c], first->source, *pose, cam_in_world[c]);
       if (rig_) {
         result.camera_windows.push_back({cameras_[c].windows_channel, std::move(w)});
       } else {
@@ -391,26 +401,25 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
 }
 
 std::vector<std::vector<int32_t>> Localizer::occluded_tracks(
-    int64_t utime, const std::vector<const wingman::detections_t*>& per_camera, const PoseSample& pose) const {
+    int64_t utime, const std::vector<const wingman::detections_t*>& per_camera,
+    const std::vector<CameraPoseInWorld>& cam_in_world) const {
   std::vector<std::vector<int32_t>> out(per_camera.size());
   if (tracker_.num_confirmed() < 2) return out;
   std::vector<TrackOutput> tracks = tracker_.predicted_tracks(utime);
   tracks.erase(std::remove_if(tracks.begin(), tracks.end(), [](const TrackOutput& t) { return !t.confirmed; }),
                tracks.end());
-  static const BoxRelation sphere = BoxRelation::sphere();
   const double m = options_.tracker.occlusion_margin;
   for (size_t c = 0; c < per_camera.size(); ++c) {
     if (per_camera[c] == nullptr) continue;
     const bool ground_truth = per_camera[c]->source == wingman::detections_t::SOURCE_GROUND_TRUTH;
-    const CameraPoseInWorld now = camera_pose_in_world(cameras_[c].extrinsics, pose);
     CameraAtExposure cam;
-    cam.R_cam_to_world = now.R_cam_to_world;
-    cam.p_cam_in_world = now.p_cam_in_world;
+    cam.R_cam_to_world = cam_in_world[c].R_cam_to_world;
+    cam.p_cam_in_world = cam_in_world[c].p_cam_in_world;
     // Each track's predicted box, grown by the margin on every side: left, top, right, bottom.
     std::vector<std::pair<int32_t, Eigen::Vector4d>> boxes;
     for (const TrackOutput& t : tracks) {
       const auto w = predict_track_window(t, options_.sphere.radius_m, cameras_[c].camera, cam,
-                                          ground_truth ? sphere : cnn_relation_);
+                                          ground_truth ? sphere_relation() : cnn_relation_);
       if (!w) continue;
       const double hw = (0.5 + m) * w->w, hh = (0.5 + m) * w->h;
       boxes.push_back({t.track_id, Eigen::Vector4d(w->cx - hw, w->cy - hh, w->cx + hw, w->cy + hh)});
@@ -431,7 +440,7 @@ std::vector<std::vector<int32_t>> Localizer::occluded_tracks(
 }
 
 wingman::track_windows_t Localizer::track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
-                                                  const PoseSample& pose) const {
+                                                  const PoseSample& pose, const CameraPoseInWorld& now) const {
   // The camera's next exposure: one of its frame intervals (the last one seen, at most 0.5 s) after this one.
   constexpr int64_t kMaxInterval_us = 500000;
   const int64_t interval_us =
@@ -444,19 +453,17 @@ wingman::track_windows_t Localizer::track_windows(int64_t utime, const Localizer
   out.image_height = c.camera.height();
   // The camera then: the pose at this exposure moved on with the body's velocity (its rotation held).
   const double dt = static_cast<double>(interval_us) * 1e-6;
-  const CameraPoseInWorld now = camera_pose_in_world(c.extrinsics, pose);
   CameraAtExposure cam;
   cam.R_cam_to_world = now.R_cam_to_world;
   cam.v_cam_in_world = pose.v_body_in_world;
   cam.p_cam_in_world = now.p_cam_in_world + dt * pose.v_body_in_world;
   const bool ground_truth = source == wingman::detections_t::SOURCE_GROUND_TRUTH;
-  static const BoxRelation sphere = BoxRelation::sphere();  // built once, not per frame
   for (const TrackOutput& t : tracker_.predicted_tracks(out.utime_predicted)) {
     if (static_cast<int>(out.windows.size()) >= options_.windows.max_windows) break;
     // The box relation holds for full-resolution re-detections too (measured: docs/detector.md, "Tracker-driven
     // windows").
-    if (auto w =
-            predict_track_window(t, options_.sphere.radius_m, c.camera, cam, ground_truth ? sphere : cnn_relation_))
+    if (auto w = predict_track_window(t, options_.sphere.radius_m, c.camera, cam,
+                                      ground_truth ? sphere_relation() : cnn_relation_))
       out.windows.push_back(*w);
   }
   out.num_windows = static_cast<int32_t>(out.windows.size());

@@ -6,6 +6,7 @@
 #include <wingman/geometry/camera_rig.hpp>
 #include <wingman/geometry/extrinsics.hpp>
 #include "wingman/localizer/box_relation.hpp"
+#include "wingman/localizer/camera_to_world.hpp"
 #include "wingman/localizer/localizer_options.hpp"
 #include "wingman/localizer/pose_buffer.hpp"
 #include "wingman/localizer/tracker.hpp"
@@ -186,13 +187,15 @@ class Localizer {
   /// it had sent nothing. For one camera the same (its bookkeeping is unused).
   void restart(const LocalizerCamera* keep);
   /// Per camera of the exposure (null: none), the confirmed tracks occluding each other there
-  /// (tracker.occlusion_margin; FrameViews::occluded), their states predicted to `utime`, camera `c` at `pose`.
+  /// (tracker.occlusion_margin; FrameViews::occluded), their states predicted to `utime`, camera c at
+  /// `cam_in_world[c]`.
   std::vector<std::vector<int32_t>> occluded_tracks(int64_t utime,
                                                     const std::vector<const wingman::detections_t*>& per_camera,
-                                                    const PoseSample& pose) const;
-  /// The windows of the tracks after the exposure at `utime`, camera `c` at `pose` (the own pose at utime).
-  wingman::track_windows_t track_windows(int64_t utime, const LocalizerCamera& c, int8_t source,
-                                         const PoseSample& pose) const;
+                                                    const std::vector<CameraPoseInWorld>& cam_in_world) const;
+  /// The windows of the tracks after the exposure at `utime`: camera `c` at `now` then, moving with the body's
+  /// velocity of `pose` (the own pose at utime).
+  wingman::track_windows_t track_windows(int64_t utime, const LocalizerCamera& c, int8_t source, const PoseSample& pose,
+                                         const CameraPoseInWorld& now) const;
 
   LocalizerOptions options_;
   bool rig_ = false;
