@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -283,25 +284,32 @@ std::string write_switches(const testing::TempDir& dir) {
   return path;
 }
 
-TEST(Eval, ANeighboursTrackPassingNearerTheLeaderIsNotTheLeadersIdentity) {
-  // The leader (1) at (0, 10, 5) is track 3 throughout, 0.6 m off; vehicle 2 stands 2 m east of it, track 4, 0.5 m
-  // off, except in frames 4-6, where track 4 (a neighbour's track coasting through a crossing with a range error) lies
-  // 0.5 m from the leader, nearer than track 3. One to one, each track keeps its vehicle: no switch and one id each
-  // (matched to the nearest vehicle independently, the leader had two ids and two switches).
+/// Ten frames of the follower at the origin, the leader (1) at (0, 10, 5) and vehicle 2 at (`x2`, 10, 5), with the
+/// targets `targets(k, utime)` of frame k, evaluated with the default options.
+EvalResult evaluate_two_drones(double x2, const std::function<std::vector<target_t>(int, int64_t)>& targets) {
   testing::TempDir dir;
   std::vector<testing::LogEvent> events;
   for (int k = 0; k < 10; ++k) {
     const int64_t u = kT0 + k * 100000;
     events.push_back(make_event(
-        "GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5), vehicle(2, 2, 10, 5)}), u));
-    const double x4 = k >= 4 && k <= 6 ? 0.5 : 2.5;
-    events.push_back(
-        make_event("TARGETS", targets_msg(u, {world_target(3, -0.6, 10, 5, u), world_target(4, x4, 10, 5, u)}), u));
+        "GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5), vehicle(2, x2, 10, 5)}), u));
+    events.push_back(make_event("TARGETS", targets_msg(u, targets(k, u)), u));
   }
   EvalOptions o;
-  o.log = dir.file("neighbour.lcmlog");
+  o.log = dir.file("two.lcmlog");
   testing::write_log(o.log, events);
-  const EvalResult r = evaluate_log(o);
+  return evaluate_log(o);
+}
+
+TEST(Eval, ANeighboursTrackPassingNearerTheLeaderIsNotTheLeadersIdentity) {
+  // The leader (1) at (0, 10, 5) is track 3 throughout, 0.6 m off; vehicle 2 stands 2 m east of it, track 4, 0.5 m
+  // off, except in frames 4-6, where track 4 (a neighbour's track coasting through a crossing with a range error) lies
+  // 0.5 m from the leader, nearer than track 3. One to one, each track keeps its vehicle: no switch and one id each
+  // (matched to the nearest vehicle independently, the leader had two ids and two switches).
+  const EvalResult r = evaluate_two_drones(2.0, [](int k, int64_t u) {
+    const double x4 = k >= 4 && k <= 6 ? 0.5 : 2.5;
+    return std::vector<target_t>{world_target(3, -0.6, 10, 5, u), world_target(4, x4, 10, 5, u)};
+  });
   EXPECT_EQ(r.track_ids_on_leader, 1);
   EXPECT_EQ(r.leader_id_switches, 0);
   ASSERT_EQ(r.ids_by_vehicle.size(), 2u);
@@ -315,19 +323,9 @@ TEST(Eval, ANeighboursTrackPassingNearerTheLeaderIsNotTheLeadersIdentity) {
 TEST(Eval, CountsTrackIdsAndSwitchesOfEveryVehicleNotOnlyTheLeaders) {
   // Two targets (a crossing scenario): the leader (1) keeps track 3; vehicle 2, 5 m beside it, is track 4 for four
   // frames, then track 5: 2 ids, 1 switch.
-  testing::TempDir dir;
-  std::vector<testing::LogEvent> events;
-  for (int k = 0; k < 10; ++k) {
-    const int64_t u = kT0 + k * 100000;
-    events.push_back(make_event(
-        "GROUND_TRUTH", truth_frame(k, u, {vehicle(0, 0, 0, 5), vehicle(1, 0, 10, 5), vehicle(2, 5, 10, 5)}), u));
-    events.push_back(make_event(
-        "TARGETS", targets_msg(u, {world_target(3, 0, 10, 5, u), world_target(k < 4 ? 4 : 5, 5, 10, 5, u)}), u));
-  }
-  EvalOptions o;
-  o.log = dir.file("two.lcmlog");
-  testing::write_log(o.log, events);
-  const EvalResult r = evaluate_log(o);
+  const EvalResult r = evaluate_two_drones(5.0, [](int k, int64_t u) {
+    return std::vector<target_t>{world_target(3, 0, 10, 5, u), world_target(k < 4 ? 4 : 5, 5, 10, 5, u)};
+  });
   ASSERT_EQ(r.ids_by_vehicle.size(), 2u);
   EXPECT_EQ(r.ids_by_vehicle.at(1).track_ids, 1);
   EXPECT_EQ(r.ids_by_vehicle.at(1).id_switches, 0);
