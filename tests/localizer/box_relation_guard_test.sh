@@ -32,4 +32,11 @@ rows=$(($(wc -l < "$work/samples.csv") - 1))
   { echo "box_relation_guard: FAIL: --samples has $rows rows for ${found:-?} targets found" >&2; exit 1; }
 bad=$(awk -F, 'NR > 1 && !($4 > 0.1 && $4 < $3) {n++} END {print n + 0}' "$work/samples.csv")
 [ "$bad" -eq 0 ] || { echo "box_relation_guard: FAIL: $bad rows without 0.1 < frame_radius_m < radius_m" >&2; exit 1; }
-echo "box_relation_guard: --samples: $rows rows, frame radii within (0.1 m, bounding radius)"
+# ... and its range error under the relation checked (within the report's |error| p90 bound of 1) and its image.
+bad=$(awk -F, 'NR > 1 && !($13 + 0 == $13 && $13 > -1 && $13 < 1) {n++} END {print n + 0}' "$work/samples.csv")
+[ "$bad" -eq 0 ] || { echo "box_relation_guard: FAIL: $bad rows without a range_error in (-1, 1)" >&2; exit 1; }
+missing=0
+while IFS= read -r image; do [ -f "$work/set/$image" ] || missing=$((missing + 1)); done < <(
+  tail -n +2 "$work/samples.csv" | cut -d, -f14 | tr -d '"')
+[ "$missing" -eq 0 ] || { echo "box_relation_guard: FAIL: $missing rows name an image not in the set" >&2; exit 1; }
+echo "box_relation_guard: --samples: $rows rows, frame radii within (0.1 m, bounding radius), range errors, images"

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -37,9 +38,12 @@ struct Sample {
   double frame_radius_m = 0;  ///< without propellers; 0: the render did not say
   double elevation_deg = 0;   ///< the camera seen from the target: above (+) or below (-) its horizontal plane
   double det_w = 0, det_h = 0, image_w = 0;
-  double sphere_w = 0, sphere_h = 0;
+  double sphere_w = 0, sphere_h = 0, sphere_cx = 0, sphere_cy = 0;
   double width_ratio = 0, height_ratio = 0;  // detected / sphere box
   geometry::PixelBox det;
+  std::string image;       ///< the render's image, relative to the set's folder
+  /// range / true range - 1 under the relation fitted or checked (exact localizer); NaN: no range (behind the camera)
+  double range_error = std::numeric_limits<double>::quiet_NaN();
   std::shared_ptr<const geometry::CameraModel> camera;
 };
 
@@ -290,8 +294,9 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
         s.elevation_deg = std::atan2(dz, std::hypot(dx, dy)) * 180.0 / M_PI;
       }
       s.det = det, s.det_w = det.w, s.det_h = det.h, s.image_w = W;
-      s.sphere_w = sphere.w, s.sphere_h = sphere.h;
+      s.sphere_w = sphere.w, s.sphere_h = sphere.h, s.sphere_cx = sphere.cx, s.sphere_cy = sphere.cy;
       s.width_ratio = det.w / sphere.w, s.height_ratio = det.h / sphere.h;
+      s.image = meta.at("image").get<std::string>();
       s.camera = camera;
       samples.push_back(std::move(s));
     } catch (const nlohmann::json::exception& e) {
@@ -303,18 +308,6 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   images.update(static_cast<int64_t>(metas.size()), fmt::format("{} targets found", summary.matched));
   images.finish();
   if (samples.empty()) throw std::runtime_error("the detector found none of the targets: nothing to measure");
-  if (!rq.samples_csv.empty()) {
-    std::ofstream csv(rq.samples_csv);
-    if (!csv) throw std::runtime_error(rq.samples_csv + ": cannot write the samples (--samples)");
-    csv << "airframe,range_m,radius_m,frame_radius_m,elevation_deg,image_w,det_w,det_h,sphere_w,sphere_h,width_ratio,"
-           "height_ratio\n";
-    for (const Sample& s : samples)
-      csv << fmt::format("\"{}\",{:.4f},{:.4f},{:.4f},{:.2f},{:g},{:.3f},{:.3f},{:.3f},{:.3f},{:.5f},{:.5f}\n",
-                         s.airframe, s.range_m, s.radius_m, s.frame_radius_m, s.elevation_deg, s.image_w, s.det_w,
-                         s.det_h, s.sphere_w, s.sphere_h, s.width_ratio, s.height_ratio);
-    if (!csv) throw std::runtime_error(rq.samples_csv + ": write failed (--samples)");
-  }
-
   localizer::BoxRelation relation;
   if (!rq.check.empty()) {
     relation = localizer::BoxRelation::load(rq.check);
@@ -333,10 +326,11 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   const auto& tb = relation.table();
   const size_t m = tb.aspect_edges.empty() ? 1 : tb.aspect_edges.size() - 1;
   std::vector<std::vector<double>> residual_by_bin(relation.is_sphere() ? 0 : (tb.size_edges.size() - 1) * m);
-  for (const Sample& s : samples) {
+  for (Sample& s : samples) {
     const auto es = range_error(s, sphere);
     const auto er = range_error(s, relation);
     if (!es || !er) continue;
+    s.range_error = *er;
     e_sphere_all.push_back(*es), e_sphere_af[s.airframe].push_back(*es);
     e_rel_all.push_back(*er), e_rel_af[s.airframe].push_back(*er), e_rel_range[range_bin(s.range_m)].push_back(*er);
     if (!residual_by_bin.empty()) residual_by_bin[tb.cell(s.det_w / s.image_w, s.det_h / s.det_w)].push_back(*er);
@@ -345,6 +339,21 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   for (const auto& [k, v] : e_sphere_af) summary.sphere_by_airframe[k] = stats_of(v);
   for (const auto& [k, v] : e_rel_af) summary.relation_by_airframe[k] = stats_of(v);
   for (const auto& [k, v] : e_rel_range) summary.relation_by_range[k] = stats_of(v);
+
+  if (!rq.samples_csv.empty()) {
+    std::ofstream csv(rq.samples_csv);
+    if (!csv) throw std::runtime_error(rq.samples_csv + ": cannot write the samples (--samples)");
+    csv << "airframe,range_m,radius_m,frame_radius_m,elevation_deg,image_w,det_w,det_h,sphere_w,sphere_h,width_ratio,"
+           "height_ratio,range_error,image,det_cx,det_cy,sphere_cx,sphere_cy\n";
+    for (const Sample& s : samples)
+      csv << fmt::format(
+          "\"{}\",{:.4f},{:.4f},{:.4f},{:.2f},{:g},{:.3f},{:.3f},{:.3f},{:.3f},{:.5f},{:.5f},{:.5f},\"{}\",{:.3f},{:.3f},"
+          "{:.3f},{:.3f}\n",
+          s.airframe, s.range_m, s.radius_m, s.frame_radius_m, s.elevation_deg, s.image_w, s.det_w, s.det_h, s.sphere_w,
+          s.sphere_h, s.width_ratio, s.height_ratio, s.range_error, s.image, s.det.cx, s.det.cy, s.sphere_cx,
+          s.sphere_cy);
+    if (!csv) throw std::runtime_error(rq.samples_csv + ": write failed (--samples)");
+  }
 
   if (rq.check.empty()) {
     localizer::BoxRelation::Table table = relation.table();

@@ -39,7 +39,8 @@ struct BoxRelationRequest {
   double min_iou = 0.3;
   int max_images = 0;  ///< 0: all
   /// Also write every matched target as one CSV row here (airframe, true range, bounding and frame radius, the
-  /// line of sight's elevation, the detected and sphere boxes, the ratios); "" = none.
+  /// line of sight's elevation, the detected and sphere boxes, the ratios, the range error under the relation, the
+  /// image and both boxes' centres); "" = none.
   std::string samples_csv;
   std::string command_line;  ///< written into the file as measured_with
 };
