@@ -41,7 +41,7 @@ struct Sample {
   double sphere_w = 0, sphere_h = 0, sphere_cx = 0, sphere_cy = 0;
   double width_ratio = 0, height_ratio = 0;  // detected / sphere box
   geometry::PixelBox det;
-  std::string image;       ///< the render's image, relative to the set's folder
+  std::string image;  ///< the render's image, relative to the set's folder
   /// range / true range - 1 under the relation fitted or checked (exact localizer); NaN: no range (behind the camera)
   double range_error = std::numeric_limits<double>::quiet_NaN();
   std::shared_ptr<const geometry::CameraModel> camera;
@@ -347,7 +347,8 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
            "height_ratio,range_error,image,det_cx,det_cy,sphere_cx,sphere_cy\n";
     for (const Sample& s : samples)
       csv << fmt::format(
-          "\"{}\",{:.4f},{:.4f},{:.4f},{:.2f},{:g},{:.3f},{:.3f},{:.3f},{:.3f},{:.5f},{:.5f},{:.5f},\"{}\",{:.3f},{:.3f},"
+          "\"{}\",{:.4f},{:.4f},{:.4f},{:.2f},{:g},{:.3f},{:.3f},{:.3f},{:.3f},{:.5f},{:.5f},{:.5f},\"{}\",{:.3f},{:."
+          "3f},"
           "{:.3f},{:.3f}\n",
           s.airframe, s.range_m, s.radius_m, s.frame_radius_m, s.elevation_deg, s.image_w, s.det_w, s.det_h, s.sphere_w,
           s.sphere_h, s.width_ratio, s.height_ratio, s.range_error, s.image, s.det.cx, s.det.cy, s.sphere_cx,

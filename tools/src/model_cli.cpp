@@ -73,8 +73,9 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.relation->add_option("--model-name", rq.model_name, "The model's name written into the file");
   s.relation->add_option("--min-iou", rq.min_iou, "A detection is the target's at this IoU with its outline box");
   s.relation->add_option("--max-images", rq.max_images, "At most this many images (0: all)");
-  s.relation->add_option("--samples", rq.samples_csv,
-                         "Also write every matched target (geometry, detected and sphere boxes, ratios, range error, image) to this CSV");
+  s.relation->add_option(
+      "--samples", rq.samples_csv,
+      "Also write every matched target (geometry, detected and sphere boxes, ratios, range error, image) to this CSV");
   s.relation->add_option("--max-median-error", s.max_median_error,
                          "Exit 1 when |median range error| over all targets exceeds this (a guard; negative: none)");
   s.relation->add_option("--max-mad", s.max_mad,
