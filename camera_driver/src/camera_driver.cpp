@@ -141,8 +141,11 @@ std::unique_ptr<FrameSource> make_source(const CameraDriverOptions& options, std
 }
 
 CameraDriver::CameraDriver(OutputOptions options, std::unique_ptr<FrameSource> source)
-    : options_(std::move(options)), source_(std::move(source)) {
+    : options_(std::move(options)),
+      source_(std::move(source)),
+      time_offset_us_(std::llround(options_.time_offset_s * 1e6)) {
   if (!source_) throw std::invalid_argument("CameraDriver: source must not be null");
+  if (const auto bad = options_.validate(); !bad.empty()) throw std::invalid_argument(bad.front());
 }
 
 void CameraDriver::open() { source_->open(); }
@@ -183,6 +186,7 @@ DriverStep CameraDriver::step(int timeout_ms) {
     out = &encoded_;
   }
   step.image = to_image_message(std::move(*out), options_.camera_id);  // the next read refills the frame
+  step.image.utime += time_offset_us_;
   ++frames_out_;
   step.convert_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return step;

@@ -5,6 +5,7 @@
 #include <wingman/common/config.hpp>
 
 #include <cctype>
+#include <cmath>
 
 namespace wingman::camera_driver {
 
@@ -26,6 +27,8 @@ std::vector<std::string> OutputOptions::validate() const {
                         "contradicts output.encoding = mjpeg (MJPEG camera frames would be decoded, then encoded "
                         "again); choose one"));
   }
+  if (!std::isfinite(time_offset_s) || std::abs(time_offset_s) > 1.0)
+    p.push_back(problem("output.time_offset_s", time_offset_s, "must be finite, within [-1, 1] s"));
   if (max_frames < 0) {
     p.push_back(problem("output.max_frames", static_cast<double>(max_frames), "must be >= 0 (0 = no limit)"));
   }

@@ -386,6 +386,30 @@ TEST(CameraDriver, MaxFramesEndsTheRun) {
   EXPECT_EQ(driver.frames_out(), 2);
 }
 
+// output.time_offset_s moves every published stamp by the same amount (a camera that stamps 0.13 s after its
+// exposure: -0.13 s), to the microsecond, keeping their order; a bad offset is refused at construction naming the key.
+TEST(CameraDriver, TimeOffsetMovesEveryStampToTheExposure) {
+  auto src = std::make_unique<ScriptedSource>();
+  for (int i = 0; i < 3; ++i) src->items.push_back({ReadResult{ReadStatus::kFrame, 0, "", false}, gray_frame(i, 4, 2)});
+  OutputOptions out;
+  out.time_offset_s = -0.1300004;  // rounds to -130000 us
+  CameraDriver driver(out, std::move(src));
+  for (int64_t i = 0; i < 3; ++i) {
+    const DriverStep step = driver.step(0);
+    ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;
+    EXPECT_EQ(step.image.utime, gray_frame(i, 4, 2).utime - 130'000);
+    EXPECT_EQ(step.image.seq, i);
+  }
+  OutputOptions bad;
+  bad.time_offset_s = 2.0;
+  try {
+    CameraDriver refused(bad, std::make_unique<ScriptedSource>());
+    FAIL() << "an offset of 2 s was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("output.time_offset_s = 2"));
+  }
+}
+
 TEST(CameraDriver, MakeSourceBuildsTheSelectedKind) {
   TempDir dir;
   testing::write_gray_video(dir.file("clip.avi"), 1, 16, 16, 10.0);

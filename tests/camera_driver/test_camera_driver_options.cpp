@@ -59,6 +59,13 @@ TEST(CameraDriverOptions, EncodingIsRawOrMjpegAtAQualityAndNotWithDecodeMjpeg) {
   EXPECT_EQ(load_error("output: {encoding: raw, decode_mjpeg: true}\n"), "");
 }
 
+TEST(CameraDriverOptions, TimeOffsetIsFiniteAndWithinOneSecond) {
+  EXPECT_EQ(load_error("output: {time_offset_s: -0.13}\n"), "");
+  EXPECT_THAT(load_error("output: {time_offset_s: 1.5}\n"),
+              HasSubstr("output.time_offset_s = 1.5: must be finite, within [-1, 1] s"));
+  EXPECT_THAT(load_error("output: {time_offset_s: .nan}\n"), HasSubstr("output.time_offset_s"));
+}
+
 TEST(CameraDriverOptions, FileSourceNeedsAPathButTheCameraDoesNot) {
   EXPECT_EQ(load_error("source: {kind: v4l2}\n"), "");
   EXPECT_THAT(load_error("source: {kind: file}\n"), HasSubstr("file.path"));

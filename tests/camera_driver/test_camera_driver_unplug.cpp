@@ -116,7 +116,9 @@ TEST(CameraDriverLoop, UnplugIsAnErrorHeartbeatUntilTheReplugThenFramesResumeInO
   ASSERT_EQ(p.images.size(), 8u);
   for (size_t i = 0; i < p.images.size(); ++i) {
     EXPECT_EQ(p.images[i].seq, static_cast<int64_t>(i)) << "seq keeps increasing across the replug";
-    if (i > 0) EXPECT_GT(p.images[i].utime, p.images[i - 1].utime) << "utime is monotonic across the replug";
+    if (i > 0) {
+      EXPECT_GT(p.images[i].utime, p.images[i - 1].utime) << "utime is monotonic across the replug";
+    }
   }
   EXPECT_EQ(p.images[4].utime - p.images[3].utime, 1'900'000 + 2 * kFrameUs) << "the gap is the time unplugged";
   EXPECT_EQ(p.statuses.back().drops_total, 0) << "an unplug loses no counted frame in this script";

@@ -59,7 +59,8 @@ std::unique_ptr<FrameSource> make_source(const CameraDriverOptions& options, std
 /// The logic of wingman-camera-driver without LCM: read a frame, check it, convert it, count it.
 class CameraDriver {
  public:
-  /// `source` must not be null; it is opened by open().
+  /// `source` must not be null; it is opened by open(). Throws std::invalid_argument with the first of
+  /// options.validate()'s problems.
   CameraDriver(OutputOptions options, std::unique_ptr<FrameSource> source);
 
   /// Opens the source. Throws std::runtime_error naming the device or file.
@@ -87,6 +88,7 @@ class CameraDriver {
   int64_t frames_out_ = 0;
   int64_t driver_drops_ = 0;
   bool ended_ = false;
+  int64_t time_offset_us_ = 0;  // output.time_offset_s, microseconds
 };
 
 }  // namespace wingman::camera_driver

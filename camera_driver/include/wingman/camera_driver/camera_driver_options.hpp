@@ -34,6 +34,13 @@ struct OutputOptions {
   int max_width = 0;
   /// Stop after publishing this many frames (exit 0); 0 = no limit.
   int64_t max_frames = 0;
+  /// Added to every frame's timestamp before it is published, seconds: from the source's stamp to the exposure the
+  /// localizer should pair with the own pose (the middle of the exposure, in the own pose's clock). Negative when the
+  /// source stamps late: a V4L2 driver stamping the end of the frame or its arrival (USB transfer, readout), a
+  /// camera with a measured lag (the thesis's: 0.13 s). A Kalibr camera-IMU calibration's timeshift_cam_imu
+  /// (t_imu = t_cam + shift) where the own pose runs on that IMU's clock. 0 = stamps as the source gives them.
+  /// Finite, |offset| <= 1 s.
+  double time_offset_s = 0.0;
 
   /// One line per problem naming the key; empty when valid.
   std::vector<std::string> validate() const;
@@ -87,6 +94,9 @@ struct CameraDriverOptions {
     v("output.max_width", output.max_width,
       "raw frames wider than this are downscaled to it (aspect kept; YUYV becomes BGR8), pixels; 0 = as captured");
     v("output.max_frames", output.max_frames, "exit 0 after publishing this many frames; 0 = no limit");
+    v("output.time_offset_s", output.time_offset_s,
+      "added to every frame's timestamp: source stamp -> middle of the exposure in the own pose's clock, s "
+      "(negative for late stamps; Kalibr's timeshift_cam_imu); 0 = as stamped");
     preview.visit(v);
   }
 
