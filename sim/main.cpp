@@ -361,29 +361,47 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
             fmt::format("autopilot: mavlink: no OWN_POSE for frame {} within {} s", frame.index, o.sync.timeout_s));
       }
     }
-    // Every camera's image and detections of this frame, before the lockstep wait (once per frame).
-    for (size_t i = 0; i < outputs.size(); ++i) {
+    // Every camera's image and detections of this frame, before the lockstep wait (once per frame): those exposed at
+    // t_k, then each later exposure (cameras.stagger_s) after its own pose and ground truth.
+    std::vector<std::pair<size_t, const wingman::ground_truth_t*>> order;  // camera index, the truth of its exposure
+    {
+      std::vector<bool> later(outputs.size(), false);
+      for (const sim::SimExposure& e : frame.later)
+        for (const size_t i : e.camera_indices) later[i] = true;
+      for (size_t i = 0; i < outputs.size(); ++i)
+        if (!later[i]) order.emplace_back(i, &frame.truth);
+      for (const sim::SimExposure& e : frame.later)
+        for (const size_t i : e.camera_indices) order.emplace_back(i, &e.truth);
+    }
+    size_t next_later = 0;  // the first exposure of frame.later not published yet
+    for (size_t k = 0; k < order.size(); ++k) {
+      const auto [i, truth] = order[k];
       const sim::SimCameraFrame& view = frame.cameras[i];
       const sim::SimCameraOutput& out = outputs[i];
+      if (next_later < frame.later.size() && truth == &frame.later[next_later].truth) {
+        const sim::SimExposure& e = frame.later[next_later++];
+        if (!mav) rt.publish(o.own_pose_channel, e.own_pose);  // over MAVLink the companion's rate holds
+        rt.publish(o.ground_truth_channel, e.truth);
+      }
       if (!view.bgr.empty()) {
-        rt.publish(out.image_channel, sim::to_image_message(view.bgr, frame.utime, frame.index, view.camera_id));
+        rt.publish(out.image_channel, sim::to_image_message(view.bgr, view.utime, frame.index, view.camera_id));
         if (i == 0) {
-          if (const auto p = preview.offer_bgr(view.bgr, frame.utime, frame.index, view.camera_id))
+          if (const auto p = preview.offer_bgr(view.bgr, view.utime, frame.index, view.camera_id))
             rt.publish(preview_channel, *p);
         }
       }
       if (o.detections.from_ground_truth) {
         rt.publish(out.detections_channel,
-                   sim::truth_detections(frame.truth, frame.index, out.camera.model, view.T_cam_to_world,
-                                         view.camera_id, o.detections, static_cast<int>(i)));
+                   sim::truth_detections(*truth, frame.index, out.camera.model, view.T_cam_to_world, view.camera_id,
+                                         o.detections, static_cast<int>(i)));
       }
-      if (image_by_image && i + 1 < outputs.size() && !view.bgr.empty() && !input_ended) {
+      if (image_by_image && k + 1 < order.size() && !view.bgr.empty() && !input_ended) {
         // One image on the bus at a time: the next camera's waits for this one's detections.
-        if (!wait_until([&] { return newest_detections_utime[i] >= frame.utime; }, o.sync.timeout_s) &&
+        if (!wait_until([&] { return newest_detections_utime[i] >= view.utime; }, o.sync.timeout_s) &&
             !rt.stop_requested()) {
           ++image_by_image_timeouts;
           spdlog::warn("frame {} (utime {}): no detections_t from camera {} on {} within {} s ({} so far); going on",
-                       frame.index, frame.utime, out.camera.camera_id, out.detections_channel, o.sync.timeout_s,
+                       frame.index, view.utime, out.camera.camera_id, out.detections_channel, o.sync.timeout_s,
                        image_by_image_timeouts);
           status.set_error(fmt::format("sync.image_by_image: no detections from camera {} for frame {} within {} s",
                                        out.camera.camera_id, frame.index, o.sync.timeout_s));

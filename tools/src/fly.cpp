@@ -11,6 +11,7 @@
 #include <wingman/sim/scenario.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -83,6 +84,10 @@ std::vector<std::string> FlyOptions::validate() const {
   if (!(duration_s >= 0.0))
     p.push_back(common::problem("flight.duration_s", duration_s, "must be >= 0 seconds (0: the scenario's)"));
   if (scenario.empty()) p.push_back(common::problem("flight.scenario", scenario, "must name a scenario or a file"));
+  if (!(camera_stagger_s >= 0.0) || !std::isfinite(camera_stagger_s))
+    p.push_back(common::problem("cameras.stagger_s", camera_stagger_s, "must be >= 0 seconds (0: together)"));
+  else if (camera_stagger_s > 0 && rig.empty())
+    p.push_back(common::problem("cameras.stagger_s", camera_stagger_s, "needs cameras.rig (--rig)"));
   if (detections == "cnn" && render == "off")
     p.push_back(common::problem("flight.render", render, "cnn detections need images: on or auto"));
   return p;
@@ -214,6 +219,10 @@ FlightPlan plan_flight(const FlyOptions& o) {
     append(sim_sets, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
     plan.notes.push_back(fmt::format("fly: {} cameras from the rig {}, a detector each, fused by the localizer",
                                      rig_cameras.size(), plan.rig_file));
+    if (o.camera_stagger_s > 0) {
+      append(sim_sets, {"--set", fmt::format("cameras.stagger_s={}", o.camera_stagger_s)});
+      plan.notes.push_back(fmt::format("fly: camera i exposes i x {} s after its frame's time", o.camera_stagger_s));
+    }
   }
 
   // The flight's effective simulator configuration, as the loader merged it (a record; the process reads the --set).

@@ -159,6 +159,9 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   f->add_option("--rig", o.rig,
                 "Several cameras: config/rigs/NAME.yaml (under --config-dir) or a rig file; the simulator renders "
                 "each, a detector runs per camera and the localizer fuses them (empty: the one forward camera)");
+  f->add_option("--camera-stagger", o.camera_stagger_s,
+                "With --rig: camera i exposes i x this many seconds after its frame's time (cameras not triggered "
+                "together; the simulator's cameras.stagger_s); 0: together");
   f->add_option("--localizer-config", o.localizer_config,
                 "The localizer's config (empty: config/flights/NAME.localizer.yaml if any, else its defaults)");
   f->add_option("--follower-config", o.follower_config,
@@ -208,6 +211,7 @@ LaunchVerbs::LaunchVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
            {"--coarse-pass", "detector.coarse_pass", false},
            {"--windows", "windows.enabled", false},
            {"--rig", "cameras.rig", true},
+           {"--camera-stagger", "cameras.stagger_s", false},
            {"--localizer-config", "processes.localizer_config", true},
            {"--follower-config", "processes.follower_config", true},
            {"--render-config", "processes.render_config", true},

@@ -67,10 +67,20 @@ std::vector<SimCameraOutput> sim_cameras(const SimOptions& options) {
          options.image_channel, options.detections_channel});
     return out;
   }
-  for (const geometry::RigCamera& c : load_sim_rig(options).cameras) {
-    out.push_back({SimCamera{geometry::make_camera(c.camera), geometry::Extrinsics::from_options(c.extrinsics),
-                             options.camera.rate_hz, c.camera.camera_id},
-                   c.image_channel, c.detections_channel});
+  const geometry::CameraRig rig = load_sim_rig(options);
+  const double last_offset_s = options.camera_stagger_s * static_cast<double>(rig.cameras.size() - 1);
+  if (last_offset_s >= 1.0 / options.camera.rate_hz)
+    throw common::ConfigError(fmt::format(
+        "cameras.stagger_s = {}: the last of the {} cameras of {} would expose {} s after its frame's time, not within "
+        "the frame period {} s (camera.rate_hz {})",
+        options.camera_stagger_s, rig.cameras.size(), rig.source, last_offset_s, 1.0 / options.camera.rate_hz,
+        options.camera.rate_hz));
+  for (size_t i = 0; i < rig.cameras.size(); ++i) {
+    const geometry::RigCamera& c = rig.cameras[i];
+    out.push_back(
+        {SimCamera{geometry::make_camera(c.camera), geometry::Extrinsics::from_options(c.extrinsics),
+                   options.camera.rate_hz, c.camera.camera_id, options.camera_stagger_s * static_cast<double>(i)},
+         c.image_channel, c.detections_channel});
   }
   return out;
 }

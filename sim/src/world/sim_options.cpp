@@ -61,6 +61,11 @@ std::vector<std::string> SimOptions::validate() const {
   channel("output.own_pose_channel", own_pose_channel);
   channel("output.ground_truth_channel", ground_truth_channel);
   channel("output.detections_channel", detections_channel);
+  if (!(camera_stagger_s >= 0) || !std::isfinite(camera_stagger_s))
+    p.push_back(problem("cameras.stagger_s", camera_stagger_s, "must be >= 0 (0 = cameras exposed together)"));
+  else if (camera_stagger_s > 0 && camera_rig.empty())
+    p.push_back(
+        problem("cameras.stagger_s", camera_stagger_s, "needs cameras.rig (one camera has nothing to stagger)"));
   if (autopilot != "lcm" && autopilot != "mavlink")
     p.push_back(problem("autopilot", autopilot, "must be lcm or mavlink"));
   for (const auto& part :

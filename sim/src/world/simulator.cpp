@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace wingman::sim {
@@ -57,6 +58,11 @@ std::vector<SimCamera> checked_cameras(std::vector<SimCamera> cameras) {
           fmt::format("Simulator: camera {} has rate_hz {}, camera {} {}: all cameras expose "
                       "at the same frame times",
                       cameras[i].camera_id, cameras[i].rate_hz, cameras[0].camera_id, cameras[0].rate_hz));
+    const double period_s = 1.0 / cameras[0].rate_hz;
+    if (!(cameras[i].exposure_offset_s >= 0.0 && cameras[i].exposure_offset_s < period_s))
+      throw std::invalid_argument(
+          fmt::format("Simulator: camera {} has exposure_offset_s {}: must be in [0, {}) s (within its frame period)",
+                      cameras[i].camera_id, cameras[i].exposure_offset_s, period_s));
     for (size_t j = 0; j < i; ++j) {
       if (cameras[j].camera_id == cameras[i].camera_id)
         throw std::invalid_argument(fmt::format("Simulator: two cameras with camera_id {}", cameras[i].camera_id));
@@ -210,65 +216,61 @@ void Simulator::set_own_pose_error(const OwnPoseErrorOptions& options) {
     own_pose_error_.reset();
 }
 
-SimFrame Simulator::step() {
-  if (done()) {
-    throw std::logic_error(fmt::format("scenario {}: step() after the last frame ({})", scenario_.name, frame_count_));
-  }
-  SimFrame f;
-  f.index = next_index_++;
-  f.utime = clock_.utime(f.index);
-  advance_to(f.utime);
-
+void Simulator::expose(int64_t frame_index, const std::vector<size_t>& indices, wingman::own_pose_t& own_pose,
+                       MultirotorState& own_reported, wingman::ground_truth_t& truth,
+                       std::vector<SimCameraFrame>& views) {
+  const int64_t utime = now_utime_;
   const MultirotorState& own = camera_vehicle_->body.state();
-  f.own_reported = own_pose_error_ ? own_pose_error_->reported(own, f.utime) : own;
-  f.own_pose.utime = f.utime;
-  f.own_pose.frame = wingman::own_pose_t::FRAME_ENU;
-  geometry::to_array(f.own_reported.p_body_in_world, f.own_pose.p_body_in_world);
-  geometry::to_array(f.own_reported.q_body_to_world, f.own_pose.q_body_to_world);
-  geometry::to_array(f.own_reported.v_body_in_world, f.own_pose.v_body_in_world);
+  own_reported = own_pose_error_ ? own_pose_error_->reported(own, utime) : own;
+  own_pose.utime = utime;
+  own_pose.frame = wingman::own_pose_t::FRAME_ENU;
+  geometry::to_array(own_reported.p_body_in_world, own_pose.p_body_in_world);
+  geometry::to_array(own_reported.q_body_to_world, own_pose.q_body_to_world);
+  geometry::to_array(own_reported.v_body_in_world, own_pose.v_body_in_world);
   if (own_pose_error_ && own_pose_error_->options().report_covariance) {
     const double var_p = std::pow(own_pose_error_->options().position_std_m, 2);
     const double var_a = std::pow(own_pose_error_->options().attitude_std_rad, 2);
-    f.own_pose.has_covariance = true;
-    f.own_pose.cov_p_body_in_world[0] = f.own_pose.cov_p_body_in_world[3] = f.own_pose.cov_p_body_in_world[5] = var_p;
-    for (double& v : f.own_pose.var_rpy_body) v = var_a;
+    own_pose.has_covariance = true;
+    own_pose.cov_p_body_in_world[0] = own_pose.cov_p_body_in_world[3] = own_pose.cov_p_body_in_world[5] = var_p;
+    for (double& v : own_pose.var_rpy_body) v = var_a;
   }
 
-  f.truth.utime = f.utime;
-  f.truth.frame = wingman::own_pose_t::FRAME_ENU;
-  f.truth.image_seq = renderers_.empty() ? -1 : f.index;
+  truth.utime = utime;
+  truth.frame = wingman::own_pose_t::FRAME_ENU;
+  truth.image_seq = renderers_.empty() ? -1 : frame_index;
   std::vector<DroneInstance> targets;
   for (const auto& v : vehicles_) {
-    const MultirotorState& s = v->body.state();
+    const MultirotorState& st = v->body.state();
     wingman::vehicle_truth_t t{};
     t.vehicle_id = v->spec.id;
     t.name = v->spec.name;
-    geometry::to_array(s.p_body_in_world, t.p_body_in_world);
-    geometry::to_array(s.q_body_to_world, t.q_body_to_world);
-    geometry::to_array(s.v_body_in_world, t.v_body_in_world);
-    geometry::to_array(s.w_body_in_body, t.w_body_in_body);
+    geometry::to_array(st.p_body_in_world, t.p_body_in_world);
+    geometry::to_array(st.q_body_to_world, t.q_body_to_world);
+    geometry::to_array(st.v_body_in_world, t.v_body_in_world);
+    geometry::to_array(st.w_body_in_body, t.w_body_in_body);
     t.bounding_radius = v->model.bounding_radius();
-    f.truth.vehicles.push_back(t);
+    truth.vehicles.push_back(t);
     if (v.get() == camera_vehicle_) continue;
     DroneInstance d;
     d.vehicle_id = v->spec.id;
     d.model = &v->model;
-    d.T_body_to_world = body_to_world(s);
-    d.v_body_in_world = s.v_body_in_world;
-    d.w_body_in_body = s.w_body_in_body;
+    d.T_body_to_world = body_to_world(st);
+    d.v_body_in_world = st.v_body_in_world;
+    d.w_body_in_body = st.w_body_in_body;
     d.prop_angle_rad = v->prop_angle_rad;
     d.prop_rate_rad_s = v->prop_rate_rad_s;
     targets.push_back(d);
   }
-  f.truth.num_vehicles = static_cast<int32_t>(f.truth.vehicles.size());
+  truth.num_vehicles = static_cast<int32_t>(truth.vehicles.size());
 
-  // Every camera at the same exposure time, from the same body pose, each through its mount and lens.
+  // The cameras of this exposure from the same body pose, each through its mount and lens.
   const Eigen::Isometry3d T_body_to_world = body_to_world(own);
-  const uint64_t frame_seed = detail::mix_seed(scenario_.seed, static_cast<uint64_t>(f.index));
-  for (size_t i = 0; i < cameras_.size(); ++i) {
+  const uint64_t frame_seed = detail::mix_seed(scenario_.seed, static_cast<uint64_t>(frame_index));
+  for (const size_t i : indices) {
     const SimCamera& camera = cameras_[i];
-    SimCameraFrame view;
+    SimCameraFrame& view = views[i];
     view.camera_id = camera.camera_id;
+    view.utime = utime;
     Eigen::Isometry3d T_cam_to_body = Eigen::Isometry3d::Identity();
     T_cam_to_body.linear() = camera.mount.R_cam_to_body;
     T_cam_to_body.translation() = camera.mount.p_cam_in_body;
@@ -281,7 +283,7 @@ SimFrame Simulator::step() {
       motion.w_cam_in_cam = camera.mount.R_cam_to_body.transpose() * own.w_body_in_body;
       // The first camera keeps the single camera's seed; the others get their own noise and exposure jitter.
       const uint64_t camera_seed = i == 0 ? frame_seed : detail::mix_seed(frame_seed, i);
-      RenderResult r = renderers_[i]->render(view.T_cam_to_world, targets, f.utime, camera_seed, motion);
+      RenderResult r = renderers_[i]->render(view.T_cam_to_world, targets, utime, camera_seed, motion);
       view.bgr = std::move(r.bgr);
       boxes = std::move(r.boxes);
     } else {
@@ -300,11 +302,37 @@ SimFrame Simulator::step() {
       t.h = static_cast<float>(b.h);
       t.visible = b.visible;
       t.range = b.range_m;
-      f.truth.boxes.push_back(t);
+      truth.boxes.push_back(t);
     }
-    f.cameras.push_back(std::move(view));
   }
-  f.truth.num_boxes = static_cast<int32_t>(f.truth.boxes.size());
+  truth.num_boxes = static_cast<int32_t>(truth.boxes.size());
+}
+
+SimFrame Simulator::step() {
+  if (done()) {
+    throw std::logic_error(fmt::format("scenario {}: step() after the last frame ({})", scenario_.name, frame_count_));
+  }
+  SimFrame f;
+  f.index = next_index_++;
+  f.utime = clock_.utime(f.index);
+  f.cameras.resize(cameras_.size());
+  advance_to(f.utime);
+  // The cameras by exposure offset (microseconds): those at t_k first, in the simulator's order within each.
+  std::map<int64_t, std::vector<size_t>> by_offset;
+  for (size_t i = 0; i < cameras_.size(); ++i)
+    by_offset[std::llround(cameras_[i].exposure_offset_s * 1e6)].push_back(i);
+  const auto at_tk = by_offset.find(0);
+  expose(f.index, at_tk == by_offset.end() ? std::vector<size_t>{} : at_tk->second, f.own_pose, f.own_reported, f.truth,
+         f.cameras);
+  for (const auto& [offset_us, indices] : by_offset) {
+    if (offset_us == 0) continue;
+    advance_to(f.utime + offset_us);
+    SimExposure e;
+    e.utime = now_utime_;
+    e.camera_indices = indices;
+    expose(f.index, indices, e.own_pose, e.own_reported, e.truth, f.cameras);
+    f.later.push_back(std::move(e));
+  }
   f.bgr = f.cameras.front().bgr;
   f.T_cam_to_world = f.cameras.front().T_cam_to_world;
   return f;

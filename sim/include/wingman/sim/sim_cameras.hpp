@@ -30,8 +30,10 @@ geometry::CameraRig load_sim_rig(const SimOptions& options);
 
 /// The cameras of `options`: without cameras.rig, the one camera of camera.*, extrinsics.*, output.image_channel and
 /// output.detections_channel; with it, the rig file's cameras in file order (each its camera.*, mount and channels;
-/// camera.rate_hz from the options for all). Reads calibration files (geometry::make_camera). Throws what
-/// load_sim_rig() throws for a bad rig, and what make_camera throws for an unreadable calibration.
+/// camera.rate_hz from the options for all, camera i exposing i x cameras.stagger_s after the frame's time). Reads
+/// calibration files (geometry::make_camera). Throws what load_sim_rig() throws for a bad rig, common::ConfigError
+/// naming cameras.stagger_s when the last camera would expose beyond the frame period, and what make_camera throws
+/// for an unreadable calibration.
 std::vector<SimCameraOutput> sim_cameras(const SimOptions& options);
 
 }  // namespace wingman::sim

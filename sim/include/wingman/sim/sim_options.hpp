@@ -126,6 +126,10 @@ struct SimOptions {
   /// cameras, which replace camera.* (except camera.rate_hz, the frame rate of them all), extrinsics.*,
   /// output.image_channel and output.detections_channel. "" = the single camera of those keys.
   std::string camera_rig;
+  /// Rig cameras not triggered together: the rig's camera i (file order) exposes i x stagger_s after its frame's
+  /// time, each with its own image utime, own pose and ground truth, as free-running cameras would. Seconds, >= 0,
+  /// (cameras - 1) x stagger_s below the frame period; 0 = every camera at the frame's time. Needs cameras.rig.
+  double camera_stagger_s = 0.0;
   SimCameraOptions camera;
   geometry::ExtrinsicsOptions extrinsics;
   TruthDetectionOptions detections;
@@ -150,6 +154,8 @@ struct SimOptions {
     v("cameras.rig", camera_rig,
       "camera rig file (e.g. config/rigs/surround4.yaml): render all its cameras, which replace camera.* (but "
       "camera.rate_hz), extrinsics.*, output.image_channel and output.detections_channel; \"\" = one camera");
+    v("cameras.stagger_s", camera_stagger_s,
+      "rig: camera i exposes i x this after its frame's time (cameras not triggered together), s; 0 = together");
     camera.visit(v);
     extrinsics.visit(v);
     detections.visit(v);

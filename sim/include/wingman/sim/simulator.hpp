@@ -37,27 +37,43 @@ struct SimCamera {
   geometry::Extrinsics mount;   ///< camera optical frame -> body (FLU); the camera tilts with the body
   double rate_hz = 30.0;        ///< frames per simulated second
   int32_t camera_id = 0;        ///< copied into images, truth boxes and detections
+  /// When this camera exposes after its frame's time t_k, seconds, in [0, 1 / rate_hz): cameras that are not
+  /// triggered together (each its own exposure utime). 0 = at t_k.
+  double exposure_offset_s = 0.0;
 };
 
 /// What one camera saw of a frame.
 struct SimCameraFrame {
   int32_t camera_id = 0;  ///< SimCamera::camera_id
+  int64_t utime = 0;      ///< its exposure: t_k + its exposure_offset_s, microseconds since epoch
   cv::Mat bgr;            ///< the rendered image (CV_8UC3); empty when rendering is off
-  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the camera at t_k (optical -> ENU)
+  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the camera at its exposure (optical -> ENU)
 };
 
-/// One simulated camera frame: every camera exposed at the same time t_k.
+/// The cameras of a frame that expose after t_k (SimCamera::exposure_offset_s > 0), one per exposure time: what
+/// the vehicle reports and every vehicle's truth at that time, with those cameras' boxes.
+struct SimExposure {
+  int64_t utime = 0;                   ///< t_k + the offset, microseconds since epoch
+  wingman::own_pose_t own_pose{};      ///< the camera vehicle's reported pose at utime
+  MultirotorState own_reported;        ///< the same as a state
+  wingman::ground_truth_t truth;       ///< every vehicle at utime; the boxes of the cameras exposed then
+  std::vector<size_t> camera_indices;  ///< into SimFrame::cameras
+};
+
+/// One simulated camera frame: the cameras exposed at t_k (by default all), and those that expose after it.
 struct SimFrame {
   int64_t index = 0;  ///< frame number k (the image's seq)
   int64_t utime = 0;  ///< exposure time t_k = start_utime + round(k * 1e6 / rate), microseconds since epoch
   wingman::own_pose_t own_pose{};  ///< the camera vehicle's reported body pose at t_k (ENU world, FLU body)
   MultirotorState own_reported;    ///< the same as a state (the pose error applied), for the MAVLink telemetry
-  /// Every vehicle at t_k and every target's box in every camera (truth_box_t.camera_id; the first camera's boxes
-  /// first, in the order of the vehicles, then the second's, ...); image_seq -1 without images.
+  /// Every vehicle at t_k and every target's box in every camera exposed at t_k (truth_box_t.camera_id; the first
+  /// camera's boxes first, in the order of the vehicles, then the second's, ...); image_seq -1 without images.
   wingman::ground_truth_t truth;
   cv::Mat bgr;  ///< the first camera's rendered image (CV_8UC3, = cameras[0].bgr); empty when rendering is off
-  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the first camera at t_k (optical -> ENU)
+  Eigen::Isometry3d T_cam_to_world = Eigen::Isometry3d::Identity();  ///< the first camera at its exposure
   std::vector<SimCameraFrame> cameras;                               ///< one per camera, in the simulator's order
+  /// The cameras exposed after t_k, by exposure time (empty when every camera exposes at t_k).
+  std::vector<SimExposure> later;
 };
 
 /// Counts of what happened to setpoints (the process reports them in its status).
@@ -81,12 +97,13 @@ class Simulator {
   /// naming the problem (a vehicle's motion or dynamics invalid, a scenario that never ends), std::runtime_error
   /// when a drone mesh cannot be loaded.
   Simulator(Scenario scenario, SimCamera camera, Renderer* renderer = nullptr);
-  /// Several cameras on the camera vehicle (a rig), all exposed at each frame's time from its pose, each through its
-  /// own mount and lens. `renderers`: one per camera, in the same order (renderers[i] draws cameras[i]; not owned),
-  /// or empty: no images. Frame k's sensor noise and exposure jitter are seeded per camera: the first camera with
-  /// the seed a single camera has (so a rig's first camera gives that camera's images), camera i > 0 with a seed
-  /// mixed from it and i. Throws std::invalid_argument, besides the above, for no camera, more than 8, two with the
-  /// same camera_id, cameras with different rate_hz, or renderers that do not match the cameras one for one.
+  /// Several cameras on the camera vehicle (a rig), each exposed at its frame's time plus its exposure_offset_s
+  /// from the vehicle's pose then, through its own mount and lens. `renderers`: one per camera, in the same order
+  /// (renderers[i] draws cameras[i]; not owned), or empty: no images. Frame k's sensor noise and exposure jitter are
+  /// seeded per camera: the first camera with the seed a single camera has (so a rig's first camera gives that camera's
+  /// images), camera i > 0 with a seed mixed from it and i. Throws std::invalid_argument, besides the above, for no
+  /// camera, more than 8, two with the same camera_id, cameras with different rate_hz, an exposure_offset_s outside [0,
+  /// frame period), or renderers that do not match the cameras one for one.
   Simulator(Scenario scenario, std::vector<SimCamera> cameras, std::vector<Renderer*> renderers);
   ~Simulator();
   Simulator(const Simulator&) = delete;
@@ -107,7 +124,8 @@ class Simulator {
   /// True when the camera vehicle takes setpoints (control: setpoints).
   bool takes_setpoints() const;
 
-  /// Advances to the next frame's time and returns the frame. Precondition: !done() (std::logic_error otherwise).
+  /// Advances to the next frame's time and returns the frame; with cameras that expose later, on to the last of
+  /// their exposures (now_utime()). Precondition: !done() (std::logic_error otherwise).
   SimFrame step();
 
   /// The error of the reported own pose from now on (SimFrame::own_pose, own_reported); none by default.
@@ -130,6 +148,10 @@ class Simulator {
   void advance_to(int64_t utime);
   void integrate(Vehicle& v, int64_t from_utime, int64_t to_utime);
   void apply_due_setpoints();
+  /// At now_utime(): the reported own pose and every vehicle's truth; the cameras `indices` rendered (or projected)
+  /// into `views` and their boxes into `truth`. `frame_index` seeds the images.
+  void expose(int64_t frame_index, const std::vector<size_t>& indices, wingman::own_pose_t& own_pose,
+              MultirotorState& own_reported, wingman::ground_truth_t& truth, std::vector<SimCameraFrame>& views);
 
   Scenario scenario_;
   std::vector<SimCamera> cameras_;

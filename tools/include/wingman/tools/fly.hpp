@@ -37,6 +37,9 @@ struct FlyOptions {
   /// With a rig the simulator renders every camera, one detector runs per camera (named detector<camera_id>), and
   /// the localizer fuses them (each takes cameras.rig).
   std::string rig;
+  /// With a rig: camera i exposes i x this after its frame's time (the simulator's cameras.stagger_s: cameras not
+  /// triggered together), seconds; 0 = every camera at the frame's time.
+  double camera_stagger_s = 0.0;
   std::string localizer_config;  ///< "" = config_dir/flights/NAME.localizer.yaml if any, else the defaults
   std::string follower_config;   ///< "" = config_dir/flights/NAME.follower_ctrl.yaml if any, else the defaults
   std::string render_config;     ///< the simulator's render.* keys from this file ("" = its defaults)
@@ -68,6 +71,8 @@ struct FlyOptions {
     v("cameras.rig", rig,
       "config/rigs/NAME.yaml (under run.config_dir) or a rig file: several cameras, a detector each, fused by the "
       "localizer; \"\" = the one forward camera");
+    v("cameras.stagger_s", camera_stagger_s,
+      "with a rig: camera i exposes i x this after its frame's time (not triggered together), s; 0 = together");
     v("processes.localizer_config", localizer_config,
       "\"\" = config/flights/NAME.localizer.yaml if any, else the localizer's defaults");
     v("processes.follower_config", follower_config,
