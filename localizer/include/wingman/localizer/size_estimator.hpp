@@ -14,9 +14,9 @@ namespace wingman::localizer {
 /// Options of the size estimator (keys `tracker.size_*` of config/localizer.yaml).
 struct SizeEstimatorOptions {
   /// Estimate each target's size online; false (default): the configured size is used as it is. Off by default: in
-  /// the formation flight with ground-truth boxes it adopted a size 85 % too large as the leader turned and the
-  /// follower lagged (both fits of the pair agreeing), and the jump made a false target (docs/localization.md,
-  /// "Online size").
+  /// the formation flight with ground-truth boxes, from a radius 30 % too small, it first adopted a size 20 % too
+  /// large as the leader turned and the follower lagged (a manoeuvre both share, both fits of the pair agreeing);
+  /// 30 % too large, it adopted nothing in 40 s (docs/localization.md, "Online size").
   bool enabled = false;
   /// Standard deviation of the range scale before any evidence: how far target.radius_m (with the box relation) may
   /// be off, relative. The prior is 1 +- this. (0, 1].
