@@ -282,6 +282,7 @@ std::string V4l2Source::describe() const {
   if (stride_ > 0) s += fmt::format(" stride {}", stride_);
   s += fps_ > 0 ? fmt::format(" @ {} fps", fps_) : std::string(" @ driver rate");
   s += fmt::format(", {} buffers", buffers_.size());
+  if (!timestamp_source_.empty()) s += ", stamps at the " + timestamp_source_;
   return s;
 }
 
@@ -444,6 +445,18 @@ ReadResult V4l2Source::capture(Frame& out, int timeout_ms) {
     out.data.assign(src, src + used);
   }
 
+  if (timestamp_source_.empty()) {
+    if ((buf.flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE) {
+      timestamp_source_ = "start of exposure";
+      spdlog::info("device {}: buffer timestamps mark the start of exposure (V4L2_BUF_FLAG_TSTAMP_SRC_SOE)", dev);
+    } else {
+      timestamp_source_ = "end of the frame";
+      spdlog::warn(
+          "device {}: buffer timestamps mark the end of the frame (V4L2_BUF_FLAG_TSTAMP_SRC_EOF), later than the "
+          "exposure by its readout: set output.time_offset_s to move them to the exposure",
+          dev);
+    }
+  }
   const int64_t t_buffer_mono = static_cast<int64_t>(buf.timestamp.tv_sec) * 1000000 + buf.timestamp.tv_usec;
   out.utime = t_buffer_mono > 0 ? t_buffer_mono + (real_now - mono_now) : real_now;
   if (t_buffer_mono <= 0 && !warned_zero_timestamp_) {

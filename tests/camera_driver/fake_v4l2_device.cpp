@@ -102,7 +102,9 @@ void FakeV4l2Device::fill(Buffer& b, const FakeEvent& e, v4l2_buffer* out) {
   out->bytesused = static_cast<uint32_t>(used);
   out->length = static_cast<uint32_t>(b.memory.size());
   out->sequence = e.sequence;
-  out->flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC | V4L2_BUF_FLAG_TSTAMP_SRC_SOE | e.extra_flags;
+  out->flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC |
+               (config_.timestamp_end_of_frame ? V4L2_BUF_FLAG_TSTAMP_SRC_EOF : V4L2_BUF_FLAG_TSTAMP_SRC_SOE) |
+               e.extra_flags;
   out->field = V4L2_FIELD_NONE;
   int64_t ts = e.timestamp_us;
   if (ts < 0) ts = clock_ != nullptr ? clock_->monotonic_utime() : 1'000'000'000 + int64_t{e.sequence} * 33'333;

@@ -32,6 +32,7 @@ struct FakeDeviceConfig {
   std::vector<double> frame_rates = {15.0, 30.0};  ///< S_PARM picks the nearest, frames per second
   uint32_t max_buffers = 8;                        ///< REQBUFS grants at most this many
   uint8_t padding_byte = 0xEE;                     ///< value of the padding bytes at the end of each YUYV row
+  bool timestamp_end_of_frame = false;             ///< buffers flagged TSTAMP_SRC_EOF instead of SOE
 };
 
 /// One scripted event, consumed in order by VIDIOC_DQBUF.

@@ -311,6 +311,25 @@ TEST(V4l2Source, MonotonicBufferTimestampsBecomeEpochTime) {
   EXPECT_EQ(f.utime, rig.clock->realtime_utime()) << "zero timestamp: stamped at dequeue";
 }
 
+// What the stamps mark, from the first buffer's V4L2_BUF_FLAG_TSTAMP_SRC_* flag, ends describe(): a user sees whether
+// the camera stamps the start of exposure (UVC) or the end of the frame (then output.time_offset_s applies).
+TEST(V4l2Source, DescribeSaysWhetherTheStampsMarkTheStartOfExposureOrTheEndOfTheFrame) {
+  for (const bool eof : {false, true}) {
+    FakeDeviceConfig config;
+    config.timestamp_end_of_frame = eof;
+    Rig rig({}, config);
+    rig.source->open();
+    EXPECT_THAT(rig.source->describe(), ::testing::Not(HasSubstr("stamps"))) << "not known before the first buffer";
+    FakeEvent e;
+    e.sequence = 0;
+    rig.device->push_event(e);
+    Frame f;
+    ASSERT_EQ(rig.source->read(f, 100).status, ReadStatus::kFrame);
+    EXPECT_THAT(rig.source->describe(),
+                HasSubstr(eof ? ", stamps at the end of the frame" : ", stamps at the start of exposure"));
+  }
+}
+
 TEST(V4l2Source, TimeoutWhenNoFrameIsReady) {
   Rig rig;
   rig.source->open();

@@ -67,7 +67,10 @@ struct V4l2SourceOptions {
 ///   utime = t_buffer_mono + (realtime_utime() - monotonic_utime())
 /// with the offset sampled right after the dequeue, so the conversion error is the few microseconds
 /// between the two clock reads and NTP steps of the wall clock are followed. Buffers with a zero
-/// timestamp (some drivers) are stamped with the dequeue time instead.
+/// timestamp (some drivers) are stamped with the dequeue time instead. What the stamps mark, from the first buffer's
+/// V4L2_BUF_FLAG_TSTAMP_SRC_* flag, is logged once and ends describe(): "stamps at the start of exposure" (SOE) or
+/// "stamps at the end of the frame" (EOF: later than the exposure by its readout; a warning points to the camera
+/// driver's output.time_offset_s).
 ///
 /// Unplug: any failure of poll/DQBUF/QBUF once streaming (ENODEV, EIO, ...) or no frame for
 /// stall_timeout_s tears the stream down and returns kDisconnected. Later read() calls reopen the
@@ -149,6 +152,8 @@ class V4l2Source : public FrameSource {
   int64_t next_seq_ = 0;             // Frame::seq of the next buffer when there is no gap
   int64_t last_frame_mono_us_ = 0;   // monotonic time of the last dequeue (stall detection), microseconds
   bool warned_zero_timestamp_ = false;
+  /// What the driver's buffer timestamps mark (V4L2_BUF_FLAG_TSTAMP_SRC_*), from the first buffer: "" until then.
+  std::string timestamp_source_;
   std::string pending_failure_;  // a QBUF failure after a delivered frame: disconnect on the next read
 
   bool disconnected_ = false;
