@@ -150,6 +150,12 @@ CameraDriver::CameraDriver(OutputOptions options, std::unique_ptr<FrameSource> s
 
 void CameraDriver::open() { source_->open(); }
 
+std::string CameraDriver::describe() const {
+  std::string s = source_->describe();
+  if (time_offset_us_ != 0) s += fmt::format(", stamps moved by {:g} s (output.time_offset_s)", options_.time_offset_s);
+  return s;
+}
+
 bool CameraDriver::done() const { return ended_ || (options_.max_frames > 0 && frames_out_ >= options_.max_frames); }
 
 DriverStep CameraDriver::step(int timeout_ms) {

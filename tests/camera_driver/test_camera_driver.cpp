@@ -394,6 +394,7 @@ TEST(CameraDriver, TimeOffsetMovesEveryStampToTheExposure) {
   OutputOptions out;
   out.time_offset_s = -0.1300004;  // rounds to -130000 us
   CameraDriver driver(out, std::move(src));
+  EXPECT_THAT(driver.describe(), HasSubstr(", stamps moved by -0.13 s (output.time_offset_s)"));
   for (int64_t i = 0; i < 3; ++i) {
     const DriverStep step = driver.step(0);
     ASSERT_EQ(step.status, ReadStatus::kFrame) << step.reason;

@@ -72,7 +72,9 @@ class CameraDriver {
   bool done() const;
 
   const FrameSource& source() const { return *source_; }
-  std::string describe() const { return source_->describe(); }
+  /// The source's line, and the stamps' shift when output.time_offset_s is not 0 ("..., stamps moved by -0.13 s
+  /// (output.time_offset_s)").
+  std::string describe() const;
   /// Frames converted for publishing.
   int64_t frames_out() const { return frames_out_; }
   /// Frames dropped by the driver itself (failed checks, MJPEG decode or encode), on top of the source's.
