@@ -50,6 +50,12 @@ std::vector<std::string> TrackerOptions::validate() const {
     p.push_back(problem("tracker.confirm_min_confidence", confirm_min_confidence, "must be in [0, 1]"));
   if (!(death_timeout_s > 0 && death_timeout_s <= 3600))
     p.push_back(problem("tracker.death_timeout_s", death_timeout_s, "must be in (0, 3600] s"));
+  if (!(reacquire_s >= 0 && reacquire_s <= 3600))
+    p.push_back(problem("tracker.reacquire_s", reacquire_s, "must be in [0, 3600] s (0 = off)"));
+  if (!(reacquire_speed_mps >= 0 && reacquire_speed_mps <= 1000))
+    p.push_back(problem("tracker.reacquire_speed_mps", reacquire_speed_mps, "must be in [0, 1000] m/s"));
+  if (!(reacquire_gate_m > 0 && reacquire_gate_m <= 1000))
+    p.push_back(problem("tracker.reacquire_gate_m", reacquire_gate_m, "must be in (0, 1000] m"));
   if (window_size < 1) p.push_back(problem("tracker.window_size", window_size, "must be >= 1"));
   if (!(initial_velocity_std > 0) || !std::isfinite(initial_velocity_std))
     p.push_back(problem("tracker.initial_velocity_std", initial_velocity_std, "must be finite and > 0"));
@@ -163,6 +169,7 @@ void Tracker::hit(Track& t, const WorldMeasurement& z) {
                   : localizer::update(t.sc, c + s * (z.p_target_in_world - c), s * s * z.cov_p_in_world);
   t.last_hit_utime = z.utime;
   t.last = z;
+  t.p_at_last_hit = t.sc.p();
   t.window.push_back({z.utime, z.p_target_in_world, z.cov_p_in_world});
   while (static_cast<int>(t.window.size()) > options_.window_size) t.window.pop_front();
 }
@@ -338,6 +345,7 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
     }
     if (t.id != 0 && timed_out) {
       ++stats_.deaths;
+      if (options_.reacquire_s > 0) lost_.push_back({t.id, t.p_at_last_hit, t.last_hit_utime});
       continue;
     }
     kept.push_back(std::move(t));
@@ -358,7 +366,7 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
       ++stats_.merges;
       continue;
     }
-    t.id = next_id_++;
+    t.id = id_for_confirmed(t, utime);
     ++stats_.confirmations;
   }
   merge_duplicates(utime);
@@ -373,7 +381,7 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
     Track& t = b.track;
     ++stats_.births;
     if (t.hits >= options_.birth_hits && confident_enough(t)) {
-      t.id = next_id_++;
+      t.id = id_for_confirmed(t, utime);
       ++stats_.confirmations;
     }
     tracks_.push_back(std::move(t));
@@ -382,6 +390,30 @@ bool Tracker::update_cameras(int64_t utime, const std::vector<std::vector<WorldM
   have_frame_ = true;
   last_frame_utime_ = utime;
   return true;
+}
+
+int32_t Tracker::id_for_confirmed(const Track& t, int64_t utime) {
+  const int64_t keep_us = static_cast<int64_t>(std::llround(options_.reacquire_s * 1e6));
+  // Forget what is too old (or from the future: time went back), then take the nearest remembered track whose gate,
+  // grown by how far it may have flown since its last hit, holds t's position now.
+  lost_.erase(
+      std::remove_if(lost_.begin(), lost_.end(),
+                     [&](const Lost& l) { return utime - l.last_hit_utime > keep_us || l.last_hit_utime > utime; }),
+      lost_.end());
+  const Eigen::Vector3d p = t.sc.p();
+  auto best = lost_.end();
+  double best_d = 0.0;
+  for (auto it = lost_.begin(); it != lost_.end(); ++it) {
+    const double dt_s = static_cast<double>(utime - it->last_hit_utime) * 1e-6;
+    const double d = (p - it->p_at_last_hit).norm();
+    if (d <= options_.reacquire_gate_m + options_.reacquire_speed_mps * dt_s && (best == lost_.end() || d < best_d))
+      best = it, best_d = d;
+  }
+  if (best == lost_.end()) return next_id_++;
+  const int32_t id = best->id;
+  lost_.erase(best);
+  ++stats_.reacquired;
+  return id;
 }
 
 bool Tracker::confident_enough(const Track& t) const {

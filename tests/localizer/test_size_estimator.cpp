@@ -52,7 +52,9 @@ std::pair<double, double> fly(const Path& target, const Path& camera, double tru
     const int64_t utime = kT0 + static_cast<int64_t>(std::llround(t * 1e6));
     EXPECT_TRUE(tracker.update(utime, {detect(target(t), camera(t), true_scale, rng)}));
     const auto out = tracker.confirmed(utime);
-    if (k >= o.birth_hits - 1) EXPECT_EQ(out.size(), 1u) << "t = " << t;  // confirmed at the M-th detection
+    if (k >= o.birth_hits - 1) {
+      EXPECT_EQ(out.size(), 1u) << "t = " << t;  // confirmed at the M-th detection
+    }
     if (out.size() == 1) result = {out[0].size_scale, out[0].size_scale_sigma};
   }
   return result;

@@ -224,9 +224,10 @@ TEST(Tracker, ATrackIsConfirmedOnlyOnceTheMeanConfidenceOfItsLastNHitsReachesThe
   EXPECT_NE(problems[1].find("tracker.confirm_min_confidence = -0.1"), std::string::npos) << problems[1];
 }
 
-TEST(Tracker, DeletesAfterTheTimeoutAndNeverReusesIds) {
+TEST(Tracker, DeletesAfterTheTimeoutAndWithoutReacquisitionNeverReusesIds) {
   TrackerOptions o = three_of_five();
   o.death_timeout_s = 0.5;
+  o.reacquire_s = 0.0;
   Tracker t(o);
   for (int k = 0; k < 5; ++k) t.update(frame_utime(k), {meas({15, 0, 3})});
   ASSERT_EQ(t.confirmed(frame_utime(4)).size(), 1u);
@@ -239,6 +240,65 @@ TEST(Tracker, DeletesAfterTheTimeoutAndNeverReusesIds) {
   const auto out = t.confirmed(frame_utime(13));
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].track_id, 2);
+}
+
+// Re-acquisition (tracker.reacquire_s): a target unseen for 3 s (its track deleted after 0.5 s) that comes back 4 m
+// from its last hit (within 2 m + 5 m/s x 3.x s) is confirmed with its old id; beyond the gate, after reacquire_s, or
+// with it off, it gets a new one. Of two deleted tracks the nearer gives its id, and each id is given once.
+TEST(Tracker, ATargetThatComesBackNearWhereItWasLostKeepsItsId) {
+  struct Case {
+    const char* what;
+    double reacquire_s;
+    Eigen::Vector3d back_at;
+    int unseen_frames;
+    int32_t expected_id;
+  };
+  const Eigen::Vector3d a(15, 0, 3);
+  for (const Case& c :
+       {Case{"back 4 m away after 3 s", 10.0, {15, 4, 3}, 30, 1}, Case{"reacquisition off", 0.0, {15, 4, 3}, 30, 2},
+        Case{"beyond the gate: 20 m after 3 s", 10.0, {15, 20, 3}, 30, 2},
+        Case{"after reacquire_s", 2.0, {15, 4, 3}, 30, 2}}) {
+    SCOPED_TRACE(c.what);
+    TrackerOptions o = three_of_five();
+    o.death_timeout_s = 0.5;
+    o.reacquire_s = c.reacquire_s;
+    Tracker t(o);
+    int k = 0;
+    for (; k < 5; ++k) t.update(frame_utime(k), {meas(a)});
+    ASSERT_EQ(t.confirmed(frame_utime(k - 1)).at(0).track_id, 1);
+    for (const int end = k + c.unseen_frames; k < end; ++k) t.update(frame_utime(k), {});
+    ASSERT_EQ(t.num_confirmed(), 0u);
+    for (const int end = k + 3; k < end; ++k) t.update(frame_utime(k), {meas(c.back_at)});
+    const auto out = t.confirmed(frame_utime(k - 1));
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].track_id, c.expected_id);
+    EXPECT_EQ(t.stats().reacquired, c.expected_id == 1 ? 1 : 0);
+  }
+
+  // Two targets lost together; one comes back nearer the second's last hit: it takes the second's id; the other,
+  // back later near the first's, takes the first's.
+  TrackerOptions o = three_of_five();
+  o.death_timeout_s = 0.5;
+  Tracker t(o);
+  const Eigen::Vector3d b(15, 6, 3);
+  int k = 0;
+  for (; k < 5; ++k) t.update(frame_utime(k), {meas(a), meas(b)});
+  auto out = t.confirmed(frame_utime(k - 1));
+  ASSERT_EQ(out.size(), 2u);
+  const int32_t id_a = (out[0].p_target_in_world - a).norm() < 1 ? out[0].track_id : out[1].track_id;
+  const int32_t id_b = id_a == out[0].track_id ? out[1].track_id : out[0].track_id;
+  for (const int end = k + 10; k < end; ++k) t.update(frame_utime(k), {});
+  ASSERT_EQ(t.num_confirmed(), 0u);
+  for (const int end = k + 3; k < end; ++k) t.update(frame_utime(k), {meas({15, 5, 3})});
+  out = t.confirmed(frame_utime(k - 1));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].track_id, id_b) << "the nearer remembered track";
+  for (const int end = k + 3; k < end; ++k) t.update(frame_utime(k), {meas({15, 5, 3}), meas({15, 0.5, 3})});
+  out = t.confirmed(frame_utime(k - 1));
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NE(out[0].track_id, out[1].track_id);
+  EXPECT_TRUE((out[0].track_id == id_a) != (out[1].track_id == id_a)) << "the first's id given once, to the other";
+  EXPECT_EQ(t.stats().reacquired, 2);
 }
 
 TEST(Tracker, GatesOutADetectionFarFromTheTrack) {

@@ -59,6 +59,15 @@ struct TrackerOptions {
   double confirm_min_confidence = 0.4;
   /// A track without a hit for longer than this (image time) is deleted. Seconds, > 0.
   double death_timeout_s = 1.0;
+  /// Re-acquisition: a confirmed track deleted (death_timeout_s) less than this long ago is remembered (its id and
+  /// where it was at its last hit); a tentative track confirmed within reacquire_gate_m + reacquire_speed_mps x (the
+  /// time since that last hit) of a remembered one takes its id instead of a new one (the nearest such), so a drone
+  /// that leaves every view, or is missed for a while, and comes back keeps its identity. Seconds, >= 0 (0 = off).
+  double reacquire_s = 10.0;
+  /// How fast a remembered target may have moved while unseen, m/s (the gate's growth), >= 0.
+  double reacquire_speed_mps = 5.0;
+  /// The gate's radius at the last hit: the range error of a track, m, > 0.
+  double reacquire_gate_m = 2.0;
   /// n_f of the sliding-window mode: measurements averaged (thesis: 5). >= 1.
   int window_size = 5;
   /// Standard deviation of a new track's velocity on each axis, m/s. > 0.
@@ -105,6 +114,11 @@ struct TrackerOptions {
     v("tracker.confirm_min_confidence", confirm_min_confidence,
       "a tentative track is confirmed once the mean confidence of its last N hits reaches this, 0..1 (0 = off)");
     v("tracker.death_timeout_s", death_timeout_s, "a track without a hit for this long is deleted, s");
+    v("tracker.reacquire_s", reacquire_s,
+      "a confirmed track deleted less than this long ago gives its id to a track confirmed near it, s (0 = off)");
+    v("tracker.reacquire_speed_mps", reacquire_speed_mps,
+      "re-acquisition gate: how fast the unseen target may have moved since its last hit, m/s");
+    v("tracker.reacquire_gate_m", reacquire_gate_m, "re-acquisition gate: its radius at the last hit, m");
     v("tracker.window_size", window_size, "n_f: measurements averaged in sliding_window mode");
     v("tracker.initial_velocity_std", initial_velocity_std, "velocity standard deviation of a new track, m/s");
     v("tracker.max_prediction_s", max_prediction_s, "lag compensation: longest prediction past a track's state, s");
@@ -134,7 +148,7 @@ struct TrackerOptions {
 
 /// One confirmed track as published (or, from Tracker::predicted_tracks(), a tentative one too).
 struct TrackOutput {
-  int32_t track_id = 0;   ///< 1, 2, ... in order of confirmation; never reused; 0 for a tentative track
+  int32_t track_id = 0;   ///< 1, 2, ... in order of confirmation (a re-acquired target keeps its old one); 0 tentative
   bool confirmed = true;  ///< false: a tentative track (predicted_tracks() only)
   int32_t camera_id = 0;  ///< camera of the last detection used
   Eigen::Vector3d p_target_in_world = Eigen::Vector3d::Zero();  ///< at predicted_utime, m
@@ -167,6 +181,7 @@ struct TrackerStats {
   int64_t births_refused = 0;
   int64_t tentative_dropped = 0;  ///< tentative tracks that failed the M-of-N rule or timed out
   int64_t deaths = 0;             ///< confirmed tracks deleted after death_timeout_s
+  int64_t reacquired = 0;         ///< tracks confirmed with the id of a deleted one (reacquire_s)
   int64_t merges = 0;             ///< duplicates merged into an older confirmed track (or not confirmed)
   int64_t ambiguous = 0;          ///< confirmed-track updates skipped as a coin toss between two tracks (coasted)
   int64_t occluded = 0;           ///< confirmed-track updates skipped: occluding another track there (coasted)
@@ -254,21 +269,22 @@ class Tracker {
   struct Track {
     int32_t id = 0;  // 0 while tentative, -1 once merged away
     StateCov sc;
-    int64_t state_utime = 0;               // time sc refers to
-    int64_t birth_utime = 0;               // first detection
-    int64_t last_hit_utime = 0;            // newest detection
-    int frames = 0;                        // frames since birth, the birth frame included
-    int hits = 0;                          // hits since birth
-    std::deque<bool> recent;               // hit or miss of the last birth_window frames
-    std::deque<double> recent_confidence;  // detection confidence of the last birth_window hits
-    bool held = false;                     // once held back by confirm_min_confidence (counted once)
-    std::deque<WindowEntry> window;        // last window_size detections
-    WorldMeasurement last;                 // newest detection (as detected: the configured size)
-    SizeEstimator size;                    // the track's detections for its range scale
-    SizeEstimate scale;                    // the adopted range scale: detections enter the filter at c + s (z - c)
-    SizeEstimate candidate;                // an acceptable fit waiting for a second, later one that agrees with it
-    int64_t candidate_utime = -1;          // its time; -1: none
-    int64_t coasting_since_utime = -1;     // first frame of the current run of ambiguous frames; -1: none
+    int64_t state_utime = 0;                                  // time sc refers to
+    int64_t birth_utime = 0;                                  // first detection
+    int64_t last_hit_utime = 0;                               // newest detection
+    int frames = 0;                                           // frames since birth, the birth frame included
+    int hits = 0;                                             // hits since birth
+    std::deque<bool> recent;                                  // hit or miss of the last birth_window frames
+    std::deque<double> recent_confidence;                     // detection confidence of the last birth_window hits
+    bool held = false;                                        // once held back by confirm_min_confidence (counted once)
+    std::deque<WindowEntry> window;                           // last window_size detections
+    WorldMeasurement last;                                    // newest detection (as detected: the configured size)
+    Eigen::Vector3d p_at_last_hit = Eigen::Vector3d::Zero();  // the filter's position after the newest detection
+    SizeEstimator size;                                       // the track's detections for its range scale
+    SizeEstimate scale;                 // the adopted range scale: detections enter the filter at c + s (z - c)
+    SizeEstimate candidate;             // an acceptable fit waiting for a second, later one that agrees with it
+    int64_t candidate_utime = -1;       // its time; -1: none
+    int64_t coasting_since_utime = -1;  // first frame of the current run of ambiguous frames; -1: none
   };
 
   /// `cost` (optional): the tracks x detections squared Mahalanobis distances (kForbiddenCost outside the gates).
@@ -282,6 +298,17 @@ class Tracker {
   bool confident_enough(const Track& t) const;
   bool duplicates_a_confirmed_track(const Track& t) const;
   void merge_duplicates(int64_t utime);  // also removes tracks marked id = -1
+  /// The id for `t`, confirmed at `utime`: a remembered (deleted) track's whose gate holds it (reacquire_s), the
+  /// nearest, else a new one.
+  int32_t id_for_confirmed(const Track& t, int64_t utime);
+
+  /// A deleted confirmed track, remembered for re-acquisition.
+  struct Lost {
+    int32_t id;
+    Eigen::Vector3d p_at_last_hit;
+    int64_t last_hit_utime;
+  };
+  std::vector<Lost> lost_;
 
   TrackerOptions options_;
   TrackerMode mode_;
