@@ -363,25 +363,30 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
     }
     // Every camera's image and detections of this frame, before the lockstep wait (once per frame): those exposed at
     // t_k, then each later exposure (cameras.stagger_s) after its own pose and ground truth.
-    std::vector<std::pair<size_t, const wingman::ground_truth_t*>> order;  // camera index, the truth of its exposure
+    struct Publish {
+      size_t camera;  // index into outputs and frame.cameras
+      int exposure;   // -1: t_k (frame.truth), else frame.later[exposure]
+      bool opens_it;  // the exposure's first camera: its own pose and ground truth go out before it
+    };
+    std::vector<Publish> order;
     {
       std::vector<bool> later(outputs.size(), false);
       for (const sim::SimExposure& e : frame.later)
         for (const size_t i : e.camera_indices) later[i] = true;
       for (size_t i = 0; i < outputs.size(); ++i)
-        if (!later[i]) order.emplace_back(i, &frame.truth);
-      for (const sim::SimExposure& e : frame.later)
-        for (const size_t i : e.camera_indices) order.emplace_back(i, &e.truth);
+        if (!later[i]) order.push_back({i, -1, false});
+      for (size_t e = 0; e < frame.later.size(); ++e)
+        for (const size_t i : frame.later[e].camera_indices)
+          order.push_back({i, static_cast<int>(e), i == frame.later[e].camera_indices.front()});
     }
-    size_t next_later = 0;  // the first exposure of frame.later not published yet
     for (size_t k = 0; k < order.size(); ++k) {
-      const auto [i, truth] = order[k];
+      const size_t i = order[k].camera;
+      const wingman::ground_truth_t& truth = order[k].exposure < 0 ? frame.truth : frame.later[order[k].exposure].truth;
       const sim::SimCameraFrame& view = frame.cameras[i];
       const sim::SimCameraOutput& out = outputs[i];
-      if (next_later < frame.later.size() && truth == &frame.later[next_later].truth) {
-        const sim::SimExposure& e = frame.later[next_later++];
-        if (!mav) rt.publish(o.own_pose_channel, e.own_pose);  // over MAVLink the companion's rate holds
-        rt.publish(o.ground_truth_channel, e.truth);
+      if (order[k].opens_it) {
+        if (!mav) rt.publish(o.own_pose_channel, frame.later[order[k].exposure].own_pose);  // MAVLink: the companion's
+        rt.publish(o.ground_truth_channel, truth);
       }
       if (!view.bgr.empty()) {
         rt.publish(out.image_channel, sim::to_image_message(view.bgr, view.utime, frame.index, view.camera_id));
@@ -392,7 +397,7 @@ int run(common::Runtime& rt, const sim::SimOptions& o, const sim::Scenario& scen
       }
       if (o.detections.from_ground_truth) {
         rt.publish(out.detections_channel,
-                   sim::truth_detections(*truth, frame.index, out.camera.model, view.T_cam_to_world, view.camera_id,
+                   sim::truth_detections(truth, frame.index, out.camera.model, view.T_cam_to_world, view.camera_id,
                                          o.detections, static_cast<int>(i)));
       }
       if (image_by_image && k + 1 < order.size() && !view.bgr.empty() && !input_ended) {
