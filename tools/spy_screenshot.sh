@@ -69,26 +69,47 @@ trap cleanup EXIT
 
 fail() {
   echo "spy_screenshot: FAILED: $*" >&2
+  if [ -n "$xvfb_pid" ]; then
+    kill -0 "$xvfb_pid" 2>/dev/null && echo "spy_screenshot: Xvfb (pid $xvfb_pid) is running" >&2 ||
+      echo "spy_screenshot: Xvfb (pid $xvfb_pid) has exited" >&2
+  fi
+  # A Java exception's message is its first line and the stack follows: show both ends of a long log.
   for f in spy.log xvfb.log publish.log; do
     if [ -s "$work/$f" ]; then
-      echo "---- $f (last 20 lines) ----" >&2
-      tail -n 20 "$work/$f" >&2
+      if [ "$(wc -l <"$work/$f")" -le 40 ]; then
+        echo "---- $f ----" >&2
+        cat "$work/$f" >&2
+      else
+        echo "---- $f (first 10 and last 20 lines) ----" >&2
+        head -n 10 "$work/$f" >&2
+        echo "[...]" >&2
+        tail -n 20 "$work/$f" >&2
+      fi
     fi
   done
   exit 1
 }
 
-# Xvfb picks a free display itself and writes its number to fd 3.
+# Xvfb picks a free display itself and writes its number, then a newline, to fd 3 (two writes: a number read before
+# its newline may be cut short, e.g. 1 of 10).
 Xvfb -displayfd 3 -screen 0 "$screen" -nolisten tcp 3>"$work/display" >"$work/xvfb.log" 2>&1 &
 xvfb_pid=$!
+display_complete() { [ -s "$work/display" ] && [ "$(tail -c 1 "$work/display" | od -An -c | tr -d ' ')" = '\n' ]; }
 for _ in $(seq 100); do
-  [ -s "$work/display" ] && break
+  display_complete && break
   kill -0 "$xvfb_pid" 2>/dev/null || fail "Xvfb exited"
   sleep 0.1
 done
-[ -s "$work/display" ] || fail "Xvfb did not report a display within 10 s"
+display_complete || fail "Xvfb did not report a display within 10 s"
 DISPLAY=":$(tr -d '[:space:]' <"$work/display")"
 export DISPLAY
+# The server must answer a client before Java's toolkit connects: Java gives up at its first failed connection.
+for _ in $(seq 100); do
+  xwininfo -root >/dev/null 2>&1 && break
+  kill -0 "$xvfb_pid" 2>/dev/null || fail "Xvfb exited after reporting $DISPLAY"
+  sleep 0.1
+done
+xwininfo -root >/dev/null 2>&1 || fail "Xvfb on $DISPLAY answered no client within 10 s"
 echo "spy_screenshot: Xvfb on $DISPLAY ($screen), LCM $url"
 
 "$bin_dir/wingman" spy --lcm-url "$url" >"$work/spy.log" 2>&1 &
