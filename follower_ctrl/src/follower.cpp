@@ -151,8 +151,15 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
   if (localizer_armed_) localizer_seen_utime_ = msg.utime;
   const OwnState own = own_->predicted_to(msg.utime);
   const std::vector<TargetState> usable = usable_targets(msg, timeout_us_);
-  const std::optional<TargetState> chosen =
-      select_target(usable, followed_track_id_, select_policy_, own.p_body_in_world);
+  std::optional<TargetState> chosen = select_target(usable, followed_track_id_, select_policy_, own.p_body_in_world);
+  // Another track than the one that has gone is taken only formation.reselect_after_s after its newest image.
+  std::string waiting;
+  if (chosen && last_target_ && chosen->track_id != followed_track_id_ &&
+      seconds_between(last_target_->source_utime, msg.utime) < options_.formation.reselect_after_s) {
+    waiting = fmt::format("; not switching to track {} within formation.reselect_after_s = {} of track {}'s last image",
+                          chosen->track_id, options_.formation.reselect_after_s, followed_track_id_);
+    chosen.reset();
+  }
   TargetState target;
   std::string detail;
   if (chosen) {
@@ -164,13 +171,13 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
     detail = fmt::format("following track {} on {}", followed_track_id_, source_name(target.detection_source));
   } else if (last_target_ && common::is_fresh(msg.utime, last_target_->source_utime, timeout_us_)) {
     target = last_target_->predicted_to(msg.utime);
-    detail = fmt::format("coasting on track {}: no usable update, newest image {:.3f} s old", followed_track_id_,
-                         seconds_between(last_target_->source_utime, msg.utime));
+    detail = fmt::format("coasting on track {}: no usable update, newest image {:.3f} s old{}", followed_track_id_,
+                         seconds_between(last_target_->source_utime, msg.utime), waiting);
   } else {
     const std::string why =
         last_target_
-            ? fmt::format("target lost: track {} not seen for {:.3f} s (hold.timeout_s = {})", followed_track_id_,
-                          seconds_between(last_target_->source_utime, msg.utime), options_.hold_timeout_s)
+            ? fmt::format("target lost: track {} not seen for {:.3f} s (hold.timeout_s = {}){}", followed_track_id_,
+                          seconds_between(last_target_->source_utime, msg.utime), options_.hold_timeout_s, waiting)
             : std::string("no usable target yet (world-frame targets with an image within hold.timeout_s)");
     out.setpoint = hold(msg.utime, why);  // the lost track is remembered: a later hold still names it
     return out;

@@ -49,6 +49,7 @@ std::vector<std::string> FormationOptions::validate() const {
   finite_nonneg("formation.integral_max_m_s", integral_max_m_s);
   if (!parse_select_policy(select))
     p.push_back(problem("formation.select", select, "must be most_confident or nearest"));
+  finite_nonneg("formation.reselect_after_s", reselect_after_s);
   finite_nonneg("formation.avoid_radius_m", avoid_radius_m);
   finite_nonneg("formation.avoid_climb_mps", avoid_climb_mps);
   finite_nonneg("formation.yaw_kp", yaw_kp);

@@ -224,6 +224,7 @@ TEST(Follower, NedOwnPoseAndNedTargetsFlyTheSameAsEnuWithNedSetpoints) {
 TEST(Follower, KeepsTheFollowedTrackWhileReportedThenSwitchesWithAFreshPid) {
   auto opts = wide("formation");
   opts.formation.kd = 1.0;
+  opts.formation.reselect_after_s = 0.0;  // switch as soon as the followed track has gone
   Follower f(opts);
   auto step = [&](int k, std::vector<wingman::target_t> list) {
     const int64_t t = kT0 + k * 100 * kMs;
@@ -239,6 +240,65 @@ TEST(Follower, KeepsTheFollowedTrackWhileReportedThenSwitchesWithAFreshPid) {
   EXPECT_EQ(s.target_track_id, 2);
   // 4 m east of the formation point; without the PID reset D would add 1 * (4 - 0) / 0.1 = 40 m/s.
   EXPECT_VEC_NEAR(velocity_of(s), Vector3d(4, 0, 0), kTol);
+}
+
+TEST(Follower, AfterTheFollowedTrackHasGoneAnotherIsTakenOnlyAfterReselectAfterS) {
+  auto opts = wide("formation");
+  opts.formation.reselect_after_s = 2.0;
+  Follower f(opts);
+  // Every 100 ms of message time; the follower on station, the targets still.
+  auto step = [&](int k, std::vector<wingman::target_t> list) {
+    const int64_t t = kT0 + k * 100 * kMs;
+    f.on_own_pose(own_pose(t, {0, -6, 5}));
+    for (auto& x : list) x.source_utime = x.predicted_utime = t;
+    return *f.on_targets(targets(t, list)).setpoint;
+  };
+  const auto leader = target(1, Vector3d(0, 0, 5), Vector3d::Zero(), 0, 0, 0.5f);
+  const auto bird = target(2, Vector3d(8, 3, 5), Vector3d::Zero(), 0, 0, 0.9f);
+  EXPECT_EQ(step(0, {leader}).target_track_id, 1);
+  // The leader's track has gone at 0.1 s (its newest image at 0 s); a more confident track is there.
+  for (int k = 1; k <= 19; ++k) {  // 0.1 .. 1.9 s after the leader's last image
+    const setpoint_t s = step(k, {bird});
+    SCOPED_TRACE(testing::Message() << "t = " << k * 0.1 << " s: " << f.status().detail);
+    EXPECT_NE(f.status().detail.find("not switching to track 2 within formation.reselect_after_s = 2 of track 1's "
+                                     "last image"),
+              std::string::npos);
+    if (k <= 5) {  // hold.timeout_s 0.5: coasting on the leader
+      EXPECT_EQ(s.mode, kVelocity);
+      EXPECT_EQ(s.target_track_id, 1);
+      EXPECT_NE(f.status().detail.find("coasting on track 1"), std::string::npos);
+    } else {
+      EXPECT_EQ(s.mode, kHold);
+      EXPECT_EQ(s.target_track_id, 0);
+      EXPECT_NE(f.status().detail.find("target lost: track 1 not seen for"), std::string::npos);
+    }
+  }
+  // 2 s after the leader's last image: the other track is followed.
+  EXPECT_EQ(step(20, {bird}).target_track_id, 2);
+  EXPECT_EQ(step(21, {bird, leader}).target_track_id, 2) << "now track 2 is the followed one";
+
+  // The followed track coming back within the wait is taken back at once.
+  Follower g(opts);
+  auto step_g = [&](int k, std::vector<wingman::target_t> list) {
+    const int64_t t = kT0 + k * 100 * kMs;
+    g.on_own_pose(own_pose(t, {0, -6, 5}));
+    for (auto& x : list) x.source_utime = x.predicted_utime = t;
+    return *g.on_targets(targets(t, list)).setpoint;
+  };
+  EXPECT_EQ(step_g(0, {leader}).target_track_id, 1);
+  EXPECT_EQ(step_g(10, {bird}).mode, kHold);  // 1 s without the leader
+  const setpoint_t back = step_g(15, {bird, leader});
+  EXPECT_EQ(back.mode, kVelocity);
+  EXPECT_EQ(back.target_track_id, 1);
+  EXPECT_NE(g.status().detail.find("following track 1"), std::string::npos) << g.status().detail;
+}
+
+TEST(Follower, AtTheStartTheFirstTrackIsTakenWithoutWaiting) {
+  Follower f(wide("formation"));  // reselect_after_s 10 by default
+  f.on_own_pose(own_pose(kT0, {0, -6, 5}));
+  EXPECT_EQ(
+      f.on_targets(targets(kT0, {target(5, Vector3d(0, 0, 5), Vector3d::Zero(), kT0, kT0)})).setpoint->target_track_id,
+      5);
 }
 
 TEST(Follower, SelectionPolicyPicksTheFirstTrack) {

@@ -174,13 +174,15 @@ TEST(FormationController, ValidateNamesEveryBadKey) {
   o.select = "random";
   o.kp = -1;
   o.avoid_radius_m = std::nan("");
+  o.reselect_after_s = -1;
   const auto p = o.validate();
   const std::string all = testing::PrintToString(p);
   for (const char* key : {"formation.offset_m = '[1, 2]': must be 3 finite numbers",
                           "formation.height_mode = 'sky': must be start, fixed or target",
-                          "formation.select = 'random'", "formation.kp = -1", "formation.avoid_radius_m = nan"})
+                          "formation.select = 'random'", "formation.kp = -1", "formation.avoid_radius_m = nan",
+                          "formation.reselect_after_s = -1: must be a finite number >= 0"})
     EXPECT_NE(all.find(key), std::string::npos) << key << " not in " << all;
-  EXPECT_EQ(p.size(), 5u) << all;
+  EXPECT_EQ(p.size(), 6u) << all;
 
   FormationOptions inside;
   inside.offset_m = {0.0, -2.0, 5.0};  // 2 m horizontally, within the 3 m avoidance radius

@@ -51,6 +51,10 @@ struct FollowerOutput {
 /// Within the timeout, without a usable target in the input:
 ///  - formation coasts on the last target's constant-velocity prediction (the tracker's model);
 ///  - pid_1d commands 0 along its axis (ramped by the acceleration limit), height still held.
+/// Formation keeps the followed track while the localizer reports it; once it has gone, another track is chosen
+/// (formation.select) only formation.reselect_after_s after the gone track's newest image: until then the follower
+/// coasts and holds as above (the hold's detail names the track it does not switch to) and takes the followed track
+/// back when it is reported again (the tracker gives a re-acquired target its old id).
 /// Own poses: when no driving input has arrived for longer than hold.timeout_s of own-pose time
 /// (counted from the first own pose when none has arrived yet), each own pose gives one MODE_HOLD
 /// with its utime, so a stopped localizer or detector cannot leave the follower flying.

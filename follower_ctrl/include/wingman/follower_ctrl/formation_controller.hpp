@@ -37,6 +37,12 @@ struct FormationOptions {
   /// Which target to follow when none is followed yet or the followed track has gone:
   /// "most_confident" or "nearest". A followed track is kept while the tracker reports it.
   std::string select = "most_confident";
+  /// After the followed track has gone, seconds of message time (since its newest image) before another track may
+  /// be chosen; until then the follower coasts and then holds, and takes the followed track back if the localizer
+  /// reports it again. The default is the tracker's memory for a lost track (the localizer's tracker.reacquire_s,
+  /// 10 s): a track confirmed near where the lost one could be takes its id, so within that time another id is
+  /// something else (a bird, a false track, another drone). 0: switch at once (>= 0, finite).
+  double reselect_after_s = 10.0;
   /// Collision avoidance: while the target is closer than this (3-D distance, metres), the command
   /// has no component towards it and climbs at avoid_climb_mps. 0 disables.
   double avoid_radius_m = 3.0;
@@ -68,6 +74,8 @@ struct FormationOptions {
     v("formation.integral_max_m_s", integral_max_m_s, "clamp of each axis's position error integral, m s");
     v("formation.select", select,
       "target choice when no track is followed or it has gone: most_confident or nearest (a followed track is kept)");
+    v("formation.reselect_after_s", reselect_after_s,
+      "after the followed track has gone, wait this long (message time since its newest image, s) before another");
     v("formation.avoid_radius_m", avoid_radius_m,
       "collision avoidance: target closer than this (3-D), m -> no approach and climb; 0 disables");
     v("formation.avoid_climb_mps", avoid_climb_mps, "climb rate while avoiding, m/s");
