@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -71,6 +72,7 @@ void Follower::forget_time_state() {
   first_pose_utime_.reset();
   last_driving_utime_.reset();
   followed_track_id_ = 0;
+  followed_since_utime_ = 0;
   last_target_.reset();
   last_box_utime_.reset();
   formation_.reset();
@@ -152,18 +154,26 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
   const OwnState own = own_->predicted_to(msg.utime);
   const std::vector<TargetState> usable = usable_targets(msg, timeout_us_);
   std::optional<TargetState> chosen = select_target(usable, followed_track_id_, select_policy_, own.p_body_in_world);
-  // Another track than the one that has gone is taken only formation.reselect_after_s after its newest image.
+  // Another track than the one that has gone is taken only after a wait since its newest image: as long as it was
+  // followed, at most formation.reselect_after_s.
   std::string waiting;
-  if (chosen && last_target_ && chosen->track_id != followed_track_id_ &&
-      seconds_between(last_target_->source_utime, msg.utime) < options_.formation.reselect_after_s) {
-    waiting = fmt::format("; not switching to track {} within formation.reselect_after_s = {} of track {}'s last image",
-                          chosen->track_id, options_.formation.reselect_after_s, followed_track_id_);
-    chosen.reset();
+  if (chosen && last_target_ && chosen->track_id != followed_track_id_) {
+    const double followed_s = seconds_between(followed_since_utime_, last_target_->source_utime);
+    const double wait_s = std::min(options_.formation.reselect_after_s, followed_s);
+    if (seconds_between(last_target_->source_utime, msg.utime) < wait_s)
+      waiting = fmt::format(
+          "; not switching to track {} for {:.3f} s after track {}'s last image (as long as it was followed, at most "
+          "formation.reselect_after_s = {})",
+          chosen->track_id, wait_s, followed_track_id_, options_.formation.reselect_after_s);
   }
+  if (!waiting.empty()) chosen.reset();
   TargetState target;
   std::string detail;
   if (chosen) {
-    if (chosen->track_id != followed_track_id_) formation_.reset_pid();  // track switch
+    if (chosen->track_id != followed_track_id_) {  // a track switch, or the first track
+      formation_.reset_pid();
+      followed_since_utime_ = chosen->source_utime;
+    }
     followed_track_id_ = chosen->track_id;
     last_target_ = *chosen;
     last_source_ = chosen->detection_source;

@@ -242,55 +242,60 @@ TEST(Follower, KeepsTheFollowedTrackWhileReportedThenSwitchesWithAFreshPid) {
   EXPECT_VEC_NEAR(velocity_of(s), Vector3d(4, 0, 0), kTol);
 }
 
-TEST(Follower, AfterTheFollowedTrackHasGoneAnotherIsTakenOnlyAfterReselectAfterS) {
+TEST(Follower, AfterTheFollowedTrackHasGoneAnotherIsTakenOnlyAfterAWait) {
   auto opts = wide("formation");
   opts.formation.reselect_after_s = 2.0;
-  Follower f(opts);
-  // Every 100 ms of message time; the follower on station, the targets still.
-  auto step = [&](int k, std::vector<wingman::target_t> list) {
-    const int64_t t = kT0 + k * 100 * kMs;
-    f.on_own_pose(own_pose(t, {0, -6, 5}));
-    for (auto& x : list) x.source_utime = x.predicted_utime = t;
-    return *f.on_targets(targets(t, list)).setpoint;
-  };
   const auto leader = target(1, Vector3d(0, 0, 5), Vector3d::Zero(), 0, 0, 0.5f);
   const auto bird = target(2, Vector3d(8, 3, 5), Vector3d::Zero(), 0, 0, 0.9f);
-  EXPECT_EQ(step(0, {leader}).target_track_id, 1);
-  // The leader's track has gone at 0.1 s (its newest image at 0 s); a more confident track is there.
-  for (int k = 1; k <= 19; ++k) {  // 0.1 .. 1.9 s after the leader's last image
-    const setpoint_t s = step(k, {bird});
-    SCOPED_TRACE(testing::Message() << "t = " << k * 0.1 << " s: " << f.status().detail);
-    EXPECT_NE(f.status().detail.find("not switching to track 2 within formation.reselect_after_s = 2 of track 1's "
-                                     "last image"),
+  // Every 100 ms of message time; the follower on station, the targets still.
+  struct Flight {
+    Follower f;
+    setpoint_t step(int k, std::vector<wingman::target_t> list) {
+      const int64_t t = kT0 + k * 100 * kMs;
+      f.on_own_pose(own_pose(t, {0, -6, 5}));
+      for (auto& x : list) x.source_utime = x.predicted_utime = t;
+      return *f.on_targets(targets(t, list)).setpoint;
+    }
+  };
+
+  // The leader followed for 3 s (images 0 .. 3 s), then gone; a more confident track is there: the wait is 2 s.
+  Flight a{Follower(opts)};
+  for (int k = 0; k <= 30; ++k) ASSERT_EQ(a.step(k, {leader}).target_track_id, 1);
+  for (int k = 31; k <= 49; ++k) {  // 0.1 .. 1.9 s after the leader's last image
+    const setpoint_t s = a.step(k, {bird});
+    SCOPED_TRACE(testing::Message() << "t = " << k * 0.1 << " s: " << a.f.status().detail);
+    EXPECT_NE(a.f.status().detail.find("not switching to track 2 for 2.000 s after track 1's last image (as long as "
+                                       "it was followed, at most formation.reselect_after_s = 2)"),
               std::string::npos);
-    if (k <= 5) {  // hold.timeout_s 0.5: coasting on the leader
+    if (k <= 35) {  // hold.timeout_s 0.5: coasting on the leader
       EXPECT_EQ(s.mode, kVelocity);
       EXPECT_EQ(s.target_track_id, 1);
-      EXPECT_NE(f.status().detail.find("coasting on track 1"), std::string::npos);
+      EXPECT_NE(a.f.status().detail.find("coasting on track 1"), std::string::npos);
     } else {
       EXPECT_EQ(s.mode, kHold);
       EXPECT_EQ(s.target_track_id, 0);
-      EXPECT_NE(f.status().detail.find("target lost: track 1 not seen for"), std::string::npos);
+      EXPECT_NE(a.f.status().detail.find("target lost: track 1 not seen for"), std::string::npos);
     }
   }
-  // 2 s after the leader's last image: the other track is followed.
-  EXPECT_EQ(step(20, {bird}).target_track_id, 2);
-  EXPECT_EQ(step(21, {bird, leader}).target_track_id, 2) << "now track 2 is the followed one";
+  // 2 s after the leader's last image: the other track is followed, and kept.
+  EXPECT_EQ(a.step(50, {bird}).target_track_id, 2);
+  EXPECT_EQ(a.step(51, {bird, leader}).target_track_id, 2) << "now track 2 is the followed one";
 
   // The followed track coming back within the wait is taken back at once.
-  Follower g(opts);
-  auto step_g = [&](int k, std::vector<wingman::target_t> list) {
-    const int64_t t = kT0 + k * 100 * kMs;
-    g.on_own_pose(own_pose(t, {0, -6, 5}));
-    for (auto& x : list) x.source_utime = x.predicted_utime = t;
-    return *g.on_targets(targets(t, list)).setpoint;
-  };
-  EXPECT_EQ(step_g(0, {leader}).target_track_id, 1);
-  EXPECT_EQ(step_g(10, {bird}).mode, kHold);  // 1 s without the leader
-  const setpoint_t back = step_g(15, {bird, leader});
+  Flight b{Follower(opts)};
+  for (int k = 0; k <= 30; ++k) b.step(k, {leader});
+  EXPECT_EQ(b.step(40, {bird}).mode, kHold);  // 1 s without the leader
+  const setpoint_t back = b.step(45, {bird, leader});
   EXPECT_EQ(back.mode, kVelocity);
   EXPECT_EQ(back.target_track_id, 1);
-  EXPECT_NE(g.status().detail.find("following track 1"), std::string::npos) << g.status().detail;
+  EXPECT_NE(b.f.status().detail.find("following track 1"), std::string::npos) << b.f.status().detail;
+
+  // A track followed for 0.4 s only (a false one at the start) is waited for 0.4 s.
+  Flight c{Follower(opts)};
+  for (int k = 0; k <= 4; ++k) ASSERT_EQ(c.step(k, {bird}).target_track_id, 2);
+  EXPECT_EQ(c.step(5, {leader}).target_track_id, 2);  // 0.1 s: coasting on the bird
+  EXPECT_NE(c.f.status().detail.find("not switching to track 1 for 0.400 s"), std::string::npos) << c.f.status().detail;
+  EXPECT_EQ(c.step(8, {leader}).target_track_id, 1);  // 0.4 s after the bird's last image
 }
 
 TEST(Follower, AtTheStartTheFirstTrackIsTakenWithoutWaiting) {

@@ -52,9 +52,10 @@ struct FollowerOutput {
 ///  - formation coasts on the last target's constant-velocity prediction (the tracker's model);
 ///  - pid_1d commands 0 along its axis (ramped by the acceleration limit), height still held.
 /// Formation keeps the followed track while the localizer reports it; once it has gone, another track is chosen
-/// (formation.select) only formation.reselect_after_s after the gone track's newest image: until then the follower
-/// coasts and holds as above (the hold's detail names the track it does not switch to) and takes the followed track
-/// back when it is reported again (the tracker gives a re-acquired target its old id).
+/// (formation.select) only after a wait from the gone track's newest image: as long as that track was followed (its
+/// images), at most formation.reselect_after_s. Until then the follower coasts and holds as above (the detail names
+/// the track it does not switch to) and takes the followed track back when it is reported again (the tracker gives a
+/// re-acquired target its old id).
 /// Own poses: when no driving input has arrived for longer than hold.timeout_s of own-pose time
 /// (counted from the first own pose when none has arrived yet), each own pose gives one MODE_HOLD
 /// with its utime, so a stopped localizer or detector cannot leave the follower flying.
@@ -138,6 +139,7 @@ class Follower {
   int8_t last_source_ = wingman::detections_t::SOURCE_CNN;
   int32_t followed_track_id_ = 0;           ///< formation: the track followed, 0 none
   std::optional<TargetState> last_target_;  ///< formation: the last usable state of the followed track
+  int64_t followed_since_utime_ = 0;        ///< formation: newest image of the followed track when it was chosen
   std::optional<int64_t> last_box_utime_;   ///< pid_1d: utime of the last detections with a usable box
   int64_t localizer_timeout_us_;
   bool localizer_armed_ = false;                 ///< a localizer heartbeat has arrived

@@ -37,11 +37,13 @@ struct FormationOptions {
   /// Which target to follow when none is followed yet or the followed track has gone:
   /// "most_confident" or "nearest". A followed track is kept while the tracker reports it.
   std::string select = "most_confident";
-  /// After the followed track has gone, seconds of message time (since its newest image) before another track may
-  /// be chosen; until then the follower coasts and then holds, and takes the followed track back if the localizer
-  /// reports it again. The default is the tracker's memory for a lost track (the localizer's tracker.reacquire_s,
-  /// 10 s): a track confirmed near where the lost one could be takes its id, so within that time another id is
-  /// something else (a bird, a false track, another drone). 0: switch at once (>= 0, finite).
+  /// After the followed track has gone, the longest wait, seconds of message time since its newest image, before
+  /// another track may be chosen; the wait is as long as the gone track was followed (from its newest image when it
+  /// was chosen), at most this, so a track followed briefly (a false one at the start) is not waited for long. Until
+  /// then the follower coasts and then holds, and takes the followed track back if the localizer reports it again.
+  /// The default is the tracker's memory for a lost track (the localizer's tracker.reacquire_s, 10 s): a track
+  /// confirmed near where the lost one could be takes its id, so within that time another id is something else (a
+  /// bird, a false track, another drone). 0: switch at once (>= 0, finite).
   double reselect_after_s = 10.0;
   /// Collision avoidance: while the target is closer than this (3-D distance, metres), the command
   /// has no component towards it and climbs at avoid_climb_mps. 0 disables.
@@ -75,7 +77,8 @@ struct FormationOptions {
     v("formation.select", select,
       "target choice when no track is followed or it has gone: most_confident or nearest (a followed track is kept)");
     v("formation.reselect_after_s", reselect_after_s,
-      "after the followed track has gone, wait this long (message time since its newest image, s) before another");
+      "after the followed track has gone, wait as long as it was followed, at most this (s since its newest image), "
+      "before another");
     v("formation.avoid_radius_m", avoid_radius_m,
       "collision avoidance: target closer than this (3-D), m -> no approach and climb; 0 disables");
     v("formation.avoid_climb_mps", avoid_climb_mps, "climb rate while avoiding, m/s");
