@@ -160,13 +160,14 @@ FollowerOutput Follower::on_targets(const wingman::targets_t& msg) {
   if (chosen && last_target_ && chosen->track_id != followed_track_id_) {
     const double followed_s = seconds_between(followed_since_utime_, last_target_->source_utime);
     const double wait_s = std::min(options_.formation.reselect_after_s, followed_s);
-    if (seconds_between(last_target_->source_utime, msg.utime) < wait_s)
+    if (seconds_between(last_target_->source_utime, msg.utime) < wait_s) {
       waiting = fmt::format(
           "; not switching to track {} for {:.3f} s after track {}'s last image (as long as it was followed, at most "
           "formation.reselect_after_s = {})",
           chosen->track_id, wait_s, followed_track_id_, options_.formation.reselect_after_s);
+      chosen.reset();
+    }
   }
-  if (!waiting.empty()) chosen.reset();
   TargetState target;
   std::string detail;
   if (chosen) {
