@@ -2,7 +2,8 @@
 // wingman-detector as a process without a usable OpenCL device: no platform at all (OCL_ICD_VENDORS pointing at an
 // empty folder), a platform without devices (PoCL asked for a device kind it lacks), and a device whose kernels fail
 // to build (an option its compiler rejects). model.backend = opencl: exit 1 with one line; auto: the CPU backend, one
-// warning, and the heartbeat names the backend.
+// warning, and the heartbeat names the backend (in replay mode, where auto does not time the backends, and in
+// realtime mode, where it does).
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -45,10 +46,11 @@ std::string write_frames(const TempDir& dir) {
   return path;
 }
 
-std::string write_config(const TempDir& dir, const std::string& backend, const std::string& build_options = "") {
-  const std::string path = dir.file("detector-" + backend + ".yaml");
+std::string write_config(const TempDir& dir, const std::string& backend, const std::string& build_options = "",
+                         const std::string& mode = "replay") {
+  const std::string path = dir.file("detector-" + backend + "-" + mode + ".yaml");
   std::ofstream f(path);
-  f << "input: {mode: replay}\nmodel: {backend: " << backend << "}\n";
+  f << "input: {mode: " << mode << "}\nmodel: {backend: " << backend << "}\n";
   if (!build_options.empty()) f << "opencl: {build_options: \"" << build_options << "\"}\n";
   return path;
 }
@@ -88,14 +90,17 @@ void expect_one_line_error(const RunResult& r, const std::vector<std::string>& m
     EXPECT_NE(errors[0].find(s), std::string::npos) << "'" << s << "' in " << errors[0];
 }
 
-/// The run processed every frame on the CPU backend, warned once why, and its heartbeat said so.
-void expect_cpu_fallback(const RunResult& r, const std::string& out, const std::string& reason) {
+/// The run processed every frame (replay mode; realtime mode: at least one, the newest) on the CPU backend, warned once
+/// why, and its heartbeat said so.
+void expect_cpu_fallback(const RunResult& r, const std::string& out, const std::string& reason, bool replay = true) {
+  const std::string said = replay ? "backend cpu (auto in replay mode: no usable OpenCL device"
+                                  : "backend cpu (auto: no usable OpenCL device";
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int warnings = 0;
   for (const auto& l : lines(r.err)) {
     if (l.find(" warning: ") == std::string::npos) continue;
     ++warnings;
-    EXPECT_NE(l.find("backend cpu (auto: no usable OpenCL device"), std::string::npos) << l;
+    EXPECT_NE(l.find(said), std::string::npos) << l;
     EXPECT_NE(l.find(reason), std::string::npos) << "'" << reason << "' in " << l;
   }
   EXPECT_EQ(warnings, 1) << r.err;
@@ -109,10 +114,14 @@ void expect_cpu_fallback(const RunResult& r, const std::string& out, const std::
     if (e.channel != "STATUS_DETECTOR") continue;
     wingman::status_t s;
     ASSERT_GE(s.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0);
-    if (s.state == wingman::status_t::STATE_OK && s.detail.rfind("backend cpu (auto: no usable OpenCL device", 0) == 0)
-      detail_names_backend = true;
+    if (s.state == wingman::status_t::STATE_OK && s.detail.rfind(said, 0) == 0) detail_names_backend = true;
   }
-  EXPECT_EQ(detections, kFrames);
+  if (replay) {
+    EXPECT_EQ(detections, kFrames);
+  } else {
+    EXPECT_GE(detections, 1);
+    EXPECT_LE(detections, kFrames);
+  }
   EXPECT_TRUE(detail_names_backend) << "no STATUS_DETECTOR heartbeat with state OK naming the CPU backend";
 }
 
@@ -130,6 +139,13 @@ TEST(DetectorBackendFaults, AutoWithoutAnyPlatformRunsOnTheCpuWithOneWarning) {
   const std::string out = dir.file("out.lcmlog");
   const auto r = run_detector(dir, write_config(dir, "auto"), {"OCL_ICD_VENDORS=" + dir.path()}, out);
   expect_cpu_fallback(r, out, kNoPlatform);
+}
+
+TEST(DetectorBackendFaults, AutoInRealtimeModeWithoutAnyPlatformRunsOnTheCpuWithOneWarning) {
+  TempDir dir;
+  const std::string out = dir.file("out.lcmlog");
+  const auto r = run_detector(dir, write_config(dir, "auto", "", "realtime"), {"OCL_ICD_VENDORS=" + dir.path()}, out);
+  expect_cpu_fallback(r, out, kNoPlatform, /*replay=*/false);
 }
 
 TEST(DetectorBackendFaults, OpenClPlatformWithoutDevicesExitsOneWithOneLine) {

@@ -26,9 +26,13 @@
 #     configuration;
 #   - no program restarted during the flight (same pids), the recorder wrote a recording in the installed folder,
 #     and SIGTERM to supervisord stops every program with exit status 0.
-# Then: both flights' eval.json are equal, the fields with latency in their names aside (wall-clock), and their
-# targets.csv are equal byte for byte; the /usr flight is within installed_flight's bounds (localization RMS <= 0.45
-# m, formation RMS <= 0.60 m, estimates in >= 90 % of the frames with the leader visible, one id, no false target).
+# Then: each flight is within installed_flight's bounds (localization RMS <= 0.45 m, formation RMS <= 0.60 m,
+# estimates in >= 90 % of the frames with the leader visible, one id, no false target). When both detectors ran the
+# same backend (their heartbeats say which: "auto" times OpenCL against OpenCV's CPU path at start, so under load the
+# two installs may choose differently), both flights' eval.json are equal, the fields with latency in their names
+# aside (wall-clock), and their targets.csv equal byte for byte; otherwise their localization RMS agree within 0.05 m,
+# their formation RMS within 0.15 m and their frame counts within 2 % (the two backends, each pinned, flew this
+# 12-s flight 0.022 m and 0.073 m apart).
 # The host's /usr/bin/wingman-detector, /etc/wingman, /opt/wingman, /etc/opt/wingman and /var/log/wingman are
 # checked unchanged (present or absent as before).
 #
@@ -254,9 +258,22 @@ done
 [ "$(host_state)" = "$host_before" ] || { keep=1; diff <(echo "$host_before") <(host_state) || true; fail "the host changed"; }
 
 # Both prefixes, the same flight: equal figures (latency fields aside), equal targets.csv; the bounds.
+# The detector's backend "auto" takes the faster of OpenCL and OpenCV's CPU path, timed at its start: under load the two
+# installs can choose differently, and the two backends' boxes differ in the 4th decimal, which the closed loop carries
+# on. Byte-equal flights are required when both detectors ran the same backend; otherwise both flights must keep the
+# bounds and agree within stated tolerances.
 a="$work/run_usr" b="$work/run_opt_wingman"
-cmp -s "$a/targets.csv" "$b/targets.csv" || { keep=1; diff "$a/targets.csv" "$b/targets.csv" | head -n 10; fail "targets.csv differ"; }
-if ! PYTHONPATH="$src/tests/support" /usr/bin/python3 - "$a/eval.json" "$b/eval.json" "$SECONDS" <<'PY'; then
+backend() { sed -n 's/.*STATUS_DETECTOR pid [0-9]* [A-Z]*: backend \([a-z-]*\).*/\1/p' "$1/heartbeats.txt" | head -n 1; }
+backend_a=$(backend "$a") backend_b=$(backend "$b")
+[ -n "$backend_a" ] && [ -n "$backend_b" ] || fail "no detector backend in the heartbeats ($a, $b/heartbeats.txt)"
+if [ "$backend_a" = "$backend_b" ]; then
+  cmp -s "$a/targets.csv" "$b/targets.csv" ||
+    { keep=1; diff "$a/targets.csv" "$b/targets.csv" | head -n 10; fail "targets.csv differ (both detectors ran $backend_a)"; }
+else
+  echo "$me: the detectors chose different backends (/usr $backend_a, /opt/wingman $backend_b): the flights are compared" \
+       "within tolerances, not byte for byte"
+fi
+if ! PYTHONPATH="$src/tests/support" /usr/bin/python3 - "$a/eval.json" "$b/eval.json" "$backend_a" "$backend_b" <<'PY'; then
 import json, sys
 from bounds import check
 
@@ -277,6 +294,7 @@ def figures(node, path=""):
 
 
 ea, eb = (json.load(open(f)) for f in sys.argv[1:3])
+same_backend = sys.argv[3] == sys.argv[4]
 fa, fb = figures(ea), figures(eb)
 differ = sorted(k for k in set(fa) | set(fb) if fa.get(k) != fb.get(k))
 for k in differ:
@@ -295,16 +313,34 @@ for name, keys in rows:
         va, vb = va[k], vb[k]
     shown = ["%.3f" % v if isinstance(v, float) else str(v) for v in (va, vb)]
     print("  %-36s %13s %14s" % (name, shown[0], shown[1]))
-visible = ea["frames_leader_visible"]
-check("installed_supervisord", [
-    ("localization RMS (m)", ea["localization"]["rms_m"], 0.45, False),
-    ("formation RMS, horizontal (m)", ea["formation_horizontal"]["rms_m"], 0.60, False),
-    ("target estimates / frames with the leader visible", ea["target_estimates"] / max(1, visible), 0.90, True),
-    ("track ids on the leader", ea["track_ids_on_leader"], 1, False),
-    ("track ids on the leader (at least)", ea["track_ids_on_leader"], 1, True),
-    ("false targets", ea["false_targets"], 0, False),
-])
-sys.exit(1 if differ else 0)
+for name, e in (("--prefix /usr", ea), ("--prefix /opt/wingman", eb)):
+    visible = e["frames_leader_visible"]
+    check("installed_supervisord %s" % name, [
+        ("localization RMS (m)", e["localization"]["rms_m"], 0.45, False),
+        ("formation RMS, horizontal (m)", e["formation_horizontal"]["rms_m"], 0.60, False),
+        ("target estimates / frames with the leader visible", e["target_estimates"] / max(1, visible), 0.90, True),
+        ("track ids on the leader", e["track_ids_on_leader"], 1, False),
+        ("track ids on the leader (at least)", e["track_ids_on_leader"], 1, True),
+        ("false targets", e["false_targets"], 0, False),
+    ])
+if same_backend:
+    sys.exit(1 if differ else 0)
+# Different backends: the RMS figures within 0.05 m (localization) and 0.15 m (formation) of each other, the frame
+# counts within 2 % (each backend pinned, this 12-s flight: 0.339 / 0.220 m with opencl, 0.360 / 0.293 m with cpu).
+bad = []
+for keys, tol in ((("localization", "rms_m"), 0.05), (("formation_horizontal", "rms_m"), 0.15)):
+    va, vb = ea, eb
+    for k in keys:
+        va, vb = va[k], vb[k]
+    if abs(va - vb) > tol:
+        bad.append("%s: %.4f vs %.4f (tolerance %.2f m)" % (".".join(keys), va, vb, tol))
+for key in ("target_estimates", "frames_leader_visible", "frames_leader_detected"):
+    va, vb = ea[key], eb[key]
+    if abs(va - vb) > 0.02 * max(va, vb):
+        bad.append("%s: %d vs %d (tolerance 2 %%)" % (key, va, vb))
+for b in bad:
+    print("installed_supervisord: FAIL: the two backends' flights differ beyond the tolerance: " + b)
+sys.exit(1 if bad else 0)
 PY
   keep=1; fail "the two prefixes' flights differ (above) or are out of bounds"
 fi

@@ -29,9 +29,10 @@ struct DetectorOptions {
   /// Darknet .weights path, or builtin:wingman-small (the shipped trained model, built in; card:
   /// models/wingman-small.md); "" = no model: images are checked and counted, nothing is detected.
   std::string weights = "builtin:wingman-small";
-  /// auto: the faster of opencl and cpu here, timed at start-up (a GPU too: the kernels are shaped for CPUs);
-  /// without a usable OpenCL device (no platform, no device, kernels that fail to build) the CPU backend, with one
-  /// warning saying why.
+  /// auto: in realtime mode the faster of opencl and cpu here, timed at start-up (a GPU too: the kernels are shaped
+  /// for CPUs); in replay mode opencl, not timed (a timed choice can differ from run to run, and the two backends'
+  /// boxes differ in the 4th decimal: replays would not repeat); without a usable OpenCL device (no platform, no
+  /// device, kernels that fail to build) the CPU backend, with one warning saying why.
   /// opencl: OpenCL or nothing (no usable device: exit 1 with one line). cpu: OpenCV DNN.
   /// The backend that runs, and why, is the heartbeat's detail. auto chooses once, at start-up: a network built
   /// later for another frame size (model.input_size auto) takes the same kind.
@@ -62,8 +63,8 @@ struct DetectorOptions {
       "Darknet .weights path, or builtin:wingman-small (shipped, models/wingman-small.md); \"\" = no model "
       "(images are checked and counted only)");
     v("model.backend", backend,
-      "auto (the faster of opencl/cpu here, timed at start-up; no usable OpenCL device: cpu, with a warning), "
-      "opencl (no usable OpenCL device: exit 1) or cpu");
+      "auto (realtime mode: the faster of opencl/cpu here, timed at start-up; replay mode: opencl, not timed, so that "
+      "replays repeat; no usable OpenCL device: cpu, with a warning), opencl (no usable OpenCL device: exit 1) or cpu");
     v("model.input_size", input_size,
       "network input: auto (the cfg's longer side, the other fitted to the images' aspect, a multiple of 32), cfg "
       "(the cfg's size) or WxH (multiples of 32)");
