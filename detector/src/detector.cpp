@@ -72,22 +72,11 @@ std::unique_ptr<InferenceBackend> Detector::build_backend(const DarknetModel& si
   // same kind without measuring again (seconds in which no frame would be detected).
   const std::string& backend = options_.backend;
   const bool reuse = backend == "auto" && !auto_kind_.empty();
-  std::unique_ptr<InferenceBackend> made;
-  if (!reuse && backend == "auto" && options_.mode == "replay") {
-    // Replay mode: the choice must not depend on timing, or two replays of one log (two lockstep flights) could run
-    // different backends, whose boxes differ in the 4th decimal, and a closed loop carries that on. OpenCL whenever
-    // a device is usable, else the CPU backend.
-    try {
-      made = make_backend("opencl", sized, options_.opencl, options_.opencl.max_batch, nullptr);
-      why = "backend " + made->name() +
-            " (auto in replay mode: OpenCL whenever a device is usable, not timed, so that replays repeat)";
-    } catch (const std::exception& e) {
-      made = make_backend("cpu", sized, options_.opencl, options_.opencl.max_batch, nullptr);
-      why = std::string("backend cpu (auto in replay mode: no usable OpenCL device: ") + e.what() + ")";
-    }
-  } else {
-    made = make_backend(reuse ? auto_kind_ : backend, sized, options_.opencl, options_.opencl.max_batch, &why);
-  }
+  // Replay mode: the choice must not depend on timing, or two replays of one log (two lockstep flights) could run
+  // different backends, whose boxes differ in the 4th decimal, and a closed loop carries that on.
+  const AutoChoice choice = options_.mode == "replay" ? AutoChoice::kRepeatable : AutoChoice::kFastest;
+  auto made =
+      make_backend(reuse ? auto_kind_ : backend, sized, options_.opencl, options_.opencl.max_batch, &why, choice);
   if (reuse) {
     // The heartbeat keeps naming the first network and why its backend was chosen; this one is added to it.
     why = fmt::format("{}; the same backend also runs the {}x{} network", auto_why_, sized.net.width, sized.net.height);

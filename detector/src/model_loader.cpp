@@ -118,7 +118,8 @@ DarknetModel load_model(const std::string& cfg, const std::string& weights) {
 }
 
 std::unique_ptr<InferenceBackend> make_backend(const std::string& kind, const DarknetModel& model,
-                                               const OpenClOptions& opencl, int max_batch, std::string* why) {
+                                               const OpenClOptions& opencl, int max_batch, std::string* why,
+                                               AutoChoice choice) {
   OpenClOptions ocl = opencl;
   ocl.max_batch = max_batch;
   if (kind == "cpu") {
@@ -140,11 +141,17 @@ std::unique_ptr<InferenceBackend> make_backend(const std::string& kind, const Da
   }
   // A GPU is timed too: the kernels are shaped for CPUs (PoCL), and on an NVIDIA H200 they ran the thesis network
   // at 416 3x slower than OpenCV DNN on that machine's CPU cores (docs/benchmarks.md).
-  auto cpu = std::make_unique<CpuBackend>(model, max_batch);
+  const char* auto_is = choice == AutoChoice::kRepeatable ? "auto, not timed" : "auto";
   if (!gpu) {
-    if (why) *why = "backend cpu (auto: no usable OpenCL device: " + opencl_error + ")";
-    return cpu;
+    if (why) *why = fmt::format("backend cpu ({}: no usable OpenCL device: {})", auto_is, opencl_error);
+    return std::make_unique<CpuBackend>(model, max_batch);
   }
+  if (choice == AutoChoice::kRepeatable) {
+    if (why)
+      *why = "backend " + gpu->name() + " (auto, not timed: OpenCL whenever a device is usable, so that runs repeat)";
+    return gpu;
+  }
+  auto cpu = std::make_unique<CpuBackend>(model, max_batch);
   // Each warmed up once, then timed in turn, OpenCL then CPU, up to three times each, and each backend's fastest
   // forward compared: a load that changes during start-up (several detectors starting together on a small machine,
   // each timing its backends while the others do) weighs on both alike, and the fastest forward is the one it

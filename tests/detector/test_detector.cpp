@@ -289,12 +289,11 @@ TEST(Detector, AutoInReplayModeRunsOpenClWithoutTimingAndTwoRunsGiveTheSameBoxes
     const auto notes = det.take_notes();
     ASSERT_EQ(notes.size(), 1u);
     if (notes[0].text.find("no usable OpenCL device") != std::string::npos) {
-      EXPECT_EQ(notes[0].text.rfind("backend cpu (auto in replay mode: no usable OpenCL device: ", 0), 0u)
-          << notes[0].text;
+      EXPECT_EQ(notes[0].text.rfind("backend cpu (auto, not timed: no usable OpenCL device: ", 0), 0u) << notes[0].text;
       GTEST_SKIP() << "no OpenCL device here: " << notes[0].text;
     }
     EXPECT_EQ(notes[0].text.rfind("backend opencl", 0), 0u) << notes[0].text;
-    EXPECT_NE(notes[0].text.find("(auto in replay mode: OpenCL whenever a device is usable, not timed"),
+    EXPECT_NE(notes[0].text.find("(auto, not timed: OpenCL whenever a device is usable, so that runs repeat)"),
               std::string::npos)
         << notes[0].text;
     EXPECT_EQ(notes[0].text.find("fastest of"), std::string::npos) << notes[0].text;

@@ -93,8 +93,8 @@ void expect_one_line_error(const RunResult& r, const std::vector<std::string>& m
 /// The run processed every frame (replay mode; realtime mode: at least one, the newest) on the CPU backend, warned once
 /// why, and its heartbeat said so.
 void expect_cpu_fallback(const RunResult& r, const std::string& out, const std::string& reason, bool replay = true) {
-  const std::string said = replay ? "backend cpu (auto in replay mode: no usable OpenCL device"
-                                  : "backend cpu (auto: no usable OpenCL device";
+  const std::string said =
+      replay ? "backend cpu (auto, not timed: no usable OpenCL device" : "backend cpu (auto: no usable OpenCL device";
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int warnings = 0;
   for (const auto& l : lines(r.err)) {

@@ -78,7 +78,8 @@ struct PredictVerbOptions {
     v("input.images", predict.inputs, "image files and/or folders of images");
     v("model.cfg", predict.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
     v("model.weights", predict.weights, "Darknet .weights, or builtin:wingman-small (the shipped model)");
-    v("model.backend", predict.backend, "inference backend: auto, opencl or cpu");
+    v("model.backend", predict.backend,
+      "inference backend: auto (opencl whenever usable, not timed: repeatable), opencl or cpu");
     v("model.input_size", predict.input_size,
       "network input: auto (the cfg's longer side, the other fitted to each image's aspect), cfg or WxH");
     v("output.dir", predict.out_dir, "output folder for <stem>.txt");
@@ -393,7 +394,8 @@ AnalysisVerbs::AnalysisVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   pr->add_option("--cfg", predict.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
   pr->add_option("--weights", predict.weights,
                  "Darknet .weights, or builtin:wingman-small (the shipped model, models/wingman-small.md)");
-  pr->add_option("--backend", predict.backend, "Inference backend: auto, opencl or cpu");
+  pr->add_option("--backend", predict.backend,
+                 "Inference backend: auto (opencl whenever usable, not timed: repeatable), opencl or cpu");
   pr->add_option("--input-size", predict.input_size,
                  "Network input: auto (the cfg's longer side, the other fitted to each image's aspect), cfg or WxH");
   pr->add_option("--out", predict.out_dir, "Output folder for <stem>.txt");

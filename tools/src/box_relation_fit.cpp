@@ -197,7 +197,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   if (!rq.detector_config.empty()) dopt = common::load_options<detector::DetectorOptions>(rq.detector_config);
   const std::string model_id = detector::weights_model_id(dopt.weights);
   auto make_backend = [&](const detector::DarknetModel& sized) {
-    return detector::make_backend(dopt.backend, sized, dopt.opencl, 1, nullptr);
+    return detector::make_backend(dopt.backend, sized, dopt.opencl, 1, nullptr, detector::AutoChoice::kRepeatable);
   };
   detector::SizedDetector pipeline(dopt.detection, detector::load_model(dopt.cfg, dopt.weights),
                                    *detector::InputSize::parse(dopt.input_size), make_backend);

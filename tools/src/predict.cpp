@@ -90,7 +90,8 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
     // uses from this scope (batch by value; it once read a dangling `batch`, e.g. -501724864, issue #34).
     auto make_backend = [&options, &err, batch](const detector::DarknetModel& sized) {
       std::string why;
-      auto backend = detector::make_backend(options.backend, sized, detector::OpenClOptions{}, batch, &why);
+      auto backend = detector::make_backend(options.backend, sized, detector::OpenClOptions{}, batch, &why,
+                                            detector::AutoChoice::kRepeatable);
       err << fmt::format("wingman predict: {} (network input {}x{})", why, sized.net.width, sized.net.height) << "\n";
       return backend;
     };

@@ -88,7 +88,8 @@ struct ValVerbOptions {
     v("model.weights", val.weights,
       "Darknet .weights or builtin:wingman-small; \"\" without input.predictions = the shipped model");
     v("model.cfg", val.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
-    v("model.backend", val.backend, "detector backend: auto, opencl or cpu");
+    v("model.backend", val.backend,
+      "detector backend: auto (opencl whenever usable, not timed: repeatable), opencl or cpu");
     v("model.input_size", val.input_size, "network input: auto, cfg or WxH");
     v("metrics.conf", val.metrics.conf_thresh, "operating confidence for precision / recall / mean IoU");
     v("metrics.iou", val.metrics.iou_thresh, "IoU match threshold");
@@ -177,7 +178,8 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
                 "Darknet .weights, or builtin:wingman-small: run the detector (Algorithm 2) (empty without "
                 "--predictions: the shipped model)");
   v->add_option("--cfg", vo.cfg, "Darknet .cfg, builtin:wingman-small or builtin:tiny-yolo-thesis");
-  v->add_option("--backend", vo.backend, "Detector backend: auto, opencl or cpu");
+  v->add_option("--backend", vo.backend,
+                "Detector backend: auto (opencl whenever usable, not timed: repeatable), opencl or cpu");
   v->add_option("--input-size", vo.input_size,
                 "Network input: auto (the cfg's longer side, the other fitted to each image's aspect), cfg or WxH");
   v->add_option("--predictions", vo.predictions, "Instead of --weights: folder of `wingman predict` <stem>.txt files");

@@ -644,7 +644,8 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
     if (!detect) {
       auto make_backend = [&](const detector::DarknetModel& sized) {
         std::string why;
-        auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why);
+        auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why,
+                                              detector::AutoChoice::kRepeatable);
         if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
         return backend;
       };

@@ -60,7 +60,8 @@ DetectionMetrics run_val(const ValOptions& o, const std::function<void(size_t, s
   if (!o.weights.empty()) {
     auto make_backend = [&](const detector::DarknetModel& sized) {
       std::string why;
-      auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why);
+      auto backend = detector::make_backend(o.backend, sized, detector::OpenClOptions{}, 1, &why,
+                                            detector::AutoChoice::kRepeatable);
       if (log) log(fmt::format("{} (network input {}x{})", why, sized.net.width, sized.net.height));
       return backend;
     };

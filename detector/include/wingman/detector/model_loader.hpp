@@ -48,13 +48,25 @@ DarknetModel load_cfg(const std::string& cfg);
 /// The .weights half of load_model: a path or "builtin:wingman-small", into `model` (shapes computed).
 void load_weights(DarknetModel& model, const std::string& weights);
 
-/// Creates the backend `kind` ("opencl", "cpu" or "auto") for `model`. auto takes OpenCL when its
-/// device is a GPU; otherwise it times both backends on the model and takes the faster: OpenCL over 3
-/// forwards after a warm-up, the CPU backend over 1 after a warm-up, or 3 when that one is within 1.5x
-/// of OpenCL (docs/detector.md gives the start-up cost). `why` (if not null) receives one line saying
-/// what was chosen and why.
-/// Throws std::runtime_error when the named backend cannot be created (e.g. no OpenCL device).
+/// How make_backend's "auto" chooses between OpenCL and the CPU backend.
+enum class AutoChoice {
+  /// Times both on the model and takes the faster (realtime: speed matters). Two runs can choose differently when
+  /// the two are close, and the backends' boxes differ in the 4th decimal.
+  kFastest,
+  /// OpenCL whenever a device is usable, else the CPU backend, without timing: the same backend, so the same boxes,
+  /// on every run (replays, lockstep flights, offline evaluations).
+  kRepeatable,
+};
+
+/// Creates the backend `kind` ("opencl", "cpu" or "auto") for `model`. auto with AutoChoice::kFastest times both
+/// backends on the model, a warm-up each and then in turn up to 3 forwards each, and takes the one whose fastest
+/// forward was faster (the CPU backend more than 1.5x slower in the first turn is not timed further; a GPU is timed
+/// too: the kernels are shaped for CPUs); with AutoChoice::kRepeatable it takes OpenCL whenever a device is usable.
+/// Either way, without a usable OpenCL device auto takes the CPU backend and `why` says "no usable OpenCL device"
+/// and the cause. `why` (if not null) receives one line saying what was chosen and why.
+/// Throws std::runtime_error when the named backend cannot be created (e.g. opencl without a usable device).
 std::unique_ptr<InferenceBackend> make_backend(const std::string& kind, const DarknetModel& model,
-                                               const OpenClOptions& opencl, int max_batch, std::string* why);
+                                               const OpenClOptions& opencl, int max_batch, std::string* why,
+                                               AutoChoice choice = AutoChoice::kFastest);
 
 }  // namespace wingman::detector

@@ -16,8 +16,9 @@ struct PredictOptions {
   std::vector<std::string> inputs;            ///< image files and/or folders (their images, not recursive)
   std::string cfg = "builtin:wingman-small";  ///< Darknet .cfg path or builtin:<name> (detector::load_model)
   std::string weights =
-      "builtin:wingman-small";   ///< Darknet .weights path or builtin:wingman-small (the shipped model)
-  std::string backend = "auto";  ///< inference backend: auto, opencl or cpu (OpenCV DNN)
+      "builtin:wingman-small";  ///< Darknet .weights path or builtin:wingman-small (the shipped model)
+  std::string backend =
+      "auto";  ///< inference backend: auto (opencl whenever usable, not timed), opencl or cpu (OpenCV DNN)
   /// Network input size (detector::InputSize::parse): auto fits the cfg's size to each image's aspect; cfg; WxH.
   std::string input_size = "auto";
   std::string out_dir = "predictions";          ///< folder for <stem>.txt (and <stem>.pred.jpg with draw)

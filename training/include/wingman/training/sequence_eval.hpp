@@ -138,8 +138,8 @@ struct SequenceEvalOptions {
   std::vector<std::string> clips;                 ///< only these clips of the split (empty = all of them)
   std::string cfg = "builtin:wingman-small";      ///< Darknet .cfg path or builtin:<name> (detector::load_model)
   std::string weights = "builtin:wingman-small";  ///< Darknet .weights path or builtin:wingman-small
-  std::string backend = "cpu";                    ///< detector backend: auto, opencl or cpu
-  std::string input_size = "auto";                ///< network input, as ValOptions::input_size
+  std::string backend = "cpu";      ///< detector backend: auto (opencl whenever usable, not timed), opencl or cpu
+  std::string input_size = "auto";  ///< network input, as ValOptions::input_size
   /// Algorithm 2's settings: the detector's defaults (p_thresh 0.2, what wingman-detector publishes).
   detector::DetectorPipelineOptions detection;
   /// The detector's motion cue (motion.enabled): each clip's frames (every frame_step-th, at their video times) through

@@ -19,7 +19,7 @@ struct ValOptions {
   std::string cfg = "builtin:wingman-small";  ///< Darknet .cfg path or builtin:<name> (detector::load_model)
   std::string weights;          ///< run the detector with these .weights (exactly one of weights / predictions)
   std::string predictions;      ///< or read `wingman predict` output: <predictions>/<image stem>.txt per image
-  std::string backend = "cpu";  ///< detector backend: auto, opencl or cpu
+  std::string backend = "cpu";  ///< detector backend: auto (opencl whenever usable, not timed), opencl or cpu
   /// Network input size, as the detector's model.input_size (detector::InputSize::parse): auto fits the cfg's size
   /// to each image's aspect (640x512 for Halmstad's 640x512 frames), cfg keeps the cfg's, WxH is that size.
   std::string input_size = "auto";
