@@ -68,7 +68,8 @@ std::string write_input_log(const TempDir& dir) {
 
 struct DetectorRun {
   std::vector<wingman::detections_t> detections;
-  wingman::status_t status;
+  wingman::status_t status;          ///< the last heartbeat
+  std::vector<std::string> details;  ///< every heartbeat's detail, in order
 };
 
 DetectorRun run_detector(const TempDir& dir, const std::string& in, const std::string& weights,
@@ -89,6 +90,7 @@ DetectorRun run_detector(const TempDir& dir, const std::string& in, const std::s
       result.detections.push_back(d);
     } else if (e.channel == "STATUS_DETECTOR") {
       result.status.decode(e.data.data(), 0, static_cast<int>(e.data.size()));
+      result.details.push_back(result.status.detail);
     }
   }
   return result;
@@ -126,6 +128,32 @@ TEST(DetectorProcess, OpenClBackendPublishesOneDetectionsPerGoodFrameAndCountsBa
       EXPECT_EQ(b.detections[i].detections[k].cx, a.detections[i].detections[k].cx);
       EXPECT_EQ(b.detections[i].detections[k].confidence, a.detections[i].detections[k].confidence);
     }
+  }
+}
+
+TEST(DetectorProcess, AutoInReplayModeRunsOpenClUntimedWithTheOpenClRunsBoxes) {
+  // model.backend auto in replay mode does not time the backends (two replays could choose differently): OpenCL
+  // whenever a device is usable, so its boxes are the opencl run's, byte for byte.
+  TempDir dir;
+  const std::string weights = write_random_weights(dir);
+  const std::string in = write_input_log(dir);
+  const DetectorRun a = run_detector(dir, in, weights, "auto", "auto");
+  bool said = false;
+  for (const auto& d : a.details) said = said || d.find("(auto, not timed: ") != std::string::npos;
+  ASSERT_TRUE(said) << "no heartbeat saying why auto chose; the last: " << a.status.detail;
+  for (const auto& d : a.details) {
+    if (d.find("no usable OpenCL device") != std::string::npos) GTEST_SKIP() << "no OpenCL device here: " << d;
+  }
+  const DetectorRun o = run_detector(dir, in, weights, "opencl", "opencl");
+  ASSERT_EQ(a.detections.size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(o.detections.size(), a.detections.size());
+  for (size_t i = 0; i < a.detections.size(); ++i) {
+    wingman::detections_t x = a.detections[i], y = o.detections[i];
+    x.inference_latency_us = y.inference_latency_us = 0;  // the one wall-clock field
+    std::vector<uint8_t> bx(static_cast<size_t>(x.getEncodedSize())), by(static_cast<size_t>(y.getEncodedSize()));
+    x.encode(bx.data(), 0, static_cast<int>(bx.size()));
+    y.encode(by.data(), 0, static_cast<int>(by.size()));
+    EXPECT_EQ(bx, by) << "frame " << i;
   }
 }
 
