@@ -8,6 +8,7 @@
 #include <wingman/detections_t.hpp>
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
+#include <wingman/status_t.hpp>
 #include <wingman/targets_t.hpp>
 
 #include <gtest/gtest.h>
@@ -131,6 +132,51 @@ TEST(Eval, LocalizationErrorsMatchHandComputedValues) {
   EXPECT_LT(r.across_line_of_sight.max, 0.35);
   EXPECT_EQ(r.formation_horizontal.n, 0);  // no formation requested
   EXPECT_NE(r.report().find("GROUND TRUTH"), std::string::npos);
+}
+
+TEST(Eval, NamesEachDetectorsBackendFromItsHeartbeat) {
+  // The two backends' boxes differ in the 4th decimal, so a flight's figures are those of the backend that ran: the
+  // first heartbeat of each STATUS_DETECTOR... channel whose detail names it is in the JSON and the report. Other
+  // heartbeats (other processes, later details) are not.
+  testing::TempDir dir;
+  const std::string flight = write_flight(dir);
+  std::vector<testing::LogEvent> events = testing::read_log(flight);
+  const auto heartbeat = [](const std::string& process, const std::string& detail, int64_t u) {
+    status_t s{};
+    s.utime = u;
+    s.process = process;
+    s.pid = 1;
+    s.state = status_t::STATE_OK;
+    s.detail = detail;
+    return s;
+  };
+  const std::string ocl =
+      "backend opencl: pthread (auto, not timed: OpenCL whenever a device is usable, so that runs repeat)";
+  events.push_back(make_event("STATUS_DETECTOR", heartbeat("detector", "waiting for images", kT0), kT0));
+  events.push_back(make_event("STATUS_DETECTOR", heartbeat("detector", ocl, kT0 + 1), kT0 + 1));
+  events.push_back(
+      make_event("STATUS_DETECTOR", heartbeat("detector", "backend cpu (a later line)", kT0 + 2), kT0 + 2));
+  events.push_back(make_event("STATUS_DETECTOR_CAM1",
+                              heartbeat("detector_cam1", "backend cpu (OpenCV DNN), as configured", kT0), kT0));
+  events.push_back(make_event("STATUS_LOCALIZER", heartbeat("localizer", "backend of nothing", kT0), kT0));
+  EvalOptions o;
+  o.log = dir.file("with_heartbeats.lcmlog");
+  testing::write_log(o.log, events);
+  const EvalResult r = evaluate_log(o);
+  const std::map<std::string, std::string> want = {{"STATUS_DETECTOR", ocl},
+                                                   {"STATUS_DETECTOR_CAM1", "backend cpu (OpenCV DNN), as configured"}};
+  EXPECT_EQ(r.detector_backends, want);
+  const auto j = nlohmann::json::parse(r.json());
+  EXPECT_EQ(j["detector_backends"]["STATUS_DETECTOR"], ocl);
+  EXPECT_EQ(j["detector_backends"].size(), 2u);
+  EXPECT_NE(r.report().find("detector (STATUS_DETECTOR): " + ocl + "\n"), std::string::npos) << r.report();
+
+  EvalOptions without;
+  without.log = flight;
+  const EvalResult none = evaluate_log(without);
+  EXPECT_TRUE(none.detector_backends.empty());
+  EXPECT_TRUE(nlohmann::json::parse(none.json())["detector_backends"].empty());
+  EXPECT_EQ(none.report().find("detector ("), std::string::npos);
 }
 
 TEST(Eval, FormationErrorIsFollowerMinusLeaderPlusOffsetAfterSettling) {

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <map>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -60,6 +61,9 @@ struct EvalLog {
   int64_t non_drone_boxes = 0;             ///< detected boxes with class_id != 0 (not in `detections`)
   std::vector<int64_t> image_utimes;       ///< utimes of the image_t events on the image channel, log order
   std::vector<int64_t> preview_utimes;     ///< utimes of the image_t events on the preview channel, log order
+  /// Each detector's status channel (STATUS_DETECTOR...) -> the first heartbeat detail that says which backend runs
+  /// and why ("backend opencl: ... (auto, not timed: ...)"); empty when the log holds no such heartbeat.
+  std::map<std::string, std::string> detector_backends;
 };
 
 /// Reads options.log (channels and progress from `options`, which must be valid) into records. Throws

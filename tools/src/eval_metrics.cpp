@@ -278,6 +278,7 @@ void log_metrics(const EvalLog& log, EvalResult* r) {
   r->image_utimes = log.image_utimes;
   r->preview_utimes = log.preview_utimes;
   r->detection_source = detection_source_name(log.sources);
+  r->detector_backends = log.detector_backends;
   int64_t t0 = INT64_MAX, t1 = INT64_MIN;
   for (const auto& [id, t] : log.truth) {
     t0 = std::min(t0, t.utime.front());

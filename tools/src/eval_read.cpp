@@ -12,6 +12,7 @@
 #include <wingman/ground_truth_t.hpp>
 #include <wingman/image_t.hpp>
 #include <wingman/recorder/channel_pattern.hpp>
+#include <wingman/status_t.hpp>
 #include <wingman/targets_t.hpp>
 
 #include <algorithm>
@@ -128,6 +129,10 @@ EvalLog read_eval_log(const EvalOptions& o) {
     } else if (detections_channel(ev->channel)) {
       wingman::detections_t d;
       if (decode(*ev, &d)) add_detections(d, &log);
+    } else if (ev->channel.rfind("STATUS_DETECTOR", 0) == 0 && !log.detector_backends.count(ev->channel)) {
+      // The detector's heartbeat says which backend runs, and why, while nothing else needs saying.
+      wingman::status_t s;
+      if (decode(*ev, &s) && s.detail.rfind("backend ", 0) == 0) log.detector_backends[ev->channel] = s.detail;
     } else if (ev->channel == o.image_channel || ev->channel == o.preview_channel) {
       // Only the utime: the pixels are read by the report when needed.
       if (const std::optional<int64_t> u = image_utime(*ev); u && ev->channel == o.image_channel) {

@@ -67,6 +67,7 @@ std::string EvalResult::report() const {
   s += fmt::format(
       "flight: {:.1f} s of ground truth ({} frames); detections from {}\n", duration_s, truth_frames,
       detection_source == "ground_truth" ? "GROUND TRUTH (simulated boxes, no detector model)" : detection_source);
+  for (const auto& [channel, line] : detector_backends) s += fmt::format("detector ({}): {}\n", channel, line);
   const auto percent = [](int64_t part, int64_t whole) {
     return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
   };
@@ -146,6 +147,8 @@ common::Json ids_json(const std::map<int, EvalResult::VehicleIds>& ids) {
 std::string EvalResult::json() const {
   common::Json j;
   j["detection_source"] = detection_source;
+  j["detector_backends"] = common::Json::object();
+  for (const auto& [channel, line] : detector_backends) j["detector_backends"][channel] = line;
   j["duration_s"] = duration_s;
   j["truth_frames"] = truth_frames;
   j["frames_leader_visible"] = frames_leader_visible;

@@ -91,7 +91,10 @@ struct DetectionBin {
 
 /// The measured errors of one flight.
 struct EvalResult {
-  std::string detection_source;       ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
+  std::string detection_source;  ///< "cnn", "ground_truth", "mixed" or "none" (from detections_t.source)
+  /// Each detector's status channel -> its heartbeat's line on the backend that ran and why (the two backends' boxes
+  /// differ in the 4th decimal, so a flight's figures are those of its backend); empty when none was logged.
+  std::map<std::string, std::string> detector_backends;
   int64_t truth_frames = 0;           ///< ground_truth_t messages
   int64_t frames_leader_visible = 0;  ///< of those, frames in which the leader's truth box is visible
   /// Of those, frames with at least one box on the leader (box_on_leader()); a box elsewhere does not count.
