@@ -34,18 +34,8 @@ WINGMAN_BIN_DIR="$prefix/bin" "$src/tools/fly.sh" --out "$work/flight" --duratio
 
 PYTHONPATH="$src/tests/support" python3 - "$work/flight/eval.json" <<'PY'
 import json, sys
-from bounds import check
+from bounds import check, installed_flight_checks
 e = json.load(open(sys.argv[1]))
-visible = e["frames_leader_visible"]
-# (figure, measured value, bound, True when the figure must be at least the bound)
-checks = [
-    ("localization RMS (m)", e["localization"]["rms_m"], 0.45, False),
-    ("formation RMS, horizontal (m)", e["formation_horizontal"]["rms_m"], 0.60, False),
-    ("target estimates / frames with the leader visible", e["target_estimates"] / max(1, visible), 0.90, True),
-    ("track ids on the leader", e["track_ids_on_leader"], 1, False),
-    ("track ids on the leader (at least)", e["track_ids_on_leader"], 1, True),
-    ("false targets", e["false_targets"], 0, False),
-]
-check("installed_flight", checks)
+check("installed_flight", installed_flight_checks(e))
 PY
 echo "installed_flight: the installed stack ($prefix) flew within the bounds"

@@ -275,7 +275,7 @@ else
 fi
 if ! PYTHONPATH="$src/tests/support" /usr/bin/python3 - "$a/eval.json" "$b/eval.json" "$backend_a" "$backend_b" <<'PY'; then
 import json, sys
-from bounds import check
+from bounds import check, installed_flight_checks
 
 
 def figures(node, path=""):
@@ -315,15 +315,7 @@ for name, keys in rows:
     shown = ["%.3f" % v if isinstance(v, float) else str(v) for v in (va, vb)]
     print("  %-36s %13s %14s" % (name, shown[0], shown[1]))
 for name, e in (("--prefix /usr", ea), ("--prefix /opt/wingman", eb)):
-    visible = e["frames_leader_visible"]
-    check("installed_supervisord %s" % name, [
-        ("localization RMS (m)", e["localization"]["rms_m"], 0.45, False),
-        ("formation RMS, horizontal (m)", e["formation_horizontal"]["rms_m"], 0.60, False),
-        ("target estimates / frames with the leader visible", e["target_estimates"] / max(1, visible), 0.90, True),
-        ("track ids on the leader", e["track_ids_on_leader"], 1, False),
-        ("track ids on the leader (at least)", e["track_ids_on_leader"], 1, True),
-        ("false targets", e["false_targets"], 0, False),
-    ])
+    check("installed_supervisord %s" % name, installed_flight_checks(e))
 if same_backend:
     sys.exit(1 if differ else 0)
 # Different backends: the RMS figures within 0.05 m (localization) and 0.15 m (formation) of each other, the frame
