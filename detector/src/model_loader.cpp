@@ -139,8 +139,6 @@ std::unique_ptr<InferenceBackend> make_backend(const std::string& kind, const Da
   } catch (const std::exception& e) {
     opencl_error = e.what();
   }
-  // A GPU is timed too: the kernels are shaped for CPUs (PoCL), and on an NVIDIA H200 they ran the thesis network
-  // at 416 3x slower than OpenCV DNN on that machine's CPU cores (docs/benchmarks.md).
   const char* auto_is = choice == AutoChoice::kRepeatable ? "auto, not timed" : "auto";
   if (!gpu) {
     if (why) *why = fmt::format("backend cpu ({}: no usable OpenCL device: {})", auto_is, opencl_error);
@@ -148,9 +146,12 @@ std::unique_ptr<InferenceBackend> make_backend(const std::string& kind, const Da
   }
   if (choice == AutoChoice::kRepeatable) {
     if (why)
-      *why = "backend " + gpu->name() + " (auto, not timed: OpenCL whenever a device is usable, so that runs repeat)";
+      *why =
+          fmt::format("backend {} ({}: OpenCL whenever a device is usable, so that runs repeat)", gpu->name(), auto_is);
     return gpu;
   }
+  // A GPU is timed too: the kernels are shaped for CPUs (PoCL), and on an NVIDIA H200 they ran the thesis network
+  // at 416 3x slower than OpenCV DNN on that machine's CPU cores (docs/benchmarks.md).
   auto cpu = std::make_unique<CpuBackend>(model, max_batch);
   // Each warmed up once, then timed in turn, OpenCL then CPU, up to three times each, and each backend's fastest
   // forward compared: a load that changes during start-up (several detectors starting together on a small machine,
