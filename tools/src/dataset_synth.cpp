@@ -35,14 +35,12 @@ namespace wingman::tools {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr int kMaxPlacements = 50;  // attempts to place a visible target in one image
 
 using Random = SynthRandom;
 
 // Random streams: one per purpose, so that adding a draw in one place leaves the others alone.
-enum Stream : uint64_t { kCameraStream = 1, kImageStream = 2 };
+enum SynthStream : uint64_t { kCameraStream = 1, kImageStream = 2 };
 
 using Colour = std::vector<double>;
 
@@ -65,7 +63,7 @@ const std::vector<Colour> kAirframe = {{0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}, {
 
 // A random calibrated camera: field of view, principal point, and a radtan or equidistant lens.
 geometry::CameraModel random_camera(const DatasetSynthConfig& c, Random& rng, int k) {
-  const double half_fov = 0.5 * rng.uniform(c.hfov_min_deg, c.hfov_max_deg) * kDeg;
+  const double half_fov = 0.5 * rng.uniform(c.hfov_min_deg, c.hfov_max_deg) * kSynthDeg;
   const double cx = 0.5 * c.width - 0.5 + rng.normal() * 0.01 * c.width;
   const double cy = 0.5 * c.height - 0.5 + rng.normal() * 0.01 * c.height;
   const double aspect = 1.0 + 0.003 * rng.normal();
@@ -130,7 +128,7 @@ sim::DroneSpec random_airframe(const DatasetSynthConfig& c, SynthRandom& rng, co
   s.body_height_m = 0.06 * scale * rng.uniform(0.7, 1.4);
   s.motor_radius_m = 0.014 * scale * rng.uniform(0.8, 1.3);
   s.motor_height_m = 0.03 * scale * rng.uniform(0.7, 1.3);
-  const double max_prop = 2.0 * s.arm_length_m * std::sin(kPi / n) * 0.97;  // neighbouring props do not overlap
+  const double max_prop = 2.0 * s.arm_length_m * std::sin(kSynthPi / n) * 0.97;  // neighbouring props do not overlap
   s.prop_diameter_m = std::min(0.2295 * scale * rng.uniform(0.8, 1.15), max_prop);
   s.prop_chord_m = std::min(0.02 * scale * rng.uniform(0.8, 1.4), 0.4 * s.prop_diameter_m);
   s.prop_blades = rng.chance(0.7) ? 2 : rng.chance(0.8) ? 3 : 4;
@@ -162,9 +160,9 @@ Eigen::Matrix3d rpy(double roll, double pitch, double yaw) {
 Eigen::Isometry3d random_camera_pose(const DatasetSynthConfig& c, Random& rng) {
   Eigen::Matrix3d R_forward_to_optical;  // columns: optical x, y, z in the forward frame (x fwd, y left, z up)
   R_forward_to_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  const double yaw = rng.uniform(-kPi, kPi);
-  const double pitch = rng.uniform(c.camera_pitch_min_deg, c.camera_pitch_max_deg) * kDeg;
-  const double roll = rng.uniform(-c.camera_roll_max_deg, c.camera_roll_max_deg) * kDeg;
+  const double yaw = rng.uniform(-kSynthPi, kSynthPi);
+  const double pitch = rng.uniform(c.camera_pitch_min_deg, c.camera_pitch_max_deg) * kSynthDeg;
+  const double roll = rng.uniform(-c.camera_roll_max_deg, c.camera_roll_max_deg) * kSynthDeg;
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = rpy(roll, -pitch, yaw) * R_forward_to_optical;  // pitching up turns x (forward) towards +z
   T.translation() = Eigen::Vector3d(rng.uniform(-500.0, 500.0), rng.uniform(-500.0, 500.0),
@@ -379,8 +377,8 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
         // On the horizon: a world direction of small elevation within the camera's horizontal field of view.
         const Eigen::Vector3d z_cam_in_world = T_cam_to_world.linear().col(2);
         const double yaw = std::atan2(z_cam_in_world.y(), z_cam_in_world.x());
-        const double azimuth = yaw + rng.uniform(-0.5, 0.5) * config.hfov_max_deg * kDeg;
-        const double elevation = rng.uniform(-1.0, 1.0) * config.horizon_elevation_max_deg * kDeg;
+        const double azimuth = yaw + rng.uniform(-0.5, 0.5) * config.hfov_max_deg * kSynthDeg;
+        const double elevation = rng.uniform(-1.0, 1.0) * config.horizon_elevation_max_deg * kSynthDeg;
         const Eigen::Vector3d d_in_world(std::cos(elevation) * std::cos(azimuth),
                                          std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
         ray = T_cam_to_world.linear().transpose() * d_in_world;  // unit ray in the optical frame
@@ -388,12 +386,13 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
       sim::DroneInstance target;
       target.vehicle_id = 1;
       target.model = model.get();
-      const double tilt = config.target_tilt_max_deg * kDeg;
-      target.T_body_to_world.linear() = rpy(rng.uniform(-tilt, tilt), rng.uniform(-tilt, tilt), rng.uniform(-kPi, kPi));
+      const double tilt = config.target_tilt_max_deg * kSynthDeg;
+      target.T_body_to_world.linear() =
+          rpy(rng.uniform(-tilt, tilt), rng.uniform(-tilt, tilt), rng.uniform(-kSynthPi, kSynthPi));
       target.T_body_to_world.translation() = T_cam_to_world * (ray * range);
       target.v_body_in_world = rng.direction() * rng.uniform(0.0, 15.0);
       target.w_body_in_body = rng.direction() * rng.uniform(0.0, 1.0);
-      target.prop_angle_rad = rng.uniform(0.0, 2.0 * kPi);
+      target.prop_angle_rad = rng.uniform(0.0, 2.0 * kSynthPi);
       target.prop_rate_rad_s = rng.uniform(300.0, 900.0);
       sim::CameraMotion motion;
       motion.v_cam_in_world = rng.direction() * rng.uniform(0.0, 10.0);

@@ -21,7 +21,6 @@ using launcher::process;
 
 namespace {
 
-constexpr double kGraceS = 10.0;  // seconds a process gets to end after SIGTERM before it is killed
 const char* kImageChannel = "IMAGE_CAM0";
 const char* kDetectionsChannel = "DETECTIONS_CAM0";
 
@@ -61,9 +60,9 @@ int run_demo_camera(const DemoCameraOptions& o, std::ostream& out, std::ostream&
 
   // Ends the demo with `rc` after stopping the pipeline, then the logger (its last heartbeats recorded).
   auto finish = [&](int rc) {
-    group.stop(pipeline, kGraceS);
+    group.stop(pipeline, launcher::ProcessGroup::kDefaultGraceS);
     bus.spin(300);
-    group.stop({logger}, kGraceS);
+    group.stop({logger}, launcher::ProcessGroup::kDefaultGraceS);
     return rc;
   };
   // Whether a pipeline process has ended (named on `err` once).

@@ -60,10 +60,6 @@ std::vector<std::string> own_pose_sets(const std::string& spec) {
           "--set", "own_pose.correlation_time_s=" + (parts.size() == 3 ? parts[2] : std::string("2.0"))};
 }
 
-void append(std::vector<std::string>& to, const std::vector<std::string>& more) {
-  to.insert(to.end(), more.begin(), more.end());
-}
-
 }  // namespace
 
 std::vector<std::string> FlyOptions::validate() const {
@@ -214,13 +210,13 @@ FlightPlan plan_flight(const FlyOptions& o) {
       "--set",
       fmt::format("mavlink={{firmware: {}, streams: [odometry, attitude_quaternion, local_position_ned]}}",
                   o.firmware)};
-  if (!o.own_pose_error.empty()) append(sim_sets, own_pose_sets(o.own_pose_error));
+  if (!o.own_pose_error.empty()) launcher::append_args(sim_sets, own_pose_sets(o.own_pose_error));
   if (!plan.rig_file.empty()) {
-    append(sim_sets, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
+    launcher::append_args(sim_sets, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
     plan.notes.push_back(fmt::format("fly: {} cameras from the rig {}, a detector each, fused by the localizer",
                                      rig_cameras.size(), plan.rig_file));
     if (o.camera_stagger_s > 0) {
-      append(sim_sets, {"--set", fmt::format("cameras.stagger_s={}", o.camera_stagger_s)});
+      launcher::append_args(sim_sets, {"--set", fmt::format("cameras.stagger_s={}", o.camera_stagger_s)});
       plan.notes.push_back(fmt::format("fly: camera i exposes i x {} s after its frame's time", o.camera_stagger_s));
     }
   }
@@ -228,28 +224,28 @@ FlightPlan plan_flight(const FlyOptions& o) {
   // The flight's effective simulator configuration, as the loader merged it (a record; the process reads the --set).
   plan.sim_print_config.name = "wingman-sim --print-config";
   plan.sim_print_config.argv = {exe("wingman-sim")};
-  append(plan.sim_print_config.argv, sim_sets);
+  launcher::append_args(plan.sim_print_config.argv, sim_sets);
   plan.sim_print_config.argv.push_back("--print-config");
   plan.sim_print_config.stdout_path = (fs::path(plan.out_dir) / "sim.yaml").string();
 
   plan.logger.name = "lcm-logger";
   plan.logger.argv = {"lcm-logger", "--lcm-url=" + url, "--force", "--quiet"};
-  if (!o.record_images) append(plan.logger.argv, {"--channel=IMAGE_.*", "--invert-channels"});
+  if (!o.record_images) launcher::append_args(plan.logger.argv, {"--channel=IMAGE_.*", "--invert-channels"});
   plan.logger.argv.push_back(plan.log_path);
 
   launcher::ProcessSpec detector =
       process("wingman-detector", {exe("wingman-detector"), "--lcm-url", url, "--set", "input.mode=replay"});
   if (cnn) {
-    append(detector.argv, {"--set", fmt::format("model.cfg=\"{}\"", model_cfg), "--set",
-                           fmt::format("model.weights=\"{}\"", model_weights), "--set",
-                           fmt::format("detection.zoom_in={}", bool_text(o.zoom_in)), "--set",
-                           fmt::format("detection.flip_fusion={}", bool_text(o.flip_fusion)), "--set",
-                           fmt::format("detection.coarse_pass={}", bool_text(o.coarse_pass)), "--set",
-                           fmt::format("windows.enabled={}", bool_text(o.windows))});
+    launcher::append_args(detector.argv, {"--set", fmt::format("model.cfg=\"{}\"", model_cfg), "--set",
+                                          fmt::format("model.weights=\"{}\"", model_weights), "--set",
+                                          fmt::format("detection.zoom_in={}", bool_text(o.zoom_in)), "--set",
+                                          fmt::format("detection.flip_fusion={}", bool_text(o.flip_fusion)), "--set",
+                                          fmt::format("detection.coarse_pass={}", bool_text(o.coarse_pass)), "--set",
+                                          fmt::format("windows.enabled={}", bool_text(o.windows))});
   } else {
-    append(detector.argv, {"--set", "model.weights=\"\""});
+    launcher::append_args(detector.argv, {"--set", "model.weights=\"\""});
   }
-  for (const auto& kv : o.detector_sets) append(detector.argv, {"--set", kv});
+  for (const auto& kv : o.detector_sets) launcher::append_args(detector.argv, {"--set", kv});
   // With a rig: one detector per camera, on that camera's channels (over the flight's sets), named detector<camera_id>
   // (its status channel).
   std::vector<launcher::ProcessSpec> detectors;
@@ -257,23 +253,24 @@ FlightPlan plan_flight(const FlyOptions& o) {
   for (const auto& c : rig_cameras) {
     launcher::ProcessSpec d = detector;
     d.name = fmt::format("wingman-detector-cam{}", c.camera.camera_id);
-    append(d.argv, {"--name", fmt::format("detector{}", c.camera.camera_id), "--set",
-                    fmt::format("input.channel=\"{}\"", c.image_channel), "--set",
-                    fmt::format("output.channel=\"{}\"", c.detections_channel), "--set",
-                    fmt::format("windows.channel=\"{}\"", c.windows_channel)});
+    launcher::append_args(d.argv, {"--name", fmt::format("detector{}", c.camera.camera_id), "--set",
+                                   fmt::format("input.channel=\"{}\"", c.image_channel), "--set",
+                                   fmt::format("output.channel=\"{}\"", c.detections_channel), "--set",
+                                   fmt::format("windows.channel=\"{}\"", c.windows_channel)});
     detectors.push_back(d);
   }
-  for (auto& d : detectors) append(d.argv, {"--log-level", "warn"});
+  for (auto& d : detectors) launcher::append_args(d.argv, {"--log-level", "warn"});
   launcher::ProcessSpec localizer = process("wingman-localizer", {exe("wingman-localizer"), "--lcm-url", url});
-  if (!localizer_config.empty()) append(localizer.argv, {"--config", localizer_config});
-  if (o.windows) append(localizer.argv, {"--set", "windows.publish=true"});
-  if (!plan.rig_file.empty()) append(localizer.argv, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
-  for (const auto& kv : o.localizer_sets) append(localizer.argv, {"--set", kv});
-  append(localizer.argv, {"--log-level", "warn"});
+  if (!localizer_config.empty()) launcher::append_args(localizer.argv, {"--config", localizer_config});
+  if (o.windows) launcher::append_args(localizer.argv, {"--set", "windows.publish=true"});
+  if (!plan.rig_file.empty())
+    launcher::append_args(localizer.argv, {"--set", fmt::format("cameras.rig=\"{}\"", plan.rig_file)});
+  for (const auto& kv : o.localizer_sets) launcher::append_args(localizer.argv, {"--set", kv});
+  launcher::append_args(localizer.argv, {"--log-level", "warn"});
   launcher::ProcessSpec follower = process("wingman-follower-ctrl", {exe("wingman-follower-ctrl"), "--lcm-url", url});
-  if (!follower_config.empty()) append(follower.argv, {"--config", follower_config});
-  for (const auto& kv : o.follower_sets) append(follower.argv, {"--set", kv});
-  append(follower.argv, {"--log-level", "warn"});
+  if (!follower_config.empty()) launcher::append_args(follower.argv, {"--config", follower_config});
+  for (const auto& kv : o.follower_sets) launcher::append_args(follower.argv, {"--set", kv});
+  launcher::append_args(follower.argv, {"--log-level", "warn"});
   plan.pipeline = detectors;
   plan.pipeline.push_back(localizer);
   plan.pipeline.push_back(follower);
@@ -287,9 +284,9 @@ FlightPlan plan_flight(const FlyOptions& o) {
 
   plan.sim.name = "wingman-sim";
   plan.sim.argv = {exe("wingman-sim"), "--lcm-url", url};
-  append(plan.sim.argv, sim_sets);
-  if (o.duration_s > 0.0) append(plan.sim.argv, {"--duration", fmt::format("{}", o.duration_s)});
-  if (!render_config.empty()) append(plan.sim.argv, {"--render-config", render_config});
+  launcher::append_args(plan.sim.argv, sim_sets);
+  if (o.duration_s > 0.0) launcher::append_args(plan.sim.argv, {"--duration", fmt::format("{}", o.duration_s)});
+  if (!render_config.empty()) launcher::append_args(plan.sim.argv, {"--render-config", render_config});
 
   // The formation error is measured against the follower's own target: eval reads the follower's configuration
   // (formation.offset_m) and, for the 1-D follow, the scenario's start (the leader moved back to the follower's line).

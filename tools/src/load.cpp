@@ -32,13 +32,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr double kGraceS = 10.0;                    // seconds a process gets to end after SIGTERM before it is killed
 constexpr double kStartTimeoutS = 180.0;            // every process's first heartbeat (each detector loads the model)
 const char* kFixedStartUtime = "1700000000000000";  // fast cameras: frames stamped from here (deterministic)
-
-void append(std::vector<std::string>& to, const std::vector<std::string>& more) {
-  to.insert(to.end(), more.begin(), more.end());
-}
 
 /// A counter of the `Udp:` lines of /proc/net/snmp (this network namespace's), -1 when absent.
 int64_t udp_counter(const std::string& name) {
@@ -143,8 +138,8 @@ std::vector<std::string> load_process_sets(const std::string& exe, int camera, c
         fmt::format("file={{path: \"{}\", mode: {}, fps: 30.0, loop: true}}", clip, realtime ? "realtime" : "fast")};
     // fast: the replay log's frames, stamped from a fixed start time (deterministic); realtime: by the wall clock.
     if (!realtime) {
-      append(sets, {"--set", std::string("file.start_utime=") + kFixedStartUtime, "--set",
-                    fmt::format("output.max_frames={}", max_frames)});
+      launcher::append_args(sets, {"--set", std::string("file.start_utime=") + kFixedStartUtime, "--set",
+                                   fmt::format("output.max_frames={}", max_frames)});
     }
     return sets;
   }
@@ -172,7 +167,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
                                                           py_env && *py_env ? std::string(":") + py_env : "")};
   auto summary = [&](std::vector<std::string> args) {
     launcher::ProcessSpec s = summary_base;
-    append(s.argv, args);
+    launcher::append_args(s.argv, args);
     return s;
   };
   launcher::ProcessGroup group;
@@ -213,7 +208,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   printed.emplace_back("wingman-follower-ctrl", 0, "follower_ctrl.yaml");
   for (const auto& [name, i, file] : printed) {
     launcher::ProcessSpec print = process(name, {exe(name)});
-    append(print.argv, load_process_sets(name, i, clip, !fast_cameras, o.replay_frames, !replay, o));
+    launcher::append_args(print.argv, load_process_sets(name, i, clip, !fast_cameras, o.replay_frames, !replay, o));
     print.argv.push_back("--print-config");
     print.stdout_path = (out_dir / file).string();
     if (group.run(print) != 0) {
@@ -233,9 +228,10 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
     for (int i = 0; i < o.cameras; ++i) {
       launcher::ProcessSpec cam =
           process(fmt::format("camera_{}", i), {exe("wingman-camera-driver"), "--name", fmt::format("camera_{}", i)});
-      append(cam.argv, load_process_sets("wingman-camera-driver", i, clip, false, o.replay_frames, false, o));
-      append(cam.argv,
-             {"--log-level", "warn", "--lcm-out", fmt::format("file://{}?mode={}", images, i == 0 ? "w" : "a")});
+      launcher::append_args(cam.argv,
+                            load_process_sets("wingman-camera-driver", i, clip, false, o.replay_frames, false, o));
+      launcher::append_args(
+          cam.argv, {"--log-level", "warn", "--lcm-out", fmt::format("file://{}?mode={}", images, i == 0 ? "w" : "a")});
       if (const int rc = group.run(cam); rc != 0) {
         err << "load_test: FAILED: camera_" << i << " exited " << rc << std::endl;
         return 1;
@@ -256,9 +252,9 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
       detection_logs.push_back((out_dir / fmt::format("detections_{}.lcmlog", i)).string());
       launcher::ProcessSpec det =
           process(fmt::format("detector_{}", i), {exe("wingman-detector"), "--name", fmt::format("detector_{}", i)});
-      append(det.argv, load_process_sets("wingman-detector", i, clip, false, 0, false, o));
-      append(det.argv, {"--log-level", "warn", "--lcm-in", fmt::format("file://{}?speed=0", images), "--lcm-out",
-                        fmt::format("file://{}?mode=w", detection_logs.back())});
+      launcher::append_args(det.argv, load_process_sets("wingman-detector", i, clip, false, 0, false, o));
+      launcher::append_args(det.argv, {"--log-level", "warn", "--lcm-in", fmt::format("file://{}?speed=0", images),
+                                       "--lcm-out", fmt::format("file://{}?mode=w", detection_logs.back())});
       detectors.push_back(group.start(det));
     }
     bool failed = false;
@@ -270,8 +266,8 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
       return 1;
     }
     std::vector<std::string> args = {"replay", images};
-    append(args, detection_logs);
-    append(args, {"--json", (out_dir / "summary.json").string()});
+    launcher::append_args(args, detection_logs);
+    launcher::append_args(args, {"--json", (out_dir / "summary.json").string()});
     const int rc = group.run(summary(args)) == 0 ? 0 : 1;
     if (rc == 0) fs::remove(images, ec);  // large and made anew by every run: kept only when a check failed
     return rc;
@@ -297,7 +293,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   auto start = [&](const std::string& name, const std::string& exe_name, const std::vector<std::string>& sets) {
     launcher::ProcessSpec spec =
         process(name, {exe(exe_name), "--name", name, "--lcm-url", url, "--log-level", "info"});
-    append(spec.argv, sets);
+    launcher::append_args(spec.argv, sets);
     spec.stderr_path = (out_dir / (name + ".stderr")).string();
     const size_t i = group.start(spec);
     names[i] = name;
@@ -316,11 +312,11 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   // Ends the run: the sources first, the detectors' frame in hand given time, then the rest (each publishes a final
   // STOPPING heartbeat with its counts), then the logger.
   auto stop_all = [&] {
-    group.stop(cams, kGraceS);
+    group.stop(cams, launcher::ProcessGroup::kDefaultGraceS);
     std::this_thread::sleep_for(std::chrono::seconds(3));
-    group.stop(rest, kGraceS);
+    group.stop(rest, launcher::ProcessGroup::kDefaultGraceS);
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    group.stop({logger}, kGraceS);
+    group.stop({logger}, launcher::ProcessGroup::kDefaultGraceS);
   };
   // A process that has ended: named with the end of its stderr; true.
   auto exited = [&](const char* when) {
@@ -422,7 +418,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
                                    "--udp-rcvbuf-errors",
                                    std::to_string(rcvbuf_errors)};
   if (o.report_only) args.push_back("--report-only");
-  append(args, {"--json", (out_dir / "summary.json").string()});
+  launcher::append_args(args, {"--json", (out_dir / "summary.json").string()});
   if (group.run(summary(args)) != 0) rc = 1;
   if (o.soak) {
     out << std::endl;
@@ -435,7 +431,7 @@ int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
                                           "--max-rss-growth-pct",
                                           fmt::format("{}", o.max_rss_growth_pct)};
     if (o.report_only) soak_args.push_back("--report-only");
-    append(soak_args, {"--json", (out_dir / "soak.json").string()});
+    launcher::append_args(soak_args, {"--json", (out_dir / "soak.json").string()});
     if (group.run(summary(soak_args)) != 0) rc = 1;
   }
   out << "load_test: log " << log << ", samples " << proc_csv << ", figures " << (out_dir / "summary.json").string()

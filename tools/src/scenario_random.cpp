@@ -26,10 +26,9 @@ namespace wingman::tools {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = kSynthPi / 180.0;
 
 // Random streams: one per purpose, so that a change in one draw leaves the others alone.
-enum Stream : uint64_t { kPathStream = 11, kSceneStream = 12, kAirframeStream = 13 };
+enum ScenarioStream : uint64_t { kPathStream = 11, kSceneStream = 12, kAirframeStream = 13 };
 
 // The localizer's keys this flight sets: the leader's true size, and the shortest range accepted, which must exceed
 // it (the localizer's defaults for everything else).
@@ -219,7 +218,7 @@ ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
   r.duration_s = std::round(rng.uniform(o.duration_min_s, o.duration_max_s) * 10.0) / 10.0;
   const double distance = rng.uniform(o.offset_min_m, o.offset_max_m);
   const double bearing = rng.uniform(-kSynthPi, kSynthPi);
-  const double elevation = rng.uniform(-o.offset_elevation_max_deg, o.offset_elevation_max_deg) * kDeg;
+  const double elevation = rng.uniform(-o.offset_elevation_max_deg, o.offset_elevation_max_deg) * kSynthDeg;
   r.offset_in_world = distance * Eigen::Vector3d(std::cos(elevation) * std::cos(bearing),
                                                  std::cos(elevation) * std::sin(bearing), std::sin(elevation));
   const double yaw_to_leader = std::atan2(-r.offset_in_world.y(), -r.offset_in_world.x());  // the camera's heading
@@ -275,11 +274,11 @@ ScenarioRandomResult write_random_scenario(const ScenarioRandomOptions& o) {
   yaml += fmt::format(
       "  - name: follower\n    id: 0\n    control: setpoints\n    initial:\n      position: {}\n      yaw_deg: "
       "{:.3f}\n\n",
-      vec(p_follower), yaw_to_leader / kDeg);
+      vec(p_follower), yaw_to_leader / kSynthDeg);
   yaml += fmt::format(
       "  - name: leader\n    id: 1\n    control: script\n    initial:\n      position: {}\n"
       "      yaw_deg: {:.3f}\n    drone:\n{}",
-      vec(p_leader), leader_yaw / kDeg, drone.str());
+      vec(p_leader), leader_yaw / kSynthDeg, drone.str());
   yaml += fmt::format("    dynamics:\n      max_speed_xy: {:.2f}\n      max_accel_xy: {:.2f}\n", o.speed_max_mps + 1.0,
                       std::max(2.0, 2.0 * o.accel_mps2));
   yaml += fmt::format("    motion:\n      type: waypoints\n      accel: {:.2f}\n      waypoints:\n{}", o.accel_mps2,

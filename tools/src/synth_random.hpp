@@ -18,6 +18,7 @@
 namespace wingman::tools {
 
 constexpr double kSynthPi = 3.14159265358979323846;
+constexpr double kSynthDeg = kSynthPi / 180.0;  // radians per degree
 
 // A small counter-based generator (splitmix64): the same numbers on every platform and standard library, so a seed
 // gives the same dataset everywhere.

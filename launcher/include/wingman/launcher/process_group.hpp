@@ -28,6 +28,11 @@ struct ProcessSpec {
   std::string command_line() const;
 };
 
+/// Appends the arguments `more` to the argument list `argv` (a ProcessSpec's argv, or `--set` lists built for one).
+inline void append_args(std::vector<std::string>& argv, const std::vector<std::string>& more) {
+  argv.insert(argv.end(), more.begin(), more.end());
+}
+
 /// Child processes started in order and stopped together. Every child still running when the group is destroyed
 /// is stopped (SIGTERM, then SIGKILL after `kDefaultGraceS`), so no child outlives a launcher that fails or throws.
 /// Exit codes: the child's exit status, or 128 + the signal that ended it (as a shell reports them).
