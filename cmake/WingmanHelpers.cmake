@@ -16,6 +16,9 @@ function(wingman_add_test name)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  if(WINGMAN_UNITY_BUILD)  # up to 8 files a unit: no two may define the same name in an anonymous namespace
+    set_target_properties(${name} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+  endif()
   # The test environment goes through the emulator (`env VAR=...`): gtest_discover_tests keeps only the first entry
   # of an ENVIRONMENT list property. NETNS tests then run inside tools/netns_run.sh's private network namespace.
   set(_emulator env "WINGMAN_BIN_DIR=${CMAKE_BINARY_DIR}/bin" "WINGMAN_TEST_BIN_DIR=${CMAKE_BINARY_DIR}/tests"

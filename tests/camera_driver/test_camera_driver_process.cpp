@@ -22,11 +22,11 @@ namespace wingman::camera_driver {
 namespace {
 
 using ::testing::HasSubstr;
+using testing::kStartUtime;
 using wingman::testing::Child;
 using wingman::testing::TempDir;
 using SteadyClock = std::chrono::steady_clock;
 
-constexpr int64_t kStartUtime = 1'700'000'000'000'000;
 constexpr auto kProcessTimeout = std::chrono::seconds(30);  // generous bound for a loaded machine
 
 std::vector<std::string> nonempty_lines(const std::string& text) {

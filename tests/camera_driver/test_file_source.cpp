@@ -21,11 +21,11 @@ namespace {
 
 using testing::FakeClock;
 using ::testing::HasSubstr;
+using testing::kStartUtime;
 using testing::level_of;
 using wingman::testing::TempDir;
 
-constexpr int64_t kStartUtime = 1'700'000'000'000'000;  // fixed: fast mode is then deterministic
-constexpr int kMaxReads = 1000;                         // bounds every read loop
+constexpr int kMaxFileReads = 1000;  // bounds every read loop
 
 /// Mean of all bytes of a raw frame's pixels (padding excluded).
 double mean_level(const Frame& f) {
@@ -66,7 +66,7 @@ TEST(FileSource, VideoInFastModeHasDeterministicUtimesAndFrameOrder) {
     source.open();
     EXPECT_DOUBLE_EQ(source.fps(), 10.0) << "file.fps 0 takes the video's rate";
     Frame f;
-    for (int i = 0; i < kMaxReads; ++i) {
+    for (int i = 0; i < kMaxFileReads; ++i) {
       const ReadResult r = source.read(f, 0);
       if (r.status == ReadStatus::kEnd) break;
       ASSERT_EQ(r.status, ReadStatus::kFrame) << r.reason;
@@ -234,7 +234,7 @@ TEST(FileSource, RealtimeModePacesFramesWithTheClockAndStampsTheSchedule) {
   const int64_t open_mono = clock->monotonic_utime();
   Frame f;
   std::vector<int64_t> arrival_us;
-  for (int i = 0; i < kMaxReads && arrival_us.size() < 3; ++i) {
+  for (int i = 0; i < kMaxFileReads && arrival_us.size() < 3; ++i) {
     const ReadResult r = source.read(f, 30);  // waits at most 30 ms per call
     if (r.status == ReadStatus::kTimeout) continue;
     ASSERT_EQ(r.status, ReadStatus::kFrame) << r.reason;

@@ -16,6 +16,9 @@
 
 namespace wingman::camera_driver::testing {
 
+/// A fixed start time for file sources (utime, microseconds): fast mode is then deterministic.
+constexpr int64_t kStartUtime = 1'700'000'000'000'000;
+
 /// Gray level of frame i in write_gray_video (spaced 20 apart so JPEG error cannot confuse them).
 inline int level_of(int i) { return 20 + 20 * (i % 11); }
 

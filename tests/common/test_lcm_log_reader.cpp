@@ -71,7 +71,9 @@ TEST(LcmLogReader, ReadsWhatLcmWritesEventForEvent) {
     EXPECT_EQ(e->channel, "CH" + std::to_string(i));
     EXPECT_EQ(e->timestamp, 1000 + i);
     EXPECT_EQ(e->datalen, i * 10);
-    if (i > 0) EXPECT_EQ(static_cast<const uint8_t*>(e->data)[0], i);
+    if (i > 0) {
+      EXPECT_EQ(static_cast<const uint8_t*>(e->data)[0], i);
+    }
   }
   EXPECT_EQ(r.read_next(), nullptr);
   EXPECT_EQ(r.read_next(), nullptr);

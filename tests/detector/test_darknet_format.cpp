@@ -4,6 +4,7 @@
 #include <wingman/detector/darknet_weights.hpp>
 
 #include "test_support.hpp"
+#include "thesis_model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +15,7 @@
 namespace wingman::detector {
 namespace {
 
-DarknetModel thesis() { return parse_darknet_cfg(testing::source_path("models/tiny-yolo-thesis.cfg")); }
+using test::thesis;
 
 std::string message_of(const std::function<void()>& f) {
   try {

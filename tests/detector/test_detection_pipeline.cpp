@@ -10,6 +10,7 @@
 #include <wingman/common/config.hpp>
 
 #include "test_support.hpp"
+#include "thesis_model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +23,7 @@ namespace {
 
 constexpr float kCell = 32.0f;  // 416 / 13 network pixels per grid cell
 
-DarknetModel thesis() { return parse_darknet_cfg(testing::source_path("models/tiny-yolo-thesis.cfg")); }
+using test::thesis;
 
 float sigmoid(float x) { return 1.0f / (1.0f + std::exp(-x)); }
 float logit(float p) { return std::log(p / (1.0f - p)); }

@@ -24,6 +24,7 @@ namespace wingman::follower_ctrl::test {
 
 constexpr int64_t kT0 = 1700000000000000;  ///< a message time, microseconds
 constexpr int64_t kMs = 1000;              ///< one millisecond in utime units
+constexpr double kTol = 1e-9;              ///< for hand-computed values: exact decimals, only rounding separates them
 
 // Copies of the LCM constants (the generated static members have no definition to bind a reference to).
 constexpr int8_t kHold = wingman::setpoint_t::MODE_HOLD;

@@ -20,8 +20,6 @@ using wingman::follower_ctrl::FollowerOutput;
 using wingman::follower_ctrl::swap_ned_enu;
 using namespace wingman::follower_ctrl::test;
 
-constexpr double kTol = 1e-9;
-
 Vector3d velocity_of(const setpoint_t& s) { return {s.velocity[0], s.velocity[1], s.velocity[2]}; }
 
 /// Options whose limits do not act, so the controllers' outputs show (the limits have their own tests).

@@ -22,8 +22,6 @@ using wingman::follower_ctrl::VelocityCommand;
 
 using namespace wingman::follower_ctrl::test;
 
-constexpr double kTol = 1e-9;
-
 FormationOptions fixed_height(double height_m) {
   FormationOptions o;
   o.height_mode = "fixed";

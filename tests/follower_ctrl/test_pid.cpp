@@ -2,6 +2,8 @@
 // The PID of eq. 34-37 pinned against hand-computed terms: P, I with its clamp, D on irregular message times.
 #include "wingman/follower_ctrl/pid.hpp"
 
+#include "follower_test_helpers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,8 +15,8 @@ using wingman::follower_ctrl::Pid;
 using wingman::follower_ctrl::PidGains;
 using wingman::follower_ctrl::PidTerms;
 
-constexpr int64_t kT0 = 1700000000000000;
-constexpr double kTol = 1e-9;  // the hand values are exact decimals; only rounding separates them
+using wingman::follower_ctrl::test::kT0;
+using wingman::follower_ctrl::test::kTol;
 
 const PidGains kThesis{26.0, 2.0, 2.0, 0.1};  // K_P, K_I, K_D, e_I,max
 

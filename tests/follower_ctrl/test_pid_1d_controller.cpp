@@ -22,8 +22,6 @@ using wingman::follower_ctrl::Pid1dController;
 using wingman::follower_ctrl::Pid1dOptions;
 using namespace wingman::follower_ctrl::test;
 
-constexpr double kTol = 1e-9;
-
 OwnState own_at(double yaw_rad, double z = 5.0) {
   OwnState s;
   s.utime = kT0 - 1000000;  // measured 1 s before: the acceleration limit from it is wide

@@ -23,7 +23,7 @@ using wingman::follower_ctrl::VelocityLimiter;
 
 using namespace wingman::follower_ctrl::test;
 
-constexpr double kTol = 1e-12;
+constexpr double kLimitTol = 1e-12;
 
 LimitsOptions limits(double max_h, double max_v, double acc_h, double acc_v, double floor = -100.0) {
   LimitsOptions l;
@@ -45,38 +45,40 @@ OwnState own_at(int64_t utime, const Vector3d& p, const Vector3d& v = Vector3d::
 
 TEST(VelocityLimits, SpeedLimitScalesTheHorizontalPartAndClampsTheVertical) {
   const LimitsOptions l = limits(2.5, 1.0, 1, 1);
-  EXPECT_VEC_NEAR(limit_speed(Vector3d(3, 4, 2), l), Vector3d(1.5, 2.0, 1.0), kTol);    // |(3,4)| = 5 -> 2.5
-  EXPECT_VEC_NEAR(limit_speed(Vector3d(-1, 1, -3), l), Vector3d(-1, 1, -1), kTol);      // horizontal within
-  EXPECT_VEC_NEAR(limit_speed(Vector3d(0.5, 0, 0.2), l), Vector3d(0.5, 0, 0.2), kTol);  // untouched
+  EXPECT_VEC_NEAR(limit_speed(Vector3d(3, 4, 2), l), Vector3d(1.5, 2.0, 1.0), kLimitTol);    // |(3,4)| = 5 -> 2.5
+  EXPECT_VEC_NEAR(limit_speed(Vector3d(-1, 1, -3), l), Vector3d(-1, 1, -1), kLimitTol);      // horizontal within
+  EXPECT_VEC_NEAR(limit_speed(Vector3d(0.5, 0, 0.2), l), Vector3d(0.5, 0, 0.2), kLimitTol);  // untouched
 }
 
 TEST(VelocityLimits, AccelerationLimitScalesTheChangeVectorAndClampsTheVerticalChange) {
   const LimitsOptions l = limits(10, 10, 2.0, 1.0);
   // dt = 0.5 s: horizontal change at most 1 m/s along (3, 4)/5; vertical at most 0.5 m/s.
-  EXPECT_VEC_NEAR(limit_acceleration(Vector3d(3, 4, -2), Vector3d::Zero(), 0.5, l), Vector3d(0.6, 0.8, -0.5), kTol);
-  EXPECT_VEC_NEAR(limit_acceleration(Vector3d(1.2, 1, 0.1), Vector3d(1, 1, 0), 0.5, l), Vector3d(1.2, 1, 0.1), kTol);
-  EXPECT_VEC_NEAR(limit_acceleration(Vector3d(5, 5, 5), Vector3d(1, 2, 3), 0.0, l), Vector3d(1, 2, 3), kTol);
+  EXPECT_VEC_NEAR(limit_acceleration(Vector3d(3, 4, -2), Vector3d::Zero(), 0.5, l), Vector3d(0.6, 0.8, -0.5),
+                  kLimitTol);
+  EXPECT_VEC_NEAR(limit_acceleration(Vector3d(1.2, 1, 0.1), Vector3d(1, 1, 0), 0.5, l), Vector3d(1.2, 1, 0.1),
+                  kLimitTol);
+  EXPECT_VEC_NEAR(limit_acceleration(Vector3d(5, 5, 5), Vector3d(1, 2, 3), 0.0, l), Vector3d(1, 2, 3), kLimitTol);
 }
 
 TEST(VelocityLimits, LimiterRampsFromTheMeasuredVelocityAfterAResetThenFromItsPreviousCommand) {
   VelocityLimiter limiter(limits(3.0, 1.0, 2.0, 1.0));
   const OwnState own = own_at(kT0, Vector3d(0, 0, 10), Vector3d(1, 0, 0));
   // First command 0.1 s after the measurement: 1 + 2 * 0.1.
-  EXPECT_VEC_NEAR(limiter.apply(Vector3d(3, 0, 0), kT0 + 100000, own), Vector3d(1.2, 0, 0), kTol);
-  EXPECT_VEC_NEAR(limiter.apply(Vector3d(3, 0, 0), kT0 + 200000, own), Vector3d(1.4, 0, 0), kTol);
-  EXPECT_VEC_NEAR(limiter.apply(Vector3d(-3, 0, 0), kT0 + 300000, own), Vector3d(1.2, 0, 0), kTol);
+  EXPECT_VEC_NEAR(limiter.apply(Vector3d(3, 0, 0), kT0 + 100000, own), Vector3d(1.2, 0, 0), kLimitTol);
+  EXPECT_VEC_NEAR(limiter.apply(Vector3d(3, 0, 0), kT0 + 200000, own), Vector3d(1.4, 0, 0), kLimitTol);
+  EXPECT_VEC_NEAR(limiter.apply(Vector3d(-3, 0, 0), kT0 + 300000, own), Vector3d(1.2, 0, 0), kLimitTol);
   // A command at the same time cannot change.
-  EXPECT_VEC_NEAR(limiter.apply(Vector3d(0, 0, 0), kT0 + 300000, own), Vector3d(1.2, 0, 0), kTol);
+  EXPECT_VEC_NEAR(limiter.apply(Vector3d(0, 0, 0), kT0 + 300000, own), Vector3d(1.2, 0, 0), kLimitTol);
   limiter.reset();
   // At the measurement's own time after a reset: exactly the measured velocity, no jump.
-  EXPECT_VEC_NEAR(limiter.apply(Vector3d(-3, 0, 0), kT0, own), Vector3d(1, 0, 0), kTol);
+  EXPECT_VEC_NEAR(limiter.apply(Vector3d(-3, 0, 0), kT0, own), Vector3d(1, 0, 0), kLimitTol);
   EXPECT_THROW(limiter.apply(Vector3d::Zero(), kT0 - 1, own), std::invalid_argument);
 }
 
 TEST(VelocityLimits, SpeedLimitWinsOverTheAccelerationLimitWhenTheMeasuredVelocityIsTooFast) {
   VelocityLimiter limiter(limits(3.0, 1.0, 2.0, 1.0));
   const OwnState own = own_at(kT0, Vector3d(0, 0, 10), Vector3d(5, 0, -2));
-  EXPECT_VEC_NEAR(limiter.apply(Vector3d(5, 0, -2), kT0 + 10000, own), Vector3d(3, 0, -1), kTol);
+  EXPECT_VEC_NEAR(limiter.apply(Vector3d(5, 0, -2), kT0 + 10000, own), Vector3d(3, 0, -1), kLimitTol);
 }
 
 TEST(VelocityLimits, RandomWantedVelocitiesNeverBreakTheSpeedOrAccelerationLimits) {
@@ -102,39 +104,39 @@ TEST(VelocityLimits, RandomWantedVelocitiesNeverBreakTheSpeedOrAccelerationLimit
 
 TEST(VelocityLimits, NoApproachRemovesOnlyTheClosingComponent) {
   const Vector3d d(2, 0, 0);  // obstacle east
-  EXPECT_VEC_NEAR(remove_approach(Vector3d(2, 1, 0.5), d), Vector3d(0, 1, 0.5), kTol);
-  EXPECT_VEC_NEAR(remove_approach(Vector3d(-2, 1, 0), d), Vector3d(-2, 1, 0), kTol);  // moving away: kept
+  EXPECT_VEC_NEAR(remove_approach(Vector3d(2, 1, 0.5), d), Vector3d(0, 1, 0.5), kLimitTol);
+  EXPECT_VEC_NEAR(remove_approach(Vector3d(-2, 1, 0), d), Vector3d(-2, 1, 0), kLimitTol);  // moving away: kept
   const Vector3d diag(1, 1, 0);
   const Vector3d out = remove_approach(Vector3d(1, 0, 0), diag);
-  EXPECT_VEC_NEAR(out, Vector3d(0.5, -0.5, 0), kTol);
-  EXPECT_NEAR(out.dot(diag), 0.0, kTol);
+  EXPECT_VEC_NEAR(out, Vector3d(0.5, -0.5, 0), kLimitTol);
+  EXPECT_NEAR(out.dot(diag), 0.0, kLimitTol);
 }
 
 TEST(VelocityLimits, FloorStopsDescentsAtAndBelowItOnlyAndKeepsTheNoApproachRule) {
   VelocityLimiter limiter(limits(10, 10, 1e4, 1e4, 1.0));
   EXPECT_VEC_NEAR(limiter.apply(Vector3d(0, 0, -1), kT0 + 100000, own_at(kT0, Vector3d(0, 0, 1.0))), Vector3d(0, 0, 0),
-                  kTol);
+                  kLimitTol);
   limiter.reset();
   EXPECT_VEC_NEAR(limiter.apply(Vector3d(0, 0, -1), kT0 + 100000, own_at(kT0, Vector3d(0, 0, 0.5))), Vector3d(0, 0, 0),
-                  kTol);
+                  kLimitTol);
   limiter.reset();
   EXPECT_VEC_NEAR(limiter.apply(Vector3d(0, 0, -1), kT0 + 100000, own_at(kT0, Vector3d(0, 0, 1.5))), Vector3d(0, 0, -1),
-                  kTol);
+                  kLimitTol);
   limiter.reset();
   // At the floor with the obstacle ahead and above: (1, 0, -1) does not close on (1, 0, 1), but once the
   // floor takes the descent away it would; the horizontal part gives way instead.
   const Vector3d out =
       limiter.apply(Vector3d(1, 0, -1), kT0 + 100000, own_at(kT0, Vector3d(0, 0, 1.0)), Vector3d(1, 0, 1));
   EXPECT_GE(out.z(), 0.0);
-  EXPECT_LE(out.dot(Vector3d(1, 0, 1)), kTol);
-  EXPECT_VEC_NEAR(out, Vector3d(0, 0, 0), kTol);
+  EXPECT_LE(out.dot(Vector3d(1, 0, 1)), kLimitTol);
+  EXPECT_VEC_NEAR(out, Vector3d(0, 0, 0), kLimitTol);
 }
 
 TEST(VelocityLimits, NoApproachWinsOverTheAccelerationLimit) {
   VelocityLimiter limiter(limits(3.0, 1.0, 1.0, 1.0));
   const OwnState own = own_at(kT0, Vector3d(0, 0, 10), Vector3d(2, 0, 0));                      // flying east at 2 m/s
   const Vector3d out = limiter.apply(Vector3d(2, 0, 0), kT0 + 100000, own, Vector3d(2, 0, 0));  // obstacle east
-  EXPECT_LE(out.x(), kTol) << "never closes on the obstacle, though braking from 2 m/s takes 2 s at 1 m/s^2";
+  EXPECT_LE(out.x(), kLimitTol) << "never closes on the obstacle, though braking from 2 m/s takes 2 s at 1 m/s^2";
 }
 
 TEST(VelocityLimits, YawRateIsClampedSymmetrically) {

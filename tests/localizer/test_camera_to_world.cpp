@@ -5,6 +5,8 @@
 #include <wingman/geometry/extrinsics.hpp>
 #include <wingman/localizer/camera_to_world.hpp>
 
+#include "test_rotations.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
@@ -20,12 +22,10 @@ using wingman::localizer::CameraMeasurement;
 using wingman::localizer::PoseSample;
 using wingman::localizer::to_world;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kTol = 1e-12;  // exact arithmetic up to rounding of a few products
+using wingman::testing::kPi;
+using wingman::testing::yaw;
 
-Eigen::Quaterniond yaw(double deg) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(deg * kPi / 180, Eigen::Vector3d::UnitZ()));
-}
+constexpr double kTol = 1e-12;  // exact arithmetic up to rounding of a few products
 
 Extrinsics forward_camera(double x_offset) {
   ExtrinsicsOptions o;

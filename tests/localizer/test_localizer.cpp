@@ -4,6 +4,7 @@
 #include "wingman/localizer/localizer.hpp"
 
 #include "sphere_scene.hpp"
+#include "test_constants.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,8 +23,8 @@ using wingman::localizer::Localizer;
 using wingman::localizer::LocalizerOptions;
 using wingman::localizer::LocalizerOutput;
 using wingman::localizer::NonDroneCounts;
+using wingman::testing::kT0;
 
-constexpr int64_t kT0 = 1700000000000000;
 // A pinhole with its principal point at the image centre, looking east; the default radius.
 const wingman::localizer::testing::SphereScene kScene{640, 639.5, 359.5, 0.348};
 using wingman::localizer::testing::detections;

@@ -6,6 +6,7 @@
 
 #include "rig_scene.hpp"
 #include "sphere_scene.hpp"
+#include "test_constants.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -31,8 +32,8 @@ using wingman::localizer::LocalizerOutput;
 using wingman::localizer::testing::own_pose;
 using wingman::localizer::testing::RigScene;
 
-constexpr int64_t kT0 = 1700000000000000;
-constexpr int64_t kFrameUs = 33333;  // 30 frames/s
+using wingman::testing::kFrameUs;  // 30 frames/s
+using wingman::testing::kT0;
 
 wingman::geometry::CameraRig surround4() {
   return wingman::geometry::load_camera_rig(wingman::testing::source_path("config/rigs/surround4.yaml"));

@@ -3,6 +3,8 @@
 // input order nor blinds the localizer; a bad first message is forgotten within time.resync_after_s.
 #include "wingman/localizer/localizer.hpp"
 
+#include "test_constants.hpp"
+
 #include <wingman/common/config.hpp>
 
 #include <gtest/gtest.h>
@@ -16,11 +18,11 @@ using wingman::geometry::CameraModel;
 using wingman::localizer::Localizer;
 using wingman::localizer::LocalizerOptions;
 using wingman::localizer::LocalizerOutput;
+using wingman::testing::kT0;
 
-constexpr int64_t kT0 = 1700000000000000;
 constexpr int64_t kS = 1000000;
 
-CameraModel camera() { return CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5); }
+CameraModel centred_camera() { return CameraModel::pinhole(1280, 720, 640, 640, 639.5, 359.5); }
 
 wingman::own_pose_t pose_at(int64_t utime) {
   wingman::own_pose_t m{};
@@ -55,7 +57,7 @@ struct Result {
 enum class Lie { kFutureDetections, kFutureOwnPose, kFirstMessageInTheFuture };
 
 Result fly(Lie lie) {
-  Localizer loc(LocalizerOptions{}, camera());
+  Localizer loc(LocalizerOptions{}, centred_camera());
   Result r;
   const int64_t lie_at = lie == Lie::kFirstMessageInTheFuture ? 0 : kS;
   auto send_lie = [&] {
@@ -114,7 +116,7 @@ TEST(LocalizerTime, OneFutureOwnPoseIsDroppedAndDoesNotBlindTheLocalizer) {
 }
 
 TEST(LocalizerTime, AResyncIsANoteForTheLogNamingWhatWasForgotten) {
-  Localizer loc(LocalizerOptions{}, camera());
+  Localizer loc(LocalizerOptions{}, centred_camera());
   loc.on_own_pose(pose_at(kT0 + 1000 * kS));  // a first own pose from the future: the clock anchors on it
   EXPECT_TRUE(loc.take_notes().empty());
   int refused = 0;
@@ -144,7 +146,7 @@ TEST(LocalizerTime, WhenTimeGoesBackForEveryInputTheLocalizerStartsAgainWithinTh
   // A restarted source (a replayed log, a restarted simulator): own poses and detections both jump 100 s back. They
   // are refused for time.resync_after_s of their own time, then the clock re-anchors and the localizer works again:
   // detections find own poses and the tracker takes frames (a new tracker: the old tracks live in the old times).
-  Localizer loc(LocalizerOptions{}, camera());
+  Localizer loc(LocalizerOptions{}, centred_camera());
   const int64_t back = -100 * kS;
   int refused = 0, blind_late = 0, taken_late = 0;
   int64_t next_detections = 0;
@@ -190,7 +192,7 @@ TEST(LocalizerTime, TheTimeKeysComeFromTheLocalizersConfiguration) {
     const auto o = wingman::common::load_options_from_string<LocalizerOptions>(
         "time: {max_ahead_s: " + std::to_string(max_ahead_s) + "}\n", "localizer.yaml");
     EXPECT_EQ(o.time.max_ahead_s, max_ahead_s);
-    Localizer loc(o, camera());
+    Localizer loc(o, centred_camera());
     loc.on_own_pose(pose_at(kT0));
     (void)loc.on_detections(detections_at(kT0));
     if (max_ahead_s < 2.0) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <wingman/localizer/pose_buffer.hpp>
 
+#include "test_rotations.hpp"
+
 #include <cmath>
 
 namespace {
@@ -11,12 +13,9 @@ using wingman::localizer::PoseBuffer;
 using wingman::localizer::PoseBufferOptions;
 using wingman::localizer::PoseSample;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr int64_t kT0 = 1'700'000'000'000'000;  // an epoch utime
-
-Eigen::Quaterniond yaw(double deg) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(deg * kPi / 180, Eigen::Vector3d::UnitZ()));
-}
+using wingman::testing::kPi;
+using wingman::testing::kT0;
+using wingman::testing::yaw;
 
 double yaw_deg(const Eigen::Quaterniond& q) {
   const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();

@@ -8,6 +8,8 @@
 #include <wingman/common/config.hpp>
 #include <wingman/localizer/tracker.hpp>
 
+#include "test_constants.hpp"
+
 #include <Eigen/Cholesky>
 
 #include <cmath>
@@ -20,10 +22,9 @@ using wingman::localizer::TrackerOptions;
 using wingman::localizer::TrackerStats;
 using wingman::localizer::TrackOutput;
 using wingman::localizer::WorldMeasurement;
+using wingman::testing::kT0;
 
-constexpr int64_t kT0 = 1'700'000'000'000'000;
 constexpr int64_t kFrameUs = 100'000;  // 10 Hz detections
-constexpr double kPi = 3.14159265358979323846;
 
 int64_t frame_utime(int k) { return kT0 + kFrameUs * k; }
 double seconds(int64_t utime) { return static_cast<double>(utime - kT0) * 1e-6; }

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <wingman/localizer/tracker.hpp>
 
+#include "test_constants.hpp"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -20,8 +22,8 @@ using wingman::localizer::TrackerOptions;
 using wingman::localizer::TrackOutput;
 using wingman::localizer::WorldMeasurement;
 
-constexpr int64_t kT0 = 1'700'000'000'000'000;
-constexpr int64_t kFrameUs = 33'333;
+using wingman::testing::kFrameUs;
+using wingman::testing::kT0;
 
 int64_t frame_utime(int k) { return kT0 + kFrameUs * k; }
 

@@ -5,6 +5,8 @@
 #include <wingman/mavlink/parser.hpp>
 #include <wingman/mavlink_bridge/bridge.hpp>
 
+#include "test_constants.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +17,7 @@ namespace mav = wingman::mavlink;
 
 namespace {
 
-constexpr int64_t kMs = 1000;
+using wingman::testing::kMs;
 
 /// The frame of an autopilot message, as the parser hands it on.
 template <class Msg>

@@ -157,7 +157,9 @@ TEST(MavlinkBridgeAgainstSim, Px4GatesOnOffboardClampsSpeedAndAccelerationThenHo
   double max_speed = 0, max_accel = 0;
   for (size_t i = 0; i < rig.samples.size(); ++i) {
     const Sample& s = rig.samples[i];
-    if (s.t_s < 1.0) EXPECT_LT(s.v.norm(), 1e-6) << "moved at " << s.t_s << " s before OFFBOARD";
+    if (s.t_s < 1.0) {
+      EXPECT_LT(s.v.norm(), 1e-6) << "moved at " << s.t_s << " s before OFFBOARD";
+    }
     max_speed = std::max(max_speed, horizontal(s.v));
     // The acceleration over 0.5 s of simulated time: the bridge clamps on the setpoints' stamps (the newest own pose
     // when sent), which the vehicle flies at the frame they arrive in; a frame's jitter is one step of the ramp.

@@ -5,6 +5,8 @@
 #include <wingman/mavlink_bridge/offboard_streamer.hpp>
 #include <wingman/own_pose_t.hpp>
 
+#include "test_constants.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,7 +18,7 @@ namespace mav = wingman::mavlink;
 
 namespace {
 
-constexpr int64_t kMs = 1000;
+using wingman::testing::kMs;
 
 AutopilotState px4(bool offboard, bool armed = true) {
   AutopilotState s;

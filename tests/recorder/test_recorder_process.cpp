@@ -136,7 +136,9 @@ TEST(RecorderProcess, MissingDirectoryWithoutRequireRunsReportsOnceAndCountsEver
   EXPECT_EQ(error_lines, 1u) << r.err;
   wingman::status_t last{};
   for (const auto& e : read_log(dir.file("out.lcmlog"))) {
-    if (e.channel == "STATUS_RECORDER") ASSERT_GE(last.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0);
+    if (e.channel == "STATUS_RECORDER") {
+      ASSERT_GE(last.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0);
+    }
   }
   EXPECT_NE(last.last_error.find(dir.file("absent")), std::string::npos) << last.last_error;
   EXPECT_NE(last.last_error.find("No such file or directory"), std::string::npos) << last.last_error;

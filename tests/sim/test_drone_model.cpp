@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Drone specs and models: validation, the procedural frames, spinning propellers, bounding radii, mesh loading
 // (including the assembled real airframes in ../shared/meshes).
+#include "test_constants.hpp"
 #include "test_render_support.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +17,8 @@
 namespace wingman::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test::joined;
+using wingman::testing::kPi;
 
 /// A config file section "drone:" with a DroneSpec, as a process would read it.
 struct DroneConfig {
@@ -27,12 +29,6 @@ struct DroneConfig {
   }
   std::vector<std::string> validate() const { return drone.validate(); }
 };
-
-std::string joined(const std::vector<std::string>& v) {
-  std::string s;
-  for (const std::string& x : v) s += x + "\n";
-  return s;
-}
 
 TEST(DroneSpec, DefaultsAreValid) {
   EXPECT_TRUE(DroneSpec{}.validate().empty()) << joined(DroneSpec{}.validate());

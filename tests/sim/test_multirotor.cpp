@@ -7,6 +7,8 @@
 #include <wingman/sim/multirotor.hpp>
 #include <wingman/sim/vehicle_command.hpp>
 
+#include "test_constants.hpp"
+
 #include <cmath>
 
 namespace {
@@ -17,8 +19,7 @@ using wingman::sim::kGravity;
 using wingman::sim::Multirotor;
 using wingman::sim::MultirotorLimits;
 using wingman::sim::VehicleCommand;
-
-constexpr double kDeg = M_PI / 180.0;
+using wingman::testing::kDeg;
 
 VehicleCommand velocity(const Eigen::Vector3d& v, double yaw_rate = 0.0) {
   VehicleCommand c;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Renderer: rendered pixels against the exact truth boxes across the field of view (pinhole, radtan, fisheye, real
 // calibrations, real airframes), occlusion, sensor effects, motion blur, scene, errors.
+#include "test_constants.hpp"
 #include "test_render_support.hpp"
 
 #include <gtest/gtest.h>
@@ -20,8 +21,7 @@ using test::box_of;
 using test::edge_error;
 using test::flat_options;
 using test::look_at;
-
-constexpr double kPi = 3.14159265358979323846;
+using wingman::testing::kPi;
 
 /// A random attitude with roll and pitch within +-max_tilt and any yaw.
 Eigen::Matrix3d random_attitude(std::mt19937& rng, double max_tilt) {

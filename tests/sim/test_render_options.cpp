@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // RenderOptions: valid defaults, validate() naming each bad key, the YAML loader reporting every problem at once.
+#include "test_render_support.hpp"
+
 #include <gtest/gtest.h>
 #include <wingman/common/config.hpp>
 #include <wingman/sim/render_options.hpp>
@@ -7,11 +9,7 @@
 namespace wingman::sim {
 namespace {
 
-std::string joined(const std::vector<std::string>& v) {
-  std::string s;
-  for (const std::string& x : v) s += x + "\n";
-  return s;
-}
+using test::joined;
 
 TEST(RenderOptions, DefaultsAreValid) {
   EXPECT_TRUE(RenderOptions{}.validate().empty()) << joined(RenderOptions{}.validate());

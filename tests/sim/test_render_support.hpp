@@ -13,8 +13,16 @@
 #include <sys/stat.h>
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace wingman::sim::test {
+
+/// The problems of a validate(), one per line, for readable failures.
+inline std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += x + "\n";
+  return s;
+}
 
 /// "" when ../shared/<sub> exists, else the path that is missing (for GTEST_SKIP messages).
 inline std::string missing_shared(const std::string& sub) {

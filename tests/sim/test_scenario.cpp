@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Scenario files: every shipped scenario loads; each deliberate mistake gives an error naming its key; scripted
 // motions (random walk, waypoints, teleport steps) do what the scenarios need.
+#include "test_constants.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -20,9 +21,8 @@ using wingman::sim::parse_scenario;
 using wingman::sim::Scenario;
 using wingman::sim::ScenarioError;
 using wingman::sim::VehicleSpec;
+using wingman::testing::kDeg;
 using wingman::testing::source_path;
-
-constexpr double kDeg = M_PI / 180.0;
 
 /// A valid scenario; each mistake test changes one line of it.
 const std::string kValid = R"(name: test

@@ -269,9 +269,11 @@ TEST(WeightAverage, UpdatesMatchAPlainReference) {
           << "step " << k << " float " << i;
   }
   // The integer batch counts are copied, not averaged.
-  for (size_t i = 0; i < average->buffers().size(); ++i)
-    if (!average->buffers()[i].is_floating_point())
+  for (size_t i = 0; i < average->buffers().size(); ++i) {
+    if (!average->buffers()[i].is_floating_point()) {
       EXPECT_TRUE(torch::equal(average->buffers()[i], current->buffers()[i])) << "buffer " << i;
+    }
+  }
 }
 
 TEST(WeightAverage, AnotherNetworkOrABadDecayIsRefused) {

@@ -20,7 +20,7 @@ std::string write(const testing::TempDir& dir, const std::string& text) {
   return path;
 }
 
-std::string error_of(const std::string& path) {
+std::string label_error_of(const std::string& path) {
   try {
     read_halmstad_labels(path);
   } catch (const DatasetError& e) {
@@ -57,17 +57,18 @@ TEST(HalmstadLabels, SplitKeepsEmptyFieldsAndDropsCarriageReturns) {
 
 TEST(HalmstadLabels, ErrorsNameTheFileLineAndField) {
   testing::TempDir dir;
-  EXPECT_NE(error_of(dir.file("absent.csv")).find("absent.csv: cannot read the label file"), std::string::npos);
-  EXPECT_NE(error_of(write(dir, "frame,x,y\n")).find("V_TEST_001.csv:1: expected the header"), std::string::npos);
-  EXPECT_NE(error_of(write(dir, "frame,class,x,y,w,h\n0,KITE,1,1,2,2\n"))
+  EXPECT_NE(label_error_of(dir.file("absent.csv")).find("absent.csv: cannot read the label file"), std::string::npos);
+  EXPECT_NE(label_error_of(write(dir, "frame,x,y\n")).find("V_TEST_001.csv:1: expected the header"), std::string::npos);
+  EXPECT_NE(label_error_of(write(dir, "frame,class,x,y,w,h\n0,KITE,1,1,2,2\n"))
                 .find("V_TEST_001.csv:2: field class = 'KITE': expected DRONE, AIRPLANE, BIRD or HELICOPTER"),
             std::string::npos);
-  EXPECT_NE(error_of(write(dir, "frame,class,x,y,w,h\n0,DRONE,1,1,2,2\n4294967296,DRONE,1,1,2,2\n"))
+  EXPECT_NE(label_error_of(write(dir, "frame,class,x,y,w,h\n0,DRONE,1,1,2,2\n4294967296,DRONE,1,1,2,2\n"))
                 .find("V_TEST_001.csv:3: field frame = '4294967296'"),
             std::string::npos);
-  EXPECT_NE(error_of(write(dir, "frame,class,x,y,w,h\n0,BIRD,1,1,0,2\n")).find("field w = '0': expected a positive"),
-            std::string::npos);
-  EXPECT_NE(error_of(write(dir, "frame,class,x,y,w,h\n0,BIRD,1,1,2\n")).find(":2: expected 6 fields, got 5"),
+  EXPECT_NE(
+      label_error_of(write(dir, "frame,class,x,y,w,h\n0,BIRD,1,1,0,2\n")).find("field w = '0': expected a positive"),
+      std::string::npos);
+  EXPECT_NE(label_error_of(write(dir, "frame,class,x,y,w,h\n0,BIRD,1,1,2\n")).find(":2: expected 6 fields, got 5"),
             std::string::npos);
 }
 

@@ -570,7 +570,7 @@ TEST(RunSequenceEval, BoxesCacheGivesTheSameResultWithoutTheDetectorOrTheVideo) 
 
 // ---- the `wingman` binary ----
 
-testing::RunResult wingman(const std::vector<std::string>& args, int timeout_s = 120) {
+testing::RunResult wingman_sequences(const std::vector<std::string>& args, int timeout_s = 120) {
   std::vector<std::string> argv = {testing::bin_path("wingman")};
   argv.insert(argv.end(), args.begin(), args.end());
   return testing::run(argv, std::chrono::seconds(timeout_s));
@@ -578,16 +578,17 @@ testing::RunResult wingman(const std::vector<std::string>& args, int timeout_s =
 
 TEST(WingmanValSequences, MissingSplitsAndPredictionsAreOneErrorLine) {
   Fixture fx;
-  const auto missing = wingman({"val", "--sequences", "--data", fx.root, "--halmstad-root", fx.root});
+  const auto missing = wingman_sequences({"val", "--sequences", "--data", fx.root, "--halmstad-root", fx.root});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_EQ(missing.err.rfind("wingman val: error: " + fx.root + "/splits.csv: no splits.csv", 0), 0u) << missing.err;
   EXPECT_EQ(missing.err.find("wingman val:", 1), std::string::npos) << missing.err;
-  const auto pred =
-      wingman({"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--predictions", fx.dir.path()});
+  const auto pred = wingman_sequences(
+      {"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--predictions", fx.dir.path()});
   EXPECT_EQ(pred.exit_code, 2);
   EXPECT_NE(pred.err.find("--predictions: --sequences runs the detector on every frame"), std::string::npos)
       << pred.err;
-  const auto bad = wingman({"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--hfov-deg", "0"});
+  const auto bad =
+      wingman_sequences({"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--hfov-deg", "0"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("hfov_deg = 0: must be in (0, 180)"), std::string::npos) << bad.err;
 }
@@ -596,7 +597,7 @@ TEST(WingmanValSequences, JsonFileBesideTheTable) {
   // `--json FILE` prints the table and writes the JSON, in both modes; `--json` alone prints the JSON instead.
   testing::TempDir dir;
   write_hand_case(dir);
-  const auto images = wingman(
+  const auto images = wingman_sequences(
       {"val", "--data", dir.file("data.yaml"), "--predictions", dir.file("pred"), "--json", dir.file("val.json")});
   ASSERT_EQ(images.exit_code, 0) << images.err;
   EXPECT_NE(images.out.find("match centre in truth box"), std::string::npos) << images.out;
@@ -607,8 +608,8 @@ TEST(WingmanValSequences, JsonFileBesideTheTable) {
   Fixture fx;
   REQUIRE_VIDEO(fx);
   // The shipped model on the generated 160x128 clips (whatever it finds there: the table and the file are checked).
-  const auto seq =
-      wingman({"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--json", fx.dir.file("seq.json")});
+  const auto seq = wingman_sequences(
+      {"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--json", fx.dir.file("seq.json")});
   ASSERT_EQ(seq.exit_code, 0) << seq.err;
   EXPECT_EQ(seq.out.rfind("track-level metrics: 2 clips of split 'val' (0 skipped), every frame", 0), 0u) << seq.out;
   EXPECT_NE(seq.out.find("target <= 1 false track per hour of distractor video"), std::string::npos) << seq.out;
@@ -618,8 +619,8 @@ TEST(WingmanValSequences, JsonFileBesideTheTable) {
   EXPECT_EQ(seq_doc.at("split"), "val") << seq_json;
   EXPECT_EQ(seq_doc.at("hfov_deg"), 24.0) << seq_json;
   EXPECT_EQ(seq_json.rfind("{\n  \"split\": \"val\",\n  \"hfov_deg\": 24.0,", 0), 0u) << seq_json;  // keys in order
-  const auto stdout_json =
-      wingman({"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--clips", "V_BIRD_001", "--json"});
+  const auto stdout_json = wingman_sequences(
+      {"val", "--sequences", "--data", fx.data, "--halmstad-root", fx.root, "--clips", "V_BIRD_001", "--json"});
   ASSERT_EQ(stdout_json.exit_code, 0) << stdout_json.err;
   EXPECT_EQ(nlohmann::json::parse(stdout_json.out).at("split"), "val") << stdout_json.out;
 }
