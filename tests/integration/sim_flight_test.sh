@@ -14,9 +14,13 @@
 # leader circling at 8 m (tools/fly.sh --rig surround4: ground truth for a lap, the same lap with the cameras exposed one
 # after the other, then 4 s with the CNN) and checks one track id through the hand-overs; `crossing` flies two drones
 # crossing in front of the camera (config/scenarios/crossing.yaml: 25 s with ground-truth boxes, then 14 s with the
-# shipped CNN, each through the first crossing at 10.7 s) and judges the identities inside the crossing window.
+# shipped CNN, each through the first crossing at 10.7 s) and judges the identities inside the crossing window;
+# `motion` flies the first 6 s of config/scenarios/approach.yaml (the default quad crossing the view 43-36 m away)
+# with the single pass and with the detector's motion cue (motion.enabled) and checks that the cue's track is born
+# there, at least 1.3 times as far as the single pass's first (issue 31's target).
 # Extra arguments go to tools/fly.sh (for runs by hand).
-# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered|pose_error|windows|surround|crossing] [fly.sh arguments...]
+# Usage: sim_flight_test.sh SOURCE_DIR BIN_DIR [flight|rendered|pose_error|windows|surround|crossing|motion]
+#        [fly.sh arguments...]
 set -euo pipefail
 src="$1"; bin="$2"; kind="${3:-flight}"
 shift $(( $# < 3 ? $# : 3 ))
@@ -179,6 +183,45 @@ for name, rms_max, false_max in (("truth", 0.2, 0), ("cnn", 1.3, 150)):
     check(len(chosen) == 1, f"{name}: the follower followed track ids {chosen}, expected one")
     print(f"sim_flight_test: {name}: ids by vehicle {r['ids_by_vehicle']}, RMS {loc['rms_m']:.3f} m, "
           f"false targets {r['false_targets']}, followed {chosen}")
+print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
+sys.exit(1 if problems else 0)
+PY
+  exit
+fi
+if [ "$kind" = motion ]; then
+  for flight in single motion; do
+    sets=()
+    if [ "$flight" = motion ]; then sets=(--detector-set motion.enabled=true); fi
+    log=$(WINGMAN_BIN_DIR="$bin" timeout 600 tools/fly.sh --scenario approach --duration 6 "${sets[@]}" \
+      --out "$out/$flight" "$@" 2>&1) || { echo "$log"; fail "the $flight flight failed"; }
+    echo "$log"
+    grep -Eq "\[sim\] info: 180 frames in .*0 lockstep timeouts" <<<"$log" || fail "$flight: not 180 frames in lockstep"
+    # Scored again matching within 15 m: the only drone in view, and a far track's range is 20-27 % short
+    # (docs/results.md, "The motion cue"), so its targets are more than 3 m off.
+    "$bin/wingman" eval "$out/$flight/flight.lcmlog" --match-radius 15 --csv "$out/$flight/targets_r15.csv" \
+      > "$out/$flight/eval_r15.txt" || { cat "$out/$flight/eval_r15.txt"; fail "$flight: wingman eval failed"; }
+  done
+  PYENV_VERSION=system python3 - "$out" <<'PY'
+import csv, os, sys
+problems = []
+def check(ok, what):
+    if not ok: problems.append(what)
+def first_target(name):  # (time s, true range m) of the first published target within 15 m of the leader, or None
+    for row in csv.DictReader(open(os.path.join(sys.argv[1], name, "targets_r15.csv"))):
+        if row["vehicle_id"] == "1":
+            return float(row["t_s"]), float(row["range_m"])
+    return None
+# Bounds (docs/results.md, "The motion cue"). Measured 2026-12-07 (the 2-core VM), the first 6 s of approach: the
+# single pass no target on the leader (its first comes at 21.2 s, 20.4 m, in the whole flight); the motion cue its
+# first at 2.7 s, 40.7 m.
+single, motion = first_target("single"), first_target("motion")
+check(motion is not None, "motion: no target on the leader in 6 s")
+if motion is not None:
+    check(motion[1] >= 30.0, f"motion: the leader's first target at {motion[1]:.1f} m, expected >= 30 m")
+    if single is not None:
+        check(motion[1] >= 1.3 * single[1],
+              f"motion: first target at {motion[1]:.1f} m, single pass at {single[1]:.1f} m: expected >= 1.3 times")
+print(f"sim_flight_test: the leader's first target (time s, true range m): single pass {single}, motion cue {motion}")
 print("sim_flight_test: " + ("ok" if not problems else "FAILED: " + "; ".join(problems)))
 sys.exit(1 if problems else 0)
 PY
