@@ -11,6 +11,7 @@
 # Usage: tools/load_test.sh [--mode realtime|replay] [--duration S] [--out DIR] [--cameras N]
 #                           [--soak] [--warmup S] [--sample-period S] [--replay-frames N] [--max-p99-s S]
 #                           [--max-rss-growth-pct P] [--report-only]
+#   --cameras N needs a rig of N cameras reading DETECTIONS_CAM0..N-1 (--set load.rig=FILE; the default rig has four);
 #   the options of `wingman load` (tools/load_test.sh --help lists them with their defaults and what each mode
 #   checks); relative paths are taken from the checkout's root. Environment: WINGMAN_BIN_DIR (default build/bin).
 exec "$(dirname "$0")/netns_verb.sh" load "$@"

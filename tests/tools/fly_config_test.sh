@@ -37,6 +37,14 @@ grep -q '^  cameras: 2$' <<<"$out" && grep -q '^  mode: "replay"$' <<<"$out" && 
 rc=0
 err=$("$wingman" load --set load.camera=2 --cameras 9 --print-config 2>&1) || rc=$?
 [ "$rc" = 2 ] || fail "wingman load with a bad key and a bad flag: exit $rc ($err)"
+# One chain per rig camera: two chains with the four-camera rig is one error naming both keys, before anything runs.
+rc=0
+rig=$(cd "$(dirname "$0")/../.." && pwd)/config/rigs/surround4.yaml
+err=$("$wingman" load --cameras 2 --mode replay --set "load.rig=$rig" --out "$tmp/load" 2>&1) || rc=$?
+[ "$rc" = 2 ] || fail "wingman load --cameras 2 with the four-camera rig: exit $rc, expected 2 ($err)"
+grep -Fq "load.cameras = 2 and load.rig = $rig: the rig's cameras read DETECTIONS_CAM0, DETECTIONS_CAM1, DETECTIONS_CAM2, DETECTIONS_CAM3" <<<"$err" ||
+  fail "wingman load --cameras 2: $err"
+[ ! -e "$tmp/load" ] || fail "wingman load --cameras 2 wrote $tmp/load before refusing"
 printf 'demo:\n  video: clip.avi\n' > "$tmp/demo.yaml"
 out=$("$wingman" demo-camera --config "$tmp/demo.yaml" --print-config)
 grep -q '^  video: "clip.avi"$' <<<"$out" || fail "wingman demo-camera's layers: $out"

@@ -3,15 +3,18 @@
 // tools/load_summary.py.
 #include "wingman/tools/load.hpp"
 
+#include "wingman/geometry/camera_rig.hpp"
 #include "wingman/launcher/bus_watch.hpp"
 #include "wingman/launcher/launch_setup.hpp"
 #include "wingman/launcher/process_group.hpp"
 #include "wingman/tools/make_video.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 #include <wingman/common/config.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -149,8 +152,32 @@ std::vector<std::string> load_process_sets(const std::string& exe, int camera, c
   throw std::invalid_argument("load_process_sets: no load settings for " + exe);
 }
 
+namespace {
+
+/// One chain per camera of the rig: chain i publishes DETECTIONS_CAM<i>, so the rig's cameras must read exactly
+/// DETECTIONS_CAM0 .. DETECTIONS_CAM<cameras - 1> (else the localizer waits on cameras nobody plays, or drops a chain).
+/// Throws common::ConfigError naming the rig file (unreadable, bad) and std::invalid_argument naming both keys.
+void check_rig_matches_chains(const LoadOptions& o) {
+  const geometry::CameraRig rig = geometry::load_camera_rig(o.rig);
+  std::vector<std::string> want, have;
+  for (int i = 0; i < o.cameras; ++i) want.push_back(fmt::format("DETECTIONS_CAM{}", i));
+  for (const geometry::RigCamera& c : rig.cameras) have.push_back(c.detections_channel);
+  std::sort(want.begin(), want.end());
+  std::sort(have.begin(), have.end());
+  if (want != have) {
+    throw std::invalid_argument(fmt::format(
+        "load.cameras = {} and load.rig = {}: the rig's cameras read {}, the load test's {} chain(s) publish {}: one "
+        "chain per rig camera (give --cameras {} or a rig of {} camera(s) with camera ids 0..{}: --set load.rig=FILE)",
+        o.cameras, o.rig, fmt::join(have, ", "), o.cameras, fmt::join(want, ", "), rig.cameras.size(), o.cameras,
+        o.cameras - 1));
+  }
+}
+
+}  // namespace
+
 int run_load(const LoadOptions& o, std::ostream& out, std::ostream& err) {
   if (const auto problems = o.validate(); !problems.empty()) throw std::invalid_argument(problems.front());
+  check_rig_matches_chains(o);
   const bool replay = o.mode == "replay";
   const double duration_s = o.effective_duration_s();
   const std::string bin = launcher::executables_dir(
