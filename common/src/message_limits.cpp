@@ -69,7 +69,7 @@ const WireStruct kDetection{"detection_t",
                              {"h", Wire::kF32},
                              {"confidence", Wire::kF32},
                              {"class_id", Wire::kI16},
-                             {"zoom_refined", Wire::kBool},
+                             {"pass_kind", Wire::kI8},
                              {"drone_score", Wire::kF32}}};
 const WireStruct kDetections{"detections_t",
                              {{"utime", Wire::kI64},

@@ -18,7 +18,7 @@ struct Group {
   double weight = 0.0, cx = 0.0, cy = 0.0, w = 0.0, h = 0.0;
   double drone_score = 0.0;  ///< sum of the members' drone scores
   uint32_t views = 0;        ///< bit v set: the group holds a box of view v
-  Box fused;                 ///< the weighted mean so far; zoom_refined when any member is
+  Box fused;                 ///< the weighted mean so far; the highest pass of its members
 };
 
 /// Both overloads: `min_size` null (every view sees every size) or view_count minimum sizes.
@@ -61,7 +61,7 @@ void fuse(std::vector<ViewBox>& boxes, int view_count, const float* min_size, fl
     best->drone_score += vb.box.drone_score;
     best->views |= bit;
     const int class_id = best->views == bit ? vb.box.class_id : best->fused.class_id;  // the first (most confident)
-    const bool refined = best->fused.zoom_refined || vb.box.zoom_refined;
+    const Pass pass = std::max(best->fused.pass, vb.box.pass);
     if (best->weight > 0.0) {
       best->fused.cx = static_cast<float>(best->cx / best->weight);
       best->fused.cy = static_cast<float>(best->cy / best->weight);
@@ -73,7 +73,7 @@ void fuse(std::vector<ViewBox>& boxes, int view_count, const float* min_size, fl
     best->fused.confidence = static_cast<float>(best->weight / view_count);
     best->fused.drone_score = static_cast<float>(best->drone_score / view_count);
     best->fused.class_id = class_id;
-    best->fused.zoom_refined = refined;
+    best->fused.pass = pass;
   }
   fused.clear();
   for (const Group& g : groups) {

@@ -257,12 +257,12 @@ void DetectionPipeline::detect_view(const cv::Mat& bgr_image, size_t keep) {
       run_and_decode(count);
       for (int i = 0; i < count; ++i) {
         const std::vector<Box>& found = candidates_[i];
-        if (found.empty()) continue;  // nothing re-detected: keep the original box, zoom_refined stays false
+        if (found.empty()) continue;  // nothing re-detected: keep the original box, its pass stays single
         const Box* best = &found[0];
         for (const Box& b : found)
           if (b.confidence > best->confidence) best = &b;
         Box refined = network_to_image(*best, crops_[first + i], net_size_);
-        refined.zoom_refined = true;
+        refined.pass = Pass::kZoomIn;
         detections_[zoomed_[first + i]] = refined;
       }
     }

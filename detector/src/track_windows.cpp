@@ -120,7 +120,7 @@ std::vector<Box> merge_window_boxes(std::vector<Box> first_pass, const std::vect
     }
     if (!best) continue;
     ++hits;
-    best_in_image.zoom_refined = true;
+    best_in_image.pass = Pass::kWindow;
     found.push_back(best_in_image);
     found_for.push_back(&w);
   }

@@ -35,39 +35,74 @@ size_t bin_of(const std::vector<double>& edges, double x) {
 
 }  // namespace
 
-std::vector<std::string> BoxRelation::Table::validate() const {
+std::vector<std::string> BoxRelation::Grid::validate(const std::string& prefix) const {
   std::vector<std::string> p;
   const auto vec = [](const std::vector<double>& v) { return fmt::format("[{}]", fmt::join(v, ", ")); };
-  if (!model_id.empty() && (model_id.rfind("sha256:", 0) != 0 || model_id.size() != 7 + 16))
-    p.push_back(fmt::format("box_relation.model_id = '{}': must be sha256: and 16 hex digits", model_id));
-  if (!(std::isfinite(edge_noise_rel) && edge_noise_rel >= 0))
-    p.push_back(fmt::format("box_relation.edge_noise_rel = {}: must be >= 0", edge_noise_rel));
   if (size_edges.size() < 2 || !all_finite_positive(size_edges) || !strictly_increasing(size_edges))
-    p.push_back(fmt::format("box_relation.size_edges = {}: must be >= 2 increasing numbers > 0", vec(size_edges)));
+    p.push_back(fmt::format("{}size_edges = {}: must be >= 2 increasing numbers > 0", prefix, vec(size_edges)));
   if (aspect_edges.size() < 2 || !all_finite_positive(aspect_edges) || !strictly_increasing(aspect_edges))
-    p.push_back(fmt::format("box_relation.aspect_edges = {}: must be >= 2 increasing numbers > 0", vec(aspect_edges)));
+    p.push_back(fmt::format("{}aspect_edges = {}: must be >= 2 increasing numbers > 0", prefix, vec(aspect_edges)));
   if (!p.empty()) return p;
   const size_t cells = (size_edges.size() - 1) * (aspect_edges.size() - 1);
   const auto table = [&](const char* key, const std::vector<double>& v, bool positive) {
     if (v.size() != cells) {
-      p.push_back(fmt::format("box_relation.{}: {} values, expected {} ((size_edges - 1) x (aspect_edges - 1))", key,
+      p.push_back(fmt::format("{}{}: {} values, expected {} ((size_edges - 1) x (aspect_edges - 1))", prefix, key,
                               v.size(), cells));
     } else if (!std::all_of(v.begin(), v.end(),
                             [&](double x) { return std::isfinite(x) && (positive ? x > 0 : x >= 0); })) {
-      p.push_back(fmt::format("box_relation.{} = {}: every value must be finite and {}", key, vec(v),
-                              positive ? "> 0" : ">= 0"));
+      p.push_back(
+          fmt::format("{}{} = {}: every value must be finite and {}", prefix, key, vec(v), positive ? "> 0" : ">= 0"));
     }
   };
   table("width_ratio", width_ratio, true);
   table("height_ratio", height_ratio, true);
   table("range_sigma_rel", range_sigma_rel, false);
   if (!count.empty() && count.size() != cells)
-    p.push_back(fmt::format("box_relation.count: {} values, expected {} (or none)", count.size(), cells));
+    p.push_back(fmt::format("{}count: {} values, expected {} (or none)", prefix, count.size(), cells));
   return p;
 }
 
-size_t BoxRelation::Table::size_bin(double width_fraction) const { return bin_of(size_edges, width_fraction); }
-size_t BoxRelation::Table::aspect_bin(double aspect) const { return bin_of(aspect_edges, aspect); }
+std::vector<std::string> BoxRelation::Table::validate() const {
+  std::vector<std::string> p;
+  if (!model_id.empty() && (model_id.rfind("sha256:", 0) != 0 || model_id.size() != 7 + 16))
+    p.push_back(fmt::format("box_relation.model_id = '{}': must be sha256: and 16 hex digits", model_id));
+  if (!(std::isfinite(edge_noise_rel) && edge_noise_rel >= 0))
+    p.push_back(fmt::format("box_relation.edge_noise_rel = {}: must be >= 0", edge_noise_rel));
+  for (std::string& q : Grid::validate("box_relation.")) p.push_back(std::move(q));
+  if (!window.empty())
+    for (std::string& q : window.validate("box_relation.window.")) p.push_back(std::move(q));
+  return p;
+}
+
+size_t BoxRelation::Grid::size_bin(double size) const { return bin_of(size_edges, size); }
+size_t BoxRelation::Grid::aspect_bin(double aspect) const { return bin_of(aspect_edges, aspect); }
+
+BoxScale BoxRelation::Grid::at(double size, double aspect) const {
+  BoxScale s;
+  const size_t m = aspect_edges.size() - 1;
+  const size_t a = aspect_bin(aspect);
+  // Linear in log(size) between the size bins' centres (geometric means), held beyond the outer ones.
+  const double x = std::log(size);
+  const size_t n = size_edges.size() - 1;
+  const auto centre = [&](size_t i) { return 0.5 * (std::log(size_edges[i]) + std::log(size_edges[i + 1])); };
+  size_t i0 = 0, i1 = 0;
+  double f = 0;
+  if (x <= centre(0)) {
+    i0 = i1 = 0;
+  } else if (x >= centre(n - 1)) {
+    i0 = i1 = n - 1;
+  } else {
+    i0 = 0;
+    while (i0 + 1 < n && centre(i0 + 1) < x) ++i0;
+    i1 = i0 + 1;
+    f = (x - centre(i0)) / (centre(i1) - centre(i0));
+  }
+  const auto lerp = [&](const std::vector<double>& v) { return (1 - f) * v[i0 * m + a] + f * v[i1 * m + a]; };
+  s.width_ratio = lerp(width_ratio);
+  s.height_ratio = lerp(height_ratio);
+  s.range_sigma_rel = lerp(range_sigma_rel);
+  return s;
+}
 
 BoxRelation BoxRelation::sphere() { return BoxRelation{}; }
 
@@ -128,33 +163,12 @@ std::string BoxRelation::check_model(const std::string& detections_model_id) con
       detections_model_id, name_, model_id_);
 }
 
-BoxScale BoxRelation::at(double box_width_px, double box_height_px, double image_width_px) const {
-  BoxScale s;
-  if (is_sphere() || !(box_width_px > 0 && box_height_px > 0 && image_width_px > 0)) return s;
-  const Table& t = table_;
-  const size_t m = t.aspect_edges.size() - 1;
-  const size_t a = t.aspect_bin(box_height_px / box_width_px);
-  // Linear in log(width fraction) between the size bins' centres (geometric means), held beyond the outer ones.
-  const double x = std::log(box_width_px / image_width_px);
-  const size_t n = t.size_edges.size() - 1;
-  const auto centre = [&](size_t i) { return 0.5 * (std::log(t.size_edges[i]) + std::log(t.size_edges[i + 1])); };
-  size_t i0 = 0, i1 = 0;
-  double f = 0;
-  if (x <= centre(0)) {
-    i0 = i1 = 0;
-  } else if (x >= centre(n - 1)) {
-    i0 = i1 = n - 1;
-  } else {
-    i0 = 0;
-    while (i0 + 1 < n && centre(i0 + 1) < x) ++i0;
-    i1 = i0 + 1;
-    f = (x - centre(i0)) / (centre(i1) - centre(i0));
-  }
-  const auto lerp = [&](const std::vector<double>& v) { return (1 - f) * v[i0 * m + a] + f * v[i1 * m + a]; };
-  s.width_ratio = lerp(t.width_ratio);
-  s.height_ratio = lerp(t.height_ratio);
-  s.range_sigma_rel = lerp(t.range_sigma_rel);
-  s.edge_noise_rel = t.edge_noise_rel;
+BoxScale BoxRelation::at(double box_width_px, double box_height_px, double image_width_px, int8_t pass) const {
+  if (is_sphere() || !(box_width_px > 0 && box_height_px > 0 && image_width_px > 0)) return BoxScale{};
+  const double aspect = box_height_px / box_width_px;
+  BoxScale s = pass == kPassWindow && !table_.window.empty() ? table_.window.at(box_width_px, aspect)
+                                                             : table_.at(box_width_px / image_width_px, aspect);
+  s.edge_noise_rel = table_.edge_noise_rel;
   return s;
 }
 

@@ -14,6 +14,10 @@
 #include <stdexcept>
 
 namespace wingman::localizer {
+
+static_assert(BoxRelation::kPassSingle == wingman::detection_t::PASS_SINGLE &&
+                  BoxRelation::kPassWindow == wingman::detection_t::PASS_WINDOW,
+              "BoxRelation's pass constants are detection_t's");
 std::string NonDroneCounts::summary() const {
   if (total == 0) return "";
   std::string by_class_text;
@@ -282,7 +286,7 @@ LocalizerOutput Localizer::process(int64_t utime, const std::vector<const wingma
         if (!track_every_class) continue;  // decided per box: never a target
       }
       const geometry::PixelBox box{det.cx, det.cy, det.w, det.h};
-      const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d->image_width);
+      const BoxScale scale = ground_truth ? BoxScale{} : cnn_relation_.at(det.w, det.h, d->image_width, det.pass_kind);
       LocalizeResult r = localize_box(box, cameras_[c].camera, options_.sphere, scale);
       if (!r.ok) {
         result.rejections.push_back(
@@ -460,8 +464,9 @@ wingman::track_windows_t Localizer::track_windows(int64_t utime, const Localizer
   const bool ground_truth = source == wingman::detections_t::SOURCE_GROUND_TRUTH;
   for (const TrackOutput& t : tracker_.predicted_tracks(out.utime_predicted)) {
     if (static_cast<int>(out.windows.size()) >= options_.windows.max_windows) break;
-    // The box relation holds for full-resolution re-detections too (measured: docs/detector.md, "Tracker-driven
-    // windows").
+    // The single pass's box (the main grid): it decides whether the detector searches a window (by its size in the
+    // single pass's network pixels). A window's own box of a far drone is up to a fifth wider (the window grid), which
+    // would widen the gate by a pixel or two.
     if (auto w = predict_track_window(t, options_.sphere.radius_m, c.camera, cam,
                                       ground_truth ? sphere_relation() : cnn_relation_))
       out.windows.push_back(*w);

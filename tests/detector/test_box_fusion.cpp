@@ -13,7 +13,7 @@ namespace wingman::detector {
 namespace {
 
 Box box(float cx, float cy, float w, float h, float confidence, bool refined = false) {
-  return Box{cx, cy, w, h, confidence, refined};
+  return Box{cx, cy, w, h, confidence, refined ? Pass::kZoomIn : Pass::kSingle};
 }
 
 TEST(FuseBoxes, ClassOfTheMostConfidentMemberAndMeanDroneScore) {
@@ -55,12 +55,12 @@ TEST(FuseBoxes, HandComputedPairAndASingleViewBox) {
   EXPECT_NEAR(out[0].w, 41.7143f, 1e-3);
   EXPECT_NEAR(out[0].h, 20.0f, 1e-4);
   EXPECT_NEAR(out[0].confidence, 0.7f, 1e-6);
-  EXPECT_TRUE(out[0].zoom_refined);  // one member was refined
+  EXPECT_EQ(out[0].pass, Pass::kZoomIn);  // one member was refined
   // Found by one view of two: its box, half its confidence.
   EXPECT_FLOAT_EQ(out[1].cx, 300.0f);
   EXPECT_FLOAT_EQ(out[1].w, 10.0f);
   EXPECT_NEAR(out[1].confidence, 0.25f, 1e-6);
-  EXPECT_FALSE(out[1].zoom_refined);
+  EXPECT_EQ(out[1].pass, Pass::kSingle);
   // The input is left most confident first.
   EXPECT_FLOAT_EQ(in[0].box.confidence, 0.8f);
   EXPECT_FLOAT_EQ(in[1].box.confidence, 0.6f);
@@ -188,7 +188,7 @@ TEST(MirrorHorizontally, MirrorsTheCentreAndKeepsTheRest) {
   EXPECT_FLOAT_EQ(m.w, 40.0f);
   EXPECT_FLOAT_EQ(m.h, 20.0f);
   EXPECT_FLOAT_EQ(m.confidence, 0.8f);
-  EXPECT_TRUE(m.zoom_refined);
+  EXPECT_EQ(m.pass, Pass::kZoomIn);
   // A box flush with the left border ([0, 40]) mirrors to one flush with the right ([600, 640]).
   EXPECT_FLOAT_EQ(mirror_horizontally(box(20, 5, 40, 10, 0.5f), 640.0f).cx, 620.0f);
 }

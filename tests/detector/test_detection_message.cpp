@@ -17,7 +17,7 @@ TEST(DetectionMessage, CarriesTheClassAndTheDroneScoreOfADistractor) {
   bird.confidence = 0.8f;  // objectness x P(bird)
   bird.class_id = 2;
   bird.drone_score = 0.1f;  // objectness x P(drone)
-  bird.zoom_refined = true;
+  bird.pass = wingman::detector::Pass::kWindow;
   const wingman::detection_t d = to_detection(bird);
   EXPECT_EQ(d.cx, 100.5f);
   EXPECT_EQ(d.cy, 50.25f);
@@ -26,7 +26,7 @@ TEST(DetectionMessage, CarriesTheClassAndTheDroneScoreOfADistractor) {
   EXPECT_EQ(d.confidence, 0.8f);
   EXPECT_EQ(d.class_id, 2);
   EXPECT_EQ(d.drone_score, 0.1f);
-  EXPECT_TRUE(d.zoom_refined);
+  EXPECT_EQ(d.pass_kind, wingman::detection_t::PASS_WINDOW);
 }
 
 TEST(DetectionMessage, ADroneKeepsClassZeroAndItsScore) {
@@ -40,7 +40,7 @@ TEST(DetectionMessage, ADroneKeepsClassZeroAndItsScore) {
   const wingman::detection_t d = to_detection(drone);
   EXPECT_EQ(d.class_id, 0);
   EXPECT_EQ(d.drone_score, 0.9f);
-  EXPECT_FALSE(d.zoom_refined);
+  EXPECT_EQ(d.pass_kind, wingman::detection_t::PASS_SINGLE);
 }
 
 }  // namespace

@@ -310,7 +310,7 @@ TEST(Algorithm2, SubsquareAndResizeMapToFullImagePixels) {
   EXPECT_NEAR(with_square[0].w, 1.08f * kCell * 720 / 416, 1e-2);
   EXPECT_NEAR(with_square[0].h, 1.19f * kCell * 720 / 416, 1e-2);
   EXPECT_NEAR(with_square[0].confidence, 0.8f, 1e-5);
-  EXPECT_FALSE(with_square[0].zoom_refined);
+  EXPECT_EQ(with_square[0].pass, Pass::kSingle);
   o.subsquare = false;
   auto whole = make(o, script).detect(image_1280x720());
   ASSERT_EQ(whole.size(), 1u);
@@ -348,7 +348,7 @@ TEST(Algorithm2, ZoomInKeepsMostConfidentRedetectionInClampedCrop) {
                 &batches);
   auto boxes = p.detect(image_1280x720());
   ASSERT_EQ(boxes.size(), 1u);
-  EXPECT_TRUE(boxes[0].zoom_refined);
+  EXPECT_EQ(boxes[0].pass, Pass::kZoomIn);
   EXPECT_NEAR(boxes[0].confidence, 0.95f, 1e-5);
   EXPECT_NEAR(boxes[0].cx, 864 + 3.5f * kCell, 1e-2);  // crop is full resolution: scale 1
   EXPECT_NEAR(boxes[0].cy, 152 + 2.5f * kCell, 1e-2);
@@ -363,7 +363,7 @@ TEST(Algorithm2, ZoomInFallsBackToOriginalBoxWhenRedetectionFindsNothing) {
   auto p = make(o, {{{{0, 6, 6, 0, 0, 0, 0, 0.6f}}}, {{}}});
   auto boxes = p.detect(image_1280x720());
   ASSERT_EQ(boxes.size(), 1u);
-  EXPECT_FALSE(boxes[0].zoom_refined);
+  EXPECT_EQ(boxes[0].pass, Pass::kSingle);
   EXPECT_NEAR(boxes[0].cx, 640.0f, 1e-2);
   EXPECT_NEAR(boxes[0].confidence, 0.6f, 1e-5);
 }
@@ -382,17 +382,17 @@ TEST(Algorithm2, ZoomInOnlyBoxesThatFitTheCropByZoomMaxFraction) {
   auto unzoomed = make(o, {{first}, {in_crop, in_crop}}, &batches).detect(image_1280x720());
   EXPECT_EQ(batches, (std::vector<int>{1}));
   ASSERT_EQ(unzoomed.size(), 2u);
-  EXPECT_FALSE(unzoomed[0].zoom_refined);
-  EXPECT_FALSE(unzoomed[1].zoom_refined);
+  EXPECT_EQ(unzoomed[0].pass, Pass::kSingle);
+  EXPECT_EQ(unzoomed[1].pass, Pass::kSingle);
 
   o.zoom_max_fraction = 0.5;
   batches.clear();
   auto boxes = make(o, {{first}, {in_crop}}, &batches).detect(image_1280x720());
   EXPECT_EQ(batches, (std::vector<int>{1, 1}));
   ASSERT_EQ(boxes.size(), 2u);
-  EXPECT_TRUE(boxes[0].zoom_refined);
+  EXPECT_EQ(boxes[0].pass, Pass::kZoomIn);
   EXPECT_NEAR(boxes[0].confidence, 0.95f, 1e-5);
-  EXPECT_FALSE(boxes[1].zoom_refined);
+  EXPECT_EQ(boxes[1].pass, Pass::kSingle);
   EXPECT_NEAR(boxes[1].confidence, 0.8f, 1e-5);
   EXPECT_NEAR(boxes[1].cx, 8.5f * kCell * 1280 / 416, 1e-2);
   EXPECT_NEAR(boxes[1].cy, 8.5f * kCell * 720 / 416, 1e-2);
@@ -404,8 +404,8 @@ TEST(Algorithm2, ZoomInOnlyBoxesThatFitTheCropByZoomMaxFraction) {
   boxes = make(o, {{first}, {in_crop, in_crop}}, &batches).detect(image_1280x720());
   EXPECT_EQ(batches, (std::vector<int>{1, 2}));
   ASSERT_EQ(boxes.size(), 2u);
-  EXPECT_TRUE(boxes[0].zoom_refined);
-  EXPECT_TRUE(boxes[1].zoom_refined);
+  EXPECT_EQ(boxes[0].pass, Pass::kZoomIn);
+  EXPECT_EQ(boxes[1].pass, Pass::kZoomIn);
 
   for (const double bad : {0.0, -0.1, 1.5}) {
     o.zoom_max_fraction = bad;
@@ -428,11 +428,11 @@ TEST(Algorithm2, ZoomInSkipsADetectionOverlappingAMoreConfidentOne) {
   auto boxes = make(o, {{first}, {{{0, 6, 6, 0, 0, 0, 0, 0.95f}}}}, &batches).detect(image_1280x720());
   EXPECT_EQ(batches, (std::vector<int>{1, 1}));
   ASSERT_EQ(boxes.size(), 3u);
-  EXPECT_TRUE(boxes[0].zoom_refined);  // the box at cell (1, 1), re-detected at 0.95
+  EXPECT_EQ(boxes[0].pass, Pass::kZoomIn);  // the box at cell (1, 1), re-detected at 0.95
   EXPECT_NEAR(boxes[0].confidence, 0.95f, 1e-5);
-  EXPECT_FALSE(boxes[1].zoom_refined);
+  EXPECT_EQ(boxes[1].pass, Pass::kSingle);
   EXPECT_NEAR(boxes[1].confidence, 0.9f, 1e-5);
-  EXPECT_FALSE(boxes[2].zoom_refined);  // the part: its first-pass box, unchanged
+  EXPECT_EQ(boxes[2].pass, Pass::kSingle);  // the part: its first-pass box, unchanged
   EXPECT_NEAR(boxes[2].confidence, 0.5f, 1e-5);
   EXPECT_NEAR(boxes[2].cx, 7.5f * kCell * 1280 / 416, 1e-2);
 }
@@ -449,12 +449,12 @@ TEST(Algorithm2, ZoomInSkipsImagesNoLargerThanTheNetworkInput) {
   auto same = make(o, script, &batches).detect(cv::Mat(416, 416, CV_8UC3, cv::Scalar(0, 0, 0)));
   EXPECT_EQ(batches, (std::vector<int>{1}));
   ASSERT_EQ(same.size(), 1u);
-  EXPECT_FALSE(same[0].zoom_refined);
+  EXPECT_EQ(same[0].pass, Pass::kSingle);
   batches.clear();
   auto taller = make(o, script, &batches).detect(cv::Mat(600, 416, CV_8UC3, cv::Scalar(0, 0, 0)));
   EXPECT_EQ(batches, (std::vector<int>{1, 1}));
   ASSERT_EQ(taller.size(), 1u);
-  EXPECT_TRUE(taller[0].zoom_refined);
+  EXPECT_EQ(taller[0].pass, Pass::kZoomIn);
 }
 
 TEST(Algorithm2, ZoomInCropsRunAsBatches) {

@@ -7,7 +7,7 @@
 namespace wingman::detector {
 namespace {
 
-Box nms_box(float cx, float cy, float w, float h, float conf) { return Box{cx, cy, w, h, conf, false}; }
+Box nms_box(float cx, float cy, float w, float h, float conf) { return Box{cx, cy, w, h, conf, Pass::kSingle}; }
 
 TEST(Iou, HandCases) {
   EXPECT_FLOAT_EQ(iou(nms_box(5, 5, 10, 10, 1), nms_box(5, 5, 10, 10, 1)), 1.0f);

@@ -113,7 +113,7 @@ TEST(Algorithm2Geometry, ZoomCropIsClampedInsideTheImage) {
 
 TEST(Algorithm2Geometry, NetworkBoxMapsToFullImagePixels) {
   // Centre of the network input in the 720 x 720 subsquare of a 1280 x 720 image is the image centre.
-  const Box in_net{208.0f, 104.0f, 41.6f, 20.8f, 0.5f, false};
+  const Box in_net{208.0f, 104.0f, 41.6f, 20.8f, 0.5f, Pass::kSingle};
   const Box b = network_to_image(in_net, cv::Rect(280, 0, 720, 720), {416, 416});
   EXPECT_NEAR(b.cx, 280.0f + 360.0f, 1e-3);
   EXPECT_NEAR(b.cy, 180.0f, 1e-3);

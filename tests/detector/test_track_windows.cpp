@@ -116,12 +116,12 @@ TEST(MergeWindowBoxes, TheWindowsBoxInItsGateReplacesTheSinglePassBoxOfTheSameDr
   const auto out = merge_window_boxes(first, w, crops, crop_of, crop_boxes, p, o, &stats);
   ASSERT_EQ(out.size(), 2u);
   EXPECT_FLOAT_EQ(out[0].cx, 1000.0f);  // most confident first
-  EXPECT_FALSE(out[0].zoom_refined);
+  EXPECT_EQ(out[0].pass, Pass::kSingle);
   EXPECT_FLOAT_EQ(out[1].cx, 641.0f);
   EXPECT_FLOAT_EQ(out[1].cy, 362.0f);
   EXPECT_FLOAT_EQ(out[1].w, 11.0f);
   EXPECT_FLOAT_EQ(out[1].confidence, 0.5f);
-  EXPECT_TRUE(out[1].zoom_refined);
+  EXPECT_EQ(out[1].pass, Pass::kWindow);
   EXPECT_EQ(stats.windows, 2);
   EXPECT_EQ(stats.crops, 2);
   EXPECT_EQ(stats.found, 1);
@@ -131,7 +131,7 @@ TEST(MergeWindowBoxes, TheWindowsBoxInItsGateReplacesTheSinglePassBoxOfTheSameDr
   const std::vector<std::vector<Box>> found_at = {{box(128, 129, 14, 6, 0.5f)}, {}};  // image (640, 361)
   const auto replaced = merge_window_boxes(coarse, w, crops, crop_of, found_at, p, o);
   ASSERT_EQ(replaced.size(), 1u);
-  EXPECT_TRUE(replaced[0].zoom_refined);
+  EXPECT_EQ(replaced[0].pass, Pass::kWindow);
   EXPECT_FLOAT_EQ(replaced[0].w, 14.0f);
   // With policy most_confident, one box.
   p.policy = "most_confident";
@@ -139,7 +139,8 @@ TEST(MergeWindowBoxes, TheWindowsBoxInItsGateReplacesTheSinglePassBoxOfTheSameDr
   // A window left out by the budget (crop -1) finds nothing.
   const auto none = merge_window_boxes(first, w, crops, {-1, -1}, crop_boxes, DetectorPipelineOptions{}, o);
   EXPECT_EQ(none.size(), 2u);
-  EXPECT_FALSE(none[0].zoom_refined || none[1].zoom_refined);
+  EXPECT_EQ(none[0].pass, Pass::kSingle);
+  EXPECT_EQ(none[1].pass, Pass::kSingle);
   EXPECT_THROW(merge_window_boxes(first, w, crops, {0}, crop_boxes, DetectorPipelineOptions{}, o),
                std::invalid_argument);
 }

@@ -4,8 +4,10 @@
 # checked with `wingman model box-relation --check` on 160 rendered targets of another seed (43) than its fit (41) and
 # check (42): the four shared airframes and procedural ones at 2-30 m, any view. With each airframe's true bounding
 # radius the range error's median must stay within +-0.06 and its 1.4826 MAD within 0.20 (measured on seed 42:
-# median -0.005, MAD 0.152; docs/localization.md, "Box relation"), and the detector must find 80 targets or more. A
-# change to the detector, the localizer's geometry or the relation that moves the ranges fails it.
+# median -0.005, MAD 0.152; docs/localization.md, "Box relation"), and the detector must find 80 targets or more. Then
+# its window grid the same way (`--pass window`) on 200 renders at 10-55 m of seed 53 (fit 51, check 52): median within
+# +-0.08, MAD within 0.25, 60 targets or more (measured on seed 53: 90 targets, median -0.016, MAD 0.181). A change to
+# the detector, its windows, the localizer's geometry or the relation that moves the ranges fails it.
 # Skips (exit 77) with a message when ../shared/meshes is absent.
 # Usage: box_relation_guard_test.sh SOURCE_DIR WINGMAN [WORK_DIR]
 set -euo pipefail
@@ -40,3 +42,13 @@ while IFS= read -r image; do [ -f "$work/set/$image" ] || missing=$((missing + 1
   tail -n +2 "$work/samples.csv" | cut -d, -f14 | tr -d '"')
 [ "$missing" -eq 0 ] || { echo "box_relation_guard: FAIL: $missing rows name an image not in the set" >&2; exit 1; }
 echo "box_relation_guard: --samples: $rows rows, frame radii within (0.1 m, bounding radius), range errors, images"
+# The window grid: the tracker-driven windows' boxes of far targets.
+rm -rf "$work/far"
+"$wingman" dataset synth --config "$src/config/datasets/box_relation_far.yaml" --meshes "$meshes" --count 200 --seed 53 \
+  --out "$work/far" > "$work/synth_far.log" 2>&1 ||
+  { cat "$work/synth_far.log" >&2; echo "box_relation_guard: FAIL: render (far)" >&2; exit 1; }
+"$wingman" model box-relation --data "$work/far" --pass window --check builtin:wingman-small --max-median-error 0.08 \
+  --max-mad 0.25 --min-targets 60 | tee "$work/report_far.txt"
+grep -q "not searched by a window" "$work/report_far.txt" ||
+  { echo "box_relation_guard: FAIL: --pass window did not say which targets the windows leave to the single pass" >&2; exit 1; }
+echo "box_relation_guard: window grid within bounds"

@@ -32,6 +32,16 @@ constexpr const char* kTwoByTwo = R"(box_relation:
   range_sigma_rel: [0.1, 0.2, 0.05, 0.06]
 )";
 
+/// kTwoByTwo with a window grid: sizes in image pixels, two size bins (centres 8 and 32 px) and one aspect bin.
+const std::string kWithWindow = std::string(kTwoByTwo) + R"(  window:
+    size_edges: [4, 16, 64]
+    aspect_edges: [0.05, 20]
+    width_ratio: [1.0, 0.75]
+    height_ratio: [0.9, 0.6]
+    range_sigma_rel: [0.3, 0.1]
+    count: [12, 40]
+)";
+
 TEST(BoxRelation, TheSphereRelationIsRatioOneWithoutSpread) {
   const BoxScale s = BoxRelation::load("sphere").at(50, 50, 1280);
   EXPECT_EQ(s.width_ratio, 1.0);
@@ -59,12 +69,44 @@ TEST(BoxRelation, BinsByAspectAndInterpolatesInLogWidthBetweenBinCentresHeldBeyo
   EXPECT_EQ(r.model_id(), "sha256:0123456789abcdef");
 }
 
+TEST(BoxRelation, AWindowsBoxTakesTheWindowGridBySizeInImagePixelsAndOtherBoxesTheMainGrid) {
+  const BoxRelation r = BoxRelation::parse(kWithWindow, "window.yaml");
+  ASSERT_TRUE(r.has_window_grid());
+  const double W = 1000;
+  // 8 px: the window grid's first centre, whatever the image width; the same box of the single pass: the main grid's
+  // first size bin (0.008 of the width, held below its centre), aspect 1: second aspect bin.
+  EXPECT_NEAR(r.at(8, 8, W, BoxRelation::kPassWindow).width_ratio, 1.0, 1e-12);
+  EXPECT_NEAR(r.at(8, 8, 4000, BoxRelation::kPassWindow).width_ratio, 1.0, 1e-12);
+  EXPECT_NEAR(r.at(8, 8, W, BoxRelation::kPassWindow).height_ratio, 0.9, 1e-12);
+  EXPECT_NEAR(r.at(8, 8, W, BoxRelation::kPassWindow).range_sigma_rel, 0.3, 1e-12);
+  EXPECT_NEAR(r.at(8, 8, W, BoxRelation::kPassSingle).width_ratio, 0.7, 1e-12);
+  EXPECT_NEAR(r.at(8, 8, W).width_ratio, 0.7, 1e-12);     // the default: a single-pass box
+  EXPECT_NEAR(r.at(8, 8, W, 1).width_ratio, 0.7, 1e-12);  // a zoom-in box: the main grid
+  // Halfway in log between the window centres (16 px): the mean; held beyond the last centre.
+  EXPECT_NEAR(r.at(16, 16, W, BoxRelation::kPassWindow).width_ratio, 0.875, 1e-12);
+  EXPECT_NEAR(r.at(500, 100, W, BoxRelation::kPassWindow).width_ratio, 0.75, 1e-12);
+  // The edge wander is the relation's for every pass.
+  EXPECT_EQ(r.at(8, 8, W, BoxRelation::kPassWindow).edge_noise_rel, 0.1);
+  // Without a window grid, a window's box takes the main grid.
+  const BoxRelation main_only = BoxRelation::parse(kTwoByTwo, "two.yaml");
+  EXPECT_FALSE(main_only.has_window_grid());
+  EXPECT_NEAR(main_only.at(20, 20, W, BoxRelation::kPassWindow).width_ratio, 0.7, 1e-12);
+  // The sphere relation: ratio 1 for every pass.
+  EXPECT_EQ(BoxRelation::sphere().at(8, 8, W, BoxRelation::kPassWindow).width_ratio, 1.0);
+}
+
 TEST(BoxRelation, WritesWhatItReadsBack) {
   const BoxRelation r = BoxRelation::parse(kTwoByTwo, "two.yaml");
   const BoxRelation back = BoxRelation::parse(r.to_yaml("a header"), "back.yaml");
   EXPECT_EQ(back.table().width_ratio, r.table().width_ratio);
   EXPECT_EQ(back.table().size_edges, r.table().size_edges);
   EXPECT_EQ(back.model_id(), r.model_id());
+  EXPECT_FALSE(back.has_window_grid());
+  const BoxRelation w = BoxRelation::parse(kWithWindow, "window.yaml");
+  const BoxRelation w_back = BoxRelation::parse(w.to_yaml("a header"), "back.yaml");
+  EXPECT_EQ(w_back.table().window.size_edges, w.table().window.size_edges);
+  EXPECT_EQ(w_back.table().window.width_ratio, w.table().window.width_ratio);
+  EXPECT_EQ(w_back.table().window.count, w.table().window.count);
 }
 
 std::string error_of(const std::string& text) {
@@ -93,6 +135,22 @@ TEST(BoxRelation, ABadFileIsOneErrorNamingTheFileAndKey) {
   EXPECT_NE(error_of(with("[0.01, 0.04, 0.16]", "[0.04, 0.01, 0.16]")).find("box_relation.size_edges"),
             std::string::npos);
   EXPECT_NE(error_of(with("sha256:0123456789abcdef", "0123")).find("box_relation.model_id"), std::string::npos);
+  // The window grid: all or nothing, checked like the main one.
+  t = kWithWindow;
+  EXPECT_EQ(error_of(t), "");
+  EXPECT_NE(error_of(with("    width_ratio: [1.0, 0.75]", "    width_ratio: [1.0]"))
+                .find("box_relation.window.width_ratio: 1 values, expected 2"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("    size_edges: [4, 16, 64]", "    size_edges: [16, 4, 64]"))
+                .find("box_relation.window.size_edges"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("    size_edges: [4, 16, 64]\n", "")).find("box_relation.window.size_edges"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("    range_sigma_rel: [0.3, 0.1]", "    range_sigma_rel: [0.3, -0.1]"))
+                .find("box_relation.window.range_sigma_rel"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("    count: [12, 40]", "    cuont: [12, 40]")).find("box_relation.window.cuont"),
+            std::string::npos);
   EXPECT_NE(error_of(with("  model: \"test\"", "  modle: \"test\"")).find("box_relation.modle"), std::string::npos);
   EXPECT_NE(error_of("target:\n  radius_m: 0.3\n").find("bad.yaml"), std::string::npos);
   EXPECT_NE(error_of("[1, 2").find("bad.yaml"), std::string::npos);
@@ -144,6 +202,8 @@ TEST(BoxRelation, TheShippedRelationIsMeasuredForTheShippedWeights) {
       << "models/wingman-small.boxes.yaml was measured for other weights: run `wingman model box-relation` again";
   // Outline boxes are smaller than the bounding sphere's.
   for (double w : r.table().width_ratio) EXPECT_LT(w, 1.0);
+  // The tracker-driven windows' boxes have their own grid (docs/localization.md, "Box relation").
+  EXPECT_TRUE(r.has_window_grid());
 }
 
 TEST(BoxRelation, RatiosScaleTheExactRangeAndTheirSpreadEntersTheCovariance) {

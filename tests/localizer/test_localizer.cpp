@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <map>
 #include <string>
 #include <utility>
@@ -159,6 +161,39 @@ TEST(Localizer, CnnBoxesGoThroughTheBoxRelationGroundTruthBoxesAreTheSpheres) {
   const double cnn = camera_range(wingman::detections_t::SOURCE_CNN, "");
   EXPECT_LT(cnn, 0.95 * p.norm());
   EXPECT_GT(cnn, 0.5 * p.norm());
+}
+
+TEST(Localizer, AWindowsBoxGoesThroughTheWindowGridOtherBoxesThroughTheMainGrid) {
+  // A relation whose boxes are 0.7 of the sphere's in the main grid and 0.9 in the window grid: the same box stands
+  // for a sphere box 1 / 0.7 as large from the single pass, 1 / 0.9 from a window, so its range is 0.9 / 0.7 as far.
+  const std::string path = ::testing::TempDir() + "window_grid.boxes.yaml";
+  {
+    std::ofstream f(path);
+    f << "box_relation:\n  size_edges: [0.001, 1.0]\n  aspect_edges: [0.01, 100]\n  width_ratio: [0.7]\n"
+         "  height_ratio: [0.7]\n  range_sigma_rel: [0.1]\n  window:\n    size_edges: [1, 2000]\n"
+         "    aspect_edges: [0.01, 100]\n    width_ratio: [0.9]\n    height_ratio: [0.9]\n    range_sigma_rel: [0.2]\n";
+  }
+  const Eigen::Vector3d p(10.0, 1.0, 0.5);
+  const auto range_of = [&](int8_t pass_kind) {
+    LocalizerOptions o;
+    o.sphere.box_relation = path;
+    o.tracker.birth_hits = 1;
+    Localizer loc(o, camera());
+    loc.on_own_pose(own_pose(kT0));
+    wingman::detections_t d = detections(kT0, 0, {kScene.sphere_box(p)});
+    d.source = wingman::detections_t::SOURCE_CNN;
+    d.detections[0].pass_kind = pass_kind;
+    const LocalizerOutput out = loc.on_detections(d);
+    EXPECT_TRUE(out.targets && out.targets->num_targets == 1);
+    return out.targets ? out.targets->targets[0].range : 0.0;
+  };
+  const double single = range_of(wingman::detection_t::PASS_SINGLE);
+  const double zoom_in = range_of(wingman::detection_t::PASS_ZOOM_IN);
+  const double window = range_of(wingman::detection_t::PASS_WINDOW);
+  EXPECT_NEAR(single, 0.7 * p.norm(), 0.01);
+  EXPECT_NEAR(zoom_in, single, 1e-9);  // a zoom-in box: the main grid
+  EXPECT_NEAR(window / single, 0.9 / 0.7, 0.002);
+  std::remove(path.c_str());
 }
 
 TEST(Localizer, DetectionsOfAModelTheBoxRelationWasNotMeasuredForAreDroppedNamingBoth) {

@@ -136,7 +136,7 @@ std::vector<Sample> make_samples(int64_t utime, int64_t seq) {
   d.h = kBoxH;
   d.confidence = 0.87f;
   d.class_id = 0;
-  d.zoom_refined = false;
+  d.pass_kind = wingman::detection_t::PASS_SINGLE;
   d.drone_score = 0.87f;  // a drone: the same as confidence
   detections.detections.push_back(d);
   detections.num_detections = static_cast<int32_t>(detections.detections.size());

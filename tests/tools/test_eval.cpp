@@ -513,7 +513,7 @@ detection_t box(float cx, float cy, float w, bool zoom) {
   d.cy = cy;
   d.w = d.h = w;
   d.confidence = 0.9f;
-  d.zoom_refined = zoom;
+  d.pass_kind = zoom ? wingman::detection_t::PASS_ZOOM_IN : wingman::detection_t::PASS_SINGLE;
   return d;
 }
 

@@ -39,7 +39,8 @@ struct Sample {
   double elevation_deg = 0;   ///< the camera seen from the target: above (+) or below (-) its horizontal plane
   double det_w = 0, det_h = 0, image_w = 0;
   double sphere_w = 0, sphere_h = 0, sphere_cx = 0, sphere_cy = 0;
-  double width_ratio = 0, height_ratio = 0;  // detected / sphere box
+  double width_ratio = 0, height_ratio = 0;           // detected / sphere box
+  int8_t pass = localizer::BoxRelation::kPassSingle;  ///< detection_t's PASS_ constant of the box
   geometry::PixelBox det;
   std::string image;  ///< the render's image, relative to the set's folder
   /// range / true range - 1 under the relation fitted or checked (exact localizer); NaN: no range (behind the camera)
@@ -89,37 +90,41 @@ std::optional<double> range_error(const Sample& s, const localizer::BoxRelation&
   o.min_range_m = s.radius_m * 1.01;
   o.max_range_m = 1e4;
   const localizer::LocalizeResult r =
-      localizer::localize_box(s.det, *s.camera, o, relation.at(s.det_w, s.det_h, s.image_w));
+      localizer::localize_box(s.det, *s.camera, o, relation.at(s.det_w, s.det_h, s.image_w, s.pass));
   if (!r.ok || !r.measurement.range_valid) return std::nullopt;
   return r.measurement.range / s.range_m - 1.0;
 }
 
 std::string range_bin(double range_m) {
-  static const double edges[] = {2, 5, 10, 15, 20, 30};
+  static const double edges[] = {2, 5, 10, 15, 20, 30, 40};
   for (size_t i = 0; i + 1 < std::size(edges); ++i)
     if (range_m < edges[i + 1]) return fmt::format("{:>2g}-{:g} m", edges[i], edges[i + 1]);
-  return "30+ m";
+  return "40+ m";
 }
 
-/// The fitted table: per bin the median ratios; sparse bins take the nearest size bin of the same aspect with data,
-/// else the pooled median of that size, else of everything.
-localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std::vector<Sample>& samples) {
-  localizer::BoxRelation::Table t;
-  t.model = rq.model_name;
-  t.measured_with = rq.command_line;
-  t.edge_noise_rel = rq.edge_noise_rel;
-  t.size_edges = rq.size_edges;
-  t.aspect_edges = rq.aspect_edges;
+/// The size a grid bins a sample by: the main grid its width / image width, the window grid its width in pixels.
+double grid_size(const Sample& s) {
+  return s.pass == localizer::BoxRelation::kPassWindow ? s.det_w : s.det_w / s.image_w;
+}
+
+/// A fitted grid: per bin the median ratios; sparse bins take the nearest size bin of the same aspect with data, else
+/// the pooled median of that size, else of everything. range_sigma_rel is left 0 (set from the residuals later).
+localizer::BoxRelation::Grid fit_grid(const std::vector<double>& size_edges, const std::vector<double>& aspect_edges,
+                                      int min_bin_count, const std::vector<Sample>& samples) {
+  localizer::BoxRelation::Grid t;
+  t.size_edges = size_edges;
+  t.aspect_edges = aspect_edges;
   const size_t n = t.size_edges.size() - 1, m = t.aspect_edges.size() - 1;
   std::vector<std::vector<double>> kw(n * m), kh(n * m), kw_size(n), kh_size(n);
   std::vector<double> kw_all, kh_all;
   for (const Sample& s : samples) {
-    const size_t i = t.size_bin(s.det_w / s.image_w), c = t.cell(s.det_w / s.image_w, s.det_h / s.det_w);
+    const double size = grid_size(s);
+    const size_t i = t.size_bin(size), c = t.cell(size, s.det_h / s.det_w);
     kw[c].push_back(s.width_ratio), kh[c].push_back(s.height_ratio);
     kw_size[i].push_back(s.width_ratio), kh_size[i].push_back(s.height_ratio);
     kw_all.push_back(s.width_ratio), kh_all.push_back(s.height_ratio);
   }
-  const auto enough = [&](size_t c) { return static_cast<int>(kw[c].size()) >= rq.min_bin_count; };
+  const auto enough = [&](size_t c) { return static_cast<int>(kw[c].size()) >= min_bin_count; };
   t.width_ratio.assign(n * m, 0), t.height_ratio.assign(n * m, 0), t.count.assign(n * m, 0);
   t.range_sigma_rel.assign(n * m, 0);
   for (size_t i = 0; i < n; ++i) {
@@ -139,7 +144,7 @@ localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std:
       }
       if (src < n * m) {
         t.width_ratio[c] = median(kw[src]), t.height_ratio[c] = median(kh[src]);
-      } else if (static_cast<int>(kw_size[i].size()) >= rq.min_bin_count) {
+      } else if (static_cast<int>(kw_size[i].size()) >= min_bin_count) {
         t.width_ratio[c] = median(kw_size[i]), t.height_ratio[c] = median(kh_size[i]);
       } else {
         t.width_ratio[c] = median(kw_all), t.height_ratio[c] = median(kh_all);
@@ -154,8 +159,10 @@ localizer::BoxRelation::Table fit_table(const BoxRelationRequest& rq, const std:
 std::string BoxRelationSummary::markdown() const {
   std::string s = fmt::format(
       "{} images: {} targets found by the detector (IoU with the outline box >= the threshold), {} not found, {} "
-      "skipped (cut by the image border)\n\n",
-      images, matched, unmatched, skipped_truncated);
+      "skipped (cut by the image border){}\n\n",
+      images, matched, unmatched, skipped_truncated,
+      not_searched > 0 ? fmt::format(", {} not searched by a window (the single pass sees them well)", not_searched)
+                       : "");
   s += fmt::format("Range error (range / true range - 1), the airframe's true bounding radius, exact localizer:\n\n");
   s += "| boxes | n | sphere (ratio 1): median | MAD | " + relation_name + ": median | MAD | |error| p90 |\n";
   s += "|---|---|---|---|---|---|---|\n";
@@ -179,6 +186,9 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   if (rq.data.empty()) throw std::invalid_argument("--data: a `wingman dataset synth` folder is required");
   if (rq.check.empty() && rq.out.empty())
     throw std::invalid_argument("--out FILE (fit) or --check RELATION is required");
+  if (rq.pass != "single" && rq.pass != "window")
+    throw std::invalid_argument(fmt::format("--pass {}: expected single or window", rq.pass));
+  const bool window_pass = rq.pass == "window";
   if (rq.min_iou <= 0 || rq.min_iou > 1)
     throw std::invalid_argument(fmt::format("--min-iou {}: expected (0, 1]", rq.min_iou));
   const fs::path meta_dir = fs::path(rq.data) / "meta" / rq.split;
@@ -201,15 +211,16 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   };
   detector::SizedDetector pipeline(dopt.detection, detector::load_model(dopt.cfg, dopt.weights),
                                    *detector::InputSize::parse(dopt.input_size), make_backend);
-  // With windows.enabled: each target is also searched as the tracker-driven windows search a tracked drone (a window
-  // on its outline box, 2 px of doubt), so that the relation covers the full-resolution boxes they give.
+  // --pass window: each target searched as the tracker-driven windows search a tracked drone (a window on its
+  // outline box, 2 px of doubt), whether or not the configuration enables them; only the window's boxes count.
   std::unique_ptr<detector::WindowDetector> windows;
-  if (dopt.windows.enabled)
+  if (window_pass)
     windows = std::make_unique<detector::WindowDetector>(dopt.windows, dopt.detection,
                                                          detector::load_model(dopt.cfg, dopt.weights), make_backend);
-  auto detect = [&](const cv::Mat& bgr, const geometry::PixelBox& outline) {
-    std::vector<detector::Box> boxes = pipeline.detect(bgr);
-    if (!windows) return boxes;
+  // The boxes to match, or nullopt when the windows would not search this target.
+  auto detect = [&](const cv::Mat& bgr,
+                    const geometry::PixelBox& outline) -> std::optional<std::vector<detector::Box>> {
+    if (!windows) return pipeline.detect(bgr);
     wingman::track_windows_t m{};
     m.camera_id = 0;
     m.image_width = bgr.cols;
@@ -223,7 +234,8 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     m.num_windows = 1;
     const cv::Size size(bgr.cols, bgr.rows);
     const auto search = detector::windows_to_search(m, 0, size, 0, pipeline.net_px_per_image_px(size), dopt.windows);
-    return search.empty() ? boxes : windows->detect(bgr, std::move(boxes), search);
+    if (search.empty()) return std::nullopt;
+    return windows->detect(bgr, {}, search);
   };
 
   BoxRelationSummary summary;
@@ -269,9 +281,16 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
       detector::Box truth;
       truth.cx = static_cast<float>(outline.cx), truth.cy = static_cast<float>(outline.cy);
       truth.w = static_cast<float>(outline.w), truth.h = static_cast<float>(outline.h);
-      for (const detector::Box& b : detect(bgr, outline)) {
+      const auto boxes = detect(bgr, outline);
+      if (!boxes) {
+        ++summary.not_searched;
+        continue;
+      }
+      detector::Pass pass = detector::Pass::kSingle;
+      for (const detector::Box& b : *boxes) {
         if (b.class_id != 0) continue;
-        if (const double o = detector::iou(b, truth); o > best) best = o, det = {b.cx, b.cy, b.w, b.h};
+        if (window_pass && b.pass != detector::Pass::kWindow) continue;
+        if (const double o = detector::iou(b, truth); o > best) best = o, det = {b.cx, b.cy, b.w, b.h}, pass = b.pass;
       }
       if (best < rq.min_iou) {
         ++summary.unmatched;
@@ -294,6 +313,9 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
         s.elevation_deg = std::atan2(dz, std::hypot(dx, dy)) * 180.0 / M_PI;
       }
       s.det = det, s.det_w = det.w, s.det_h = det.h, s.image_w = W;
+      // A zoom-in box is the main grid's like a single-pass one.
+      s.pass =
+          pass == detector::Pass::kWindow ? localizer::BoxRelation::kPassWindow : localizer::BoxRelation::kPassSingle;
       s.sphere_w = sphere.w, s.sphere_h = sphere.h, s.sphere_cx = sphere.cx, s.sphere_cy = sphere.cy;
       s.width_ratio = det.w / sphere.w, s.height_ratio = det.h / sphere.h;
       s.image = meta.at("image").get<std::string>();
@@ -312,8 +334,24 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   if (!rq.check.empty()) {
     relation = localizer::BoxRelation::load(rq.check);
     if (const std::string bad = relation.check_model(model_id); !bad.empty()) throw std::runtime_error(bad);
+  } else if (window_pass) {
+    // The base relation with its window grid fitted here.
+    const localizer::BoxRelation base = localizer::BoxRelation::load(rq.base);
+    if (base.is_sphere()) throw std::invalid_argument("--base sphere: the window grid needs a model's relation");
+    if (const std::string bad = base.check_model(model_id); !bad.empty())
+      throw std::runtime_error("--base " + rq.base + ": " + bad);
+    localizer::BoxRelation::Table table = base.table();
+    table.window = fit_grid(rq.window_size_edges, rq.aspect_edges, rq.min_bin_count, samples);
+    table.model_id = model_id;
+    table.measured_with = base.table().measured_with + "; " + rq.command_line;
+    relation = localizer::BoxRelation::from_table(table, rq.out);
   } else {
-    localizer::BoxRelation::Table table = fit_table(rq, samples);
+    localizer::BoxRelation::Table table;
+    static_cast<localizer::BoxRelation::Grid&>(table) =
+        fit_grid(rq.size_edges, rq.aspect_edges, rq.min_bin_count, samples);
+    table.model = rq.model_name;
+    table.measured_with = rq.command_line;
+    table.edge_noise_rel = rq.edge_noise_rel;
     table.model_id = model_id;
     relation = localizer::BoxRelation::from_table(table, rq.out);
   }
@@ -323,7 +361,10 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   const localizer::BoxRelation sphere = localizer::BoxRelation::sphere();
   std::vector<double> e_sphere_all, e_rel_all;
   std::map<std::string, std::vector<double>> e_sphere_af, e_rel_af, e_rel_range;
-  const auto& tb = relation.table();
+  // The grid the fitted or checked boxes fall in (the window grid for window boxes when the relation has one).
+  const bool in_window_grid = window_pass && relation.has_window_grid();
+  const localizer::BoxRelation::Grid& tb =
+      in_window_grid ? relation.table().window : static_cast<const localizer::BoxRelation::Grid&>(relation.table());
   const size_t m = tb.aspect_edges.empty() ? 1 : tb.aspect_edges.size() - 1;
   std::vector<std::vector<double>> residual_by_bin(relation.is_sphere() ? 0 : (tb.size_edges.size() - 1) * m);
   for (Sample& s : samples) {
@@ -333,7 +374,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     s.range_error = *er;
     e_sphere_all.push_back(*es), e_sphere_af[s.airframe].push_back(*es);
     e_rel_all.push_back(*er), e_rel_af[s.airframe].push_back(*er), e_rel_range[range_bin(s.range_m)].push_back(*er);
-    if (!residual_by_bin.empty()) residual_by_bin[tb.cell(s.det_w / s.image_w, s.det_h / s.det_w)].push_back(*er);
+    if (!residual_by_bin.empty()) residual_by_bin[tb.cell(grid_size(s), s.det_h / s.det_w)].push_back(*er);
   }
   summary.sphere_all = stats_of(e_sphere_all), summary.relation_all = stats_of(e_rel_all);
   for (const auto& [k, v] : e_sphere_af) summary.sphere_by_airframe[k] = stats_of(v);
@@ -358,6 +399,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
 
   if (rq.check.empty()) {
     localizer::BoxRelation::Table table = relation.table();
+    localizer::BoxRelation::Grid& fitted = window_pass ? table.window : table;
     // The spread of the range left in each bin: its residuals' 1.4826 MAD about zero (a bin's median stays in the
     // spread); sparse bins take the spread of all boxes.
     std::vector<double> abs_all;
@@ -366,17 +408,32 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     for (size_t c = 0; c < residual_by_bin.size(); ++c) {
       std::vector<double> a;
       for (double e : residual_by_bin[c]) a.push_back(std::abs(e));
-      table.range_sigma_rel[c] = static_cast<int>(a.size()) >= rq.min_bin_count ? 1.4826 * median(a) : all_sigma;
+      fitted.range_sigma_rel[c] = static_cast<int>(a.size()) >= rq.min_bin_count ? 1.4826 * median(a) : all_sigma;
     }
     relation = localizer::BoxRelation::from_table(table, rq.out);
-    const std::string header = fmt::format(
-        "How {} ({}) draws boxes relative to the target's bounding sphere, measured by `wingman model box-relation`\n"
-        "on {} targets found in {} rendered images (docs/localization.md, \"Box relation\"). The localizer reads it "
-        "as\n"
-        "target.box_relation. Range error on these images with the airframe's true radius: ratio 1 median {:+.3f},\n"
-        "this relation {:+.3f} (MAD {:.3f}).",
-        rq.model_name, model_id, summary.matched, summary.images, summary.sphere_all.median,
-        summary.relation_all.median, summary.relation_all.mad);
+    const std::string header =
+        window_pass
+            ? fmt::format(
+                  "How {} ({}) draws boxes relative to the target's bounding sphere (docs/localization.md, \"Box "
+                  "relation\"). The\n"
+                  "main grid is {}'s (measured_with: its first command). The window grid, measured by `wingman model "
+                  "box-relation\n"
+                  "--pass window` on {} targets found by a tracker-driven window in {} rendered images: range error of "
+                  "the window\n"
+                  "boxes with the airframe's true radius: ratio 1 median {:+.3f}, this relation {:+.3f} (MAD {:.3f}).",
+                  rq.model_name, model_id, rq.base, summary.matched, summary.images, summary.sphere_all.median,
+                  summary.relation_all.median, summary.relation_all.mad)
+            : fmt::format(
+                  "How {} ({}) draws boxes relative to the target's bounding sphere, measured by `wingman model "
+                  "box-relation`\n"
+                  "on {} targets found in {} rendered images (docs/localization.md, \"Box relation\"). The localizer "
+                  "reads it "
+                  "as\n"
+                  "target.box_relation. Range error on these images with the airframe's true radius: ratio 1 median "
+                  "{:+.3f},\n"
+                  "this relation {:+.3f} (MAD {:.3f}).",
+                  rq.model_name, model_id, summary.matched, summary.images, summary.sphere_all.median,
+                  summary.relation_all.median, summary.relation_all.mad);
     if (const fs::path parent = fs::path(rq.out).parent_path(); !parent.empty()) fs::create_directories(parent);
     std::ofstream f(rq.out);
     f << relation.to_yaml(header);

@@ -373,7 +373,8 @@ namespace {
 void frame_boxes(const EvalLog& log, EvalResult* r) {
   for (const auto& d : log.detections) {
     auto& frame = r->frames[d.utime];
-    for (const auto& b : d.boxes) frame.detections.push_back({b.cx, b.cy, b.w, b.h, d.camera_id, b.zoom_refined != 0});
+    for (const auto& b : d.boxes)
+      frame.detections.push_back({b.cx, b.cy, b.w, b.h, d.camera_id, b.pass_kind != wingman::detection_t::PASS_SINGLE});
     if (d.image_width > 0) frame.image_width = d.image_width;
     r->detections_total += static_cast<int64_t>(d.boxes.size());
     const auto boxes = log.truth_boxes_at.find(d.utime);
@@ -395,13 +396,13 @@ void frame_boxes(const EvalLog& log, EvalResult* r) {
   }
 }
 
-/// Among `d`'s boxes of one kind (zoom-in or single pass) centred inside `tb`, the one with the nearest centre;
-/// nullptr when none.
+/// Among `d`'s boxes of one kind (re-detected at a finer scale: zoom-in or window; or single pass) centred inside `tb`,
+/// the one with the nearest centre; nullptr when none.
 const wingman::detection_t* nearest_box(const EvalDetections& d, const wingman::truth_box_t& tb, bool zoom) {
   const wingman::detection_t* nearest = nullptr;
   double nearest_d = kInf;
   for (const auto& b : d.boxes) {
-    if ((b.zoom_refined != 0) != zoom) continue;
+    if ((b.pass_kind != wingman::detection_t::PASS_SINGLE) != zoom) continue;
     if (!centred_in(b, tb)) continue;
     const double dist = std::hypot(b.cx - tb.cx, b.cy - tb.cy);
     if (dist < nearest_d) nearest_d = dist, nearest = &b;

@@ -68,6 +68,15 @@ ModelVerbs::ModelVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   s.relation->add_option("--detector-config", rq.detector_config,
                          "The detector's process configuration (empty: its built-in defaults, as installed)");
   s.relation->add_option("--out", rq.out, "Fit: the relation file to write (beside the model's weights)");
+  s.relation
+      ->add_option("--pass", rq.pass,
+                   "single: the single pass's boxes (the relation's main grid); window: each target searched by a "
+                   "tracker-driven window as a tracked drone would be (windows.* of the detector configuration, "
+                   "enabled or not), the window's boxes (the relation's window grid)")
+      ->check(CLI::IsMember({"single", "window"}));
+  s.relation->add_option(
+      "--base", rq.base,
+      "--pass window, fitting: the relation whose main grid is kept (builtin:wingman-small or a file)");
   s.relation->add_option("--check", rq.check,
                          "Evaluate this relation instead of fitting: sphere, builtin:wingman-small or a file");
   s.relation->add_option("--model-name", rq.model_name, "The model's name written into the file");
@@ -89,8 +98,9 @@ int ModelVerbs::run_if_chosen(std::ostream& out, std::ostream& err) {
   State& s = *s_;
   if (*s.relation) {
     return run_verb("wingman model box-relation", err, [&] {
-      s.rq.command_line = fmt::format("wingman model box-relation --data {} --split {}{}", s.rq.data, s.rq.split,
-                                      s.rq.detector_config.empty() ? "" : " --detector-config " + s.rq.detector_config);
+      s.rq.command_line = fmt::format("wingman model box-relation --data {} --split {}{}{}", s.rq.data, s.rq.split,
+                                      s.rq.detector_config.empty() ? "" : " --detector-config " + s.rq.detector_config,
+                                      s.rq.pass == "single" ? "" : " --pass " + s.rq.pass + " --base " + s.rq.base);
       const BoxRelationSummary summary = run_box_relation(s.rq, err);
       out << summary.markdown();
       if (s.rq.check.empty()) out << "wrote " << s.rq.out << "\n";

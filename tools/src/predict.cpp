@@ -139,7 +139,7 @@ int run_predict(const PredictOptions& options, std::ostream& out, std::ostream& 
       for (const detector::Box& b : boxes) {
         const cv::Point p0(cvRound(b.cx - b.w / 2), cvRound(b.cy - b.h / 2));
         const cv::Point p1(cvRound(b.cx + b.w / 2), cvRound(b.cy + b.h / 2));
-        const cv::Scalar colour = b.zoom_refined ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255);
+        const cv::Scalar colour = b.pass != detector::Pass::kSingle ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255);
         cv::rectangle(drawn, p0, p1, colour, 2);
         cv::putText(drawn, fmt::format("{} {:.2f}", common::detection_class_name(b.class_id), b.confidence),
                     p0 + cv::Point(0, -4), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1);

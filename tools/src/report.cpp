@@ -288,7 +288,7 @@ std::string box_width_chart(const EvalResult& r) {
     s += fmt::format(R"(<circle class="data" cx="{:.1f}" cy="{:.1f}" r="2" fill="#7f7f7f" fill-opacity="0.6"/>)",
                      f.sx(b.range_m), f.sy(100.0 * b.w_truth_frac));
     s += fmt::format(R"(<circle class="data" cx="{:.1f}" cy="{:.1f}" r="2.2" fill="{}" fill-opacity="0.7"/>)",
-                     f.sx(b.range_m), f.sy(100.0 * b.w_det_frac), b.zoom_refined ? "#ff7f0e" : "#1f77b4");
+                     f.sx(b.range_m), f.sy(100.0 * b.w_det_frac), b.redetected ? "#ff7f0e" : "#1f77b4");
   }
   if (r.box_widths.empty()) s += no_data(f, "no detections matched to the leader's truth box");
   return s + "</svg>";

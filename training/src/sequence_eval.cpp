@@ -505,7 +505,7 @@ void write_clip_boxes(const std::string& path, const ClipBoxes& b) {
     for (const auto& [frame, boxes] : b.boxes)
       for (const detector::Box& x : boxes)
         f << fmt::format("{} {} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {}\n", frame, x.class_id, x.confidence,
-                         x.drone_score, x.cx, x.cy, x.w, x.h, x.zoom_refined ? 1 : 0);
+                         x.drone_score, x.cx, x.cy, x.w, x.h, static_cast<int>(x.pass));
     if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write the boxes cache file", tmp));
   }
   std::error_code ec;
@@ -543,18 +543,20 @@ ClipBoxes read_clip_boxes(const std::string& path) {
     ++n;
     if (blank(line)) continue;
     std::istringstream in(line);
-    int frame = 0, zoom = 0;
+    int frame = 0, pass = 0;
     detector::Box x;
-    if (!(in >> frame >> x.class_id >> x.confidence >> x.drone_score >> x.cx >> x.cy >> x.w >> x.h >> zoom) ||
+    if (!(in >> frame >> x.class_id >> x.confidence >> x.drone_score >> x.cx >> x.cy >> x.w >> x.h >> pass) ||
         !(in >> std::ws).eof())
-      fail("expected '<frame> <class> <confidence> <drone_score> <cx> <cy> <w> <h> <zoom 0|1>'");
+      fail("expected '<frame> <class> <confidence> <drone_score> <cx> <cy> <w> <h> <pass 0|1|2>'");
     if (frame < 0 || frame >= b.frames || frame % b.frame_step != 0)
       fail(fmt::format("frame {}: not a tracked frame of {} (frame_step {})", frame, b.frames, b.frame_step));
     if (x.class_id < 0 || !(x.w >= 0.0f && std::isfinite(x.w)) || !(x.h >= 0.0f && std::isfinite(x.h)) ||
         !std::isfinite(x.cx) || !std::isfinite(x.cy) || !(x.confidence >= 0.0f && x.confidence <= 1.0f) ||
-        !(x.drone_score >= 0.0f && x.drone_score <= 1.0f) || (zoom != 0 && zoom != 1))
-      fail("a box needs class >= 0, scores in [0, 1], finite centre, w, h >= 0 and zoom 0 or 1");
-    x.zoom_refined = zoom == 1;
+        !(x.drone_score >= 0.0f && x.drone_score <= 1.0f) || pass < 0 || pass > 2)
+      fail(
+          "a box needs class >= 0, scores in [0, 1], finite centre, w, h >= 0 and pass 0 (single), 1 (zoom-in) or 2 "
+          "(window)");
+    x.pass = static_cast<detector::Pass>(pass);
     b.boxes[frame].push_back(x);
   }
   return b;

@@ -73,7 +73,7 @@ wingman::detections_t truth_detections(const wingman::ground_truth_t& truth, int
     det.h = static_cast<float>(h);
     det.confidence = 1.0f;
     det.class_id = 0;  // every simulated vehicle is a drone
-    det.zoom_refined = false;
+    det.pass_kind = wingman::detection_t::PASS_SINGLE;
     det.drone_score = 1.0f;  // = confidence, as for every class-0 box
     d.detections.push_back(det);
   }

@@ -2,9 +2,17 @@
 // A detection box (centre, size, confidence) and its intersection over union.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 namespace wingman::detector {
+
+/// Which pass of the detector drew a box; the values are detection_t's PASS_ constants.
+enum class Pass : int8_t {
+  kSingle = 0,  ///< the whole image resized to the network
+  kZoomIn = 1,  ///< a zoom-in crop around a single-pass box, resized to the network (Algorithm 2)
+  kWindow = 2,  ///< a full-resolution window where a track or the motion cue predicted a drone (no resize)
+};
 
 /// One detection. Coordinates are pixels of the image the box refers to (network input, crop or full
 /// image, as each function says); the origin is the top-left corner of the top-left pixel.
@@ -14,7 +22,7 @@ struct Box {
   float w = 0.0f;             ///< width, pixels (>= 0)
   float h = 0.0f;             ///< height, pixels (>= 0)
   float confidence = 0.0f;    ///< objectness x the probability of the box's class (class_id), 0..1
-  bool zoom_refined = false;  ///< true when the box comes from a zoom-in re-detection (Algorithm 2)
+  Pass pass = Pass::kSingle;  ///< which pass drew the box (its sizes relate to the drone differently per pass)
   /// the most probable class of the model's [yolo]/[region] head: 0 = drone; a multi-class model's others are
   /// distractors (models/wingman-small.md names them: 1 airplane, 2 bird, 3 helicopter)
   int class_id = 0;

@@ -24,7 +24,7 @@ struct ViewBox {
 ///  3. a group's box is the confidence-weighted mean of its members' centres and sizes, its confidence the sum of its
 ///     members' confidences over `view_count` (a box that only one of two passes found keeps half its confidence:
 ///     agreement between the views ranks first), its drone_score likewise from the members' drone scores, its class_id
-///     the most confident member's, zoom_refined when any member is.
+///     the most confident member's, its pass the highest of its members' (zoom-in when any member is).
 /// `boxes` is left sorted (step 1). `fused` is overwritten with the groups' boxes in the order the groups started (not
 /// sorted by confidence). The groups' sums live in a thread-local array: a caller that reuses `fused` allocates
 /// nothing once both have grown. Preconditions: 1 <= view_count <= 32, every box's view in 0 .. view_count - 1,

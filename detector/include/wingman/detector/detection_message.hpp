@@ -11,7 +11,7 @@
 namespace wingman::detector {
 
 /// The detection_t of `b`: centre and size (pixels of the source image), confidence, class_id (0 = drone),
-/// drone_score and zoom_refined, unchanged. Every class is published; the consumers choose (the localizer tracks
+/// drone_score and pass, unchanged. Every class is published; the consumers choose (the localizer tracks
 /// class 0 only). Precondition: 0 <= b.class_id <= INT16_MAX (a model's class index).
 inline wingman::detection_t to_detection(const Box& b) {
   wingman::detection_t d{};
@@ -21,7 +21,7 @@ inline wingman::detection_t to_detection(const Box& b) {
   d.h = b.h;
   d.confidence = b.confidence;
   d.class_id = static_cast<int16_t>(b.class_id);
-  d.zoom_refined = b.zoom_refined;
+  d.pass_kind = static_cast<int8_t>(b.pass);
   d.drone_score = b.drone_score;
   return d;
 }

@@ -87,8 +87,8 @@ DetectorPipelineOptions coarse_pass_options(const DetectorPipelineOptions& optio
 ///     a drone at IoU <= o_thresh, and a crop centred on the part re-detects the part), a network-sized crop of
 ///     the full-resolution image centred on it and clamped inside the image (zoom_crop()); all crops run as
 ///     batches of up to backend.max_batch(); in each crop the most confident re-detection (>= p_thresh)
-///     replaces the detection (zoom_refined = true). The other detections, and those whose crop finds nothing,
-///     keep their first-pass box unchanged (zoom_refined = false). The refined boxes go through NMS once more
+///     replaces the detection (pass kZoomIn). The other detections, and those whose crop finds nothing,
+///     keep their first-pass box unchanged (pass kSingle). The refined boxes go through NMS once more
 ///     (two crops may find the same drone);
 ///  5. with `flip_fusion`, steps 1-4 run twice, on the image and on its horizontal mirror (each pass keeping
 ///     boxes >= p_thresh / 2 and up to max_detections), the mirror's boxes are mirrored back, and the two lists

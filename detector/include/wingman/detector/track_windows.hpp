@@ -97,7 +97,7 @@ struct WindowStats {
 };
 
 /// The single pass's boxes and the windows' boxes together: for each searched window (in order), the most confident
-/// drone box (class 0) of its crop whose centre lies in its gate, in full-image pixels, flagged zoom_refined (a
+/// drone box (class 0) of its crop whose centre lies in its gate, in full-image pixels, of pass kWindow (a
 /// full-resolution re-detection); it replaces every first-pass box of the same drone: one it overlaps at IoU >
 /// o_thresh, whose centre lies in it or holds its centre, or whose centre lies in the window's gate (the single pass's
 /// box of a far drone is often twice its size and offset, touching the drone's box at IoU near 0: measured in

@@ -21,6 +21,14 @@ struct BoxRelationRequest {
   /// The detector's process configuration (config/detector.yaml keys); "" = its built-in defaults, which are
   /// what `cmake --install` installs. Its model.* and detection.* keys decide the boxes measured.
   std::string detector_config;
+  /// Which boxes: "single" (the single pass, with zoom-in as the detector configuration says: the relation's main
+  /// grid) or "window" (each target searched as the tracker-driven windows search a tracked drone, a window on its
+  /// outline box with 2 px of doubt, when the single pass would see it under windows.max_net_px network pixels; the
+  /// window's boxes: the relation's window grid). Windows are searched whether or not the configuration enables them.
+  std::string pass = "single";
+  /// Fitting the window grid: the relation whose main grid, model and edge noise are kept (its window grid is
+  /// replaced); it must have been measured for the same weights.
+  std::string base = "builtin:wingman-small";
   /// Evaluate this relation ("sphere", "builtin:wingman-small" or a file) instead of fitting one.
   std::string check;
   /// Fitting: the relation file to write (required unless check is given).
@@ -30,6 +38,8 @@ struct BoxRelationRequest {
   /// Box-width bin edges (fraction of the image width) and aspect (h / w) bin edges of the fitted table.
   std::vector<double> size_edges = {0.004, 0.008, 0.016, 0.032, 0.064, 0.128, 0.256, 0.8};
   std::vector<double> aspect_edges = {0.05, 0.5, 0.75, 1.0, 1.5, 20.0};
+  /// The window grid's box-width bin edges, image pixels (its aspect bins: aspect_edges).
+  std::vector<double> window_size_edges = {4, 8, 11, 16, 22, 32, 45, 64, 128};
   /// Bins with fewer measured boxes are filled from their neighbours.
   int min_bin_count = 8;
   /// The frame-to-frame edge wander written into the file (BoxScale::edge_noise_rel; not measurable on single
@@ -57,8 +67,10 @@ struct RangeErrorStats {
 /// What a run measured.
 struct BoxRelationSummary {
   int64_t images = 0, matched = 0, unmatched = 0, skipped_truncated = 0;
+  /// pass "window": targets the windows would not search (the single pass sees them over windows.max_net_px)
+  int64_t not_searched = 0;
   /// Relative range error with the sphere relation (ratio 1: the radius taken as is) and with the relation
-  /// fitted or checked, overall, per airframe and per true-range bin ("2-5 m", ...).
+  /// fitted or checked, overall, per airframe and per true-range bin ("2-5 m", ..., "40+ m").
   RangeErrorStats sphere_all, relation_all;
   std::map<std::string, RangeErrorStats> sphere_by_airframe, relation_by_airframe, relation_by_range;
   std::string relation_name;

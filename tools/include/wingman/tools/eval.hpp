@@ -141,7 +141,8 @@ struct EvalResult {
   Percentiles inference_latency_ms;  ///< detections_t.inference_latency_us, ms
   /// Box-width error |w_det - w_truth| / image_width (a fraction of the image width): each detection matched to the
   /// leader's visible truth box at the same utime and camera (of the detections whose centre lies inside the truth
-  /// box, the one with the nearest centre). Single-pass boxes (zoom_refined false) and zoom-in boxes apart.
+  /// box, the one with the nearest centre). Single-pass boxes (detection_t.pass_kind PASS_SINGLE) and re-detected ones
+  /// (zoom-in or window) apart.
   ErrorStats box_width_single, box_width_zoom;
   /// Leader detection and false boxes by the leader's truth range (range_bins_m edges); the bins' visible and
   /// detected add up to frames_leader_visible and frames_leader_detected.
@@ -185,7 +186,7 @@ struct EvalResult {
     double range_m;       ///< truth box range, metres
     double w_det_frac;    ///< detected width / image width
     double w_truth_frac;  ///< truth width / image width
-    bool zoom_refined;
+    bool redetected;      ///< detection_t.pass_kind is not PASS_SINGLE (zoom-in or window)
   };
   std::vector<BoxWidthSample> box_widths;
   std::vector<double> latency_samples_ms;  ///< every latency sample (the report's histogram)
@@ -194,7 +195,7 @@ struct EvalResult {
     struct Box {
       float cx, cy, w, h;  ///< pixels of the source image
       int camera_id;
-      bool flag;            ///< truth: visible; detection: zoom_refined
+      bool flag;            ///< truth: visible; detection: re-detected (pass not PASS_SINGLE)
       int vehicle_id = -1;  ///< truth: vehicle id; detection: -1
     };
     std::vector<Box> truth_boxes, detections;
