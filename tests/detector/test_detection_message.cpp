@@ -26,7 +26,7 @@ TEST(DetectionMessage, CarriesTheClassAndTheDroneScoreOfADistractor) {
   EXPECT_EQ(d.confidence, 0.8f);
   EXPECT_EQ(d.class_id, 2);
   EXPECT_EQ(d.drone_score, 0.1f);
-  EXPECT_EQ(d.pass_kind, wingman::detection_t::PASS_WINDOW);
+  EXPECT_EQ(int{d.pass_kind}, int{wingman::detection_t::PASS_WINDOW});  // int{}: no odr-use of the constant
 }
 
 TEST(DetectionMessage, ADroneKeepsClassZeroAndItsScore) {
@@ -40,7 +40,7 @@ TEST(DetectionMessage, ADroneKeepsClassZeroAndItsScore) {
   const wingman::detection_t d = to_detection(drone);
   EXPECT_EQ(d.class_id, 0);
   EXPECT_EQ(d.drone_score, 0.9f);
-  EXPECT_EQ(d.pass_kind, wingman::detection_t::PASS_SINGLE);
+  EXPECT_EQ(int{d.pass_kind}, int{wingman::detection_t::PASS_SINGLE});
 }
 
 }  // namespace

@@ -513,7 +513,12 @@ detection_t box(float cx, float cy, float w, bool zoom) {
   d.cy = cy;
   d.w = d.h = w;
   d.confidence = 0.9f;
-  d.pass_kind = zoom ? wingman::detection_t::PASS_ZOOM_IN : wingman::detection_t::PASS_SINGLE;
+  // (Not `zoom ? A : B`: a conditional of two lvalues odr-uses the constants, which lcm-gen declares but never
+  // defines.)
+  if (zoom)
+    d.pass_kind = wingman::detection_t::PASS_ZOOM_IN;
+  else
+    d.pass_kind = wingman::detection_t::PASS_SINGLE;
   return d;
 }
 

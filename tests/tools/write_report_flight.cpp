@@ -90,7 +90,10 @@ int main(int argc, char** argv) {
     det.cy = static_cast<float>(b.cy + unit(rng));
     det.w = det.h = static_cast<float>(std::max(1.0, b.w * (1.0 + (zoom ? 0.03 : 0.1) * unit(rng))));
     det.confidence = 0.8f;
-    det.pass_kind = zoom ? wingman::detection_t::PASS_ZOOM_IN : wingman::detection_t::PASS_SINGLE;
+    if (zoom)  // (not a conditional of the two constants: that odr-uses them, and lcm-gen never defines them)
+      det.pass_kind = wingman::detection_t::PASS_ZOOM_IN;
+    else
+      det.pass_kind = wingman::detection_t::PASS_SINGLE;
     d.detections = {det};
     d.num_detections = 1;
     const int64_t latency_us = static_cast<int64_t>(20000 + 4000 * std::abs(unit(rng)));

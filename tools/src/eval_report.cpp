@@ -128,7 +128,7 @@ std::string EvalResult::report() const {
   s += stats_line("single pass", box_width_single, "%", 100.0);
   for (const auto& b : box_width_single_by_range)
     if (b.error.n > 0) s += stats_line("  range " + bin_name(b), b.error, "%", 100.0);
-  s += stats_line("zoom-in", box_width_zoom, "%", 100.0);
+  s += stats_line("zoom-in or window", box_width_zoom, "%", 100.0);
   for (const auto& b : box_width_zoom_by_range)
     if (b.error.n > 0) s += stats_line("  range " + bin_name(b), b.error, "%", 100.0);
   return s;

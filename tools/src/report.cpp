@@ -598,7 +598,7 @@ std::string html_report(const EvalResult& r, const EvalOptions& o, const std::ve
                                frames.size(), r.preview_utimes.size(), escape_html(o.preview_channel))
                  : fmt::format("<p>{} of the log's {} images, evenly spaced. ", frames.size(), r.image_utimes.size())) +
             key("#00c800", "truth box (leader, with its matched track id)") + key("#a0a0a0", "truth box (other)") +
-            key("#d62728", "detection, single pass") + key("#ff7f0e", "detection, zoom-in") +
+            key("#d62728", "detection, single pass") + key("#ff7f0e", "detection, zoom-in or window") +
             "</p>\n<div id=\"frames\">\n";
     for (const auto& f : frames) {
       html += fmt::format(
@@ -619,7 +619,7 @@ std::string html_report(const EvalResult& r, const EvalOptions& o, const std::ve
       "distance.</p>\n" +
       range_chart(r) + "\n";
   html += "<h2>Box width over distance</h2><p>" + key("#7f7f7f", "truth (projected)") +
-          key("#1f77b4", "detection, single pass") + key("#ff7f0e", "detection, zoom-in") + "</p>\n" +
+          key("#1f77b4", "detection, single pass") + key("#ff7f0e", "detection, zoom-in or window") + "</p>\n" +
           box_width_chart(r) + "\n";
   html +=
       "<h2>Latency</h2><p>From the exposure (the earlier log-event time of the image and the ground truth of the "

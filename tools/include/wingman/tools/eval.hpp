@@ -195,7 +195,7 @@ struct EvalResult {
     struct Box {
       float cx, cy, w, h;  ///< pixels of the source image
       int camera_id;
-      bool flag;            ///< truth: visible; detection: re-detected (pass not PASS_SINGLE)
+      bool flag;            ///< truth: visible; detection: re-detected (pass_kind not PASS_SINGLE)
       int vehicle_id = -1;  ///< truth: vehicle id; detection: -1
     };
     std::vector<Box> truth_boxes, detections;
