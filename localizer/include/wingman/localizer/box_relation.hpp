@@ -39,7 +39,7 @@ struct BoxScale {
 /// proxy that does not depend on the airframe's size: for the single pass its width as a fraction of the image
 /// width, the image being resized to the network; for a tracker-driven window, searched at full resolution, its width
 /// in image pixels) and its aspect h / w (the view: side-on, from behind, from above), in one grid per regime (the
-/// network draws a drone of 12 pixels differently from one of 6). Between the centres of the size bins the ratios
+/// same drone is a different number of network pixels in each). Between the centres of the size bins the ratios
 /// are interpolated linearly in log(size), and held beyond the first and last centre; aspect bins are steps.
 class BoxRelation {
  public:
