@@ -361,12 +361,12 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
   const localizer::BoxRelation sphere = localizer::BoxRelation::sphere();
   std::vector<double> e_sphere_all, e_rel_all;
   std::map<std::string, std::vector<double>> e_sphere_af, e_rel_af, e_rel_range;
-  // The grid the fitted or checked boxes fall in (the window grid for window boxes when the relation has one).
-  const bool in_window_grid = window_pass && relation.has_window_grid();
+  // Fitting: the grid fitted (the window grid with --pass window), its residuals per bin.
+  const bool fitting = rq.check.empty();
   const localizer::BoxRelation::Grid& tb =
-      in_window_grid ? relation.table().window : static_cast<const localizer::BoxRelation::Grid&>(relation.table());
-  const size_t m = tb.aspect_edges.empty() ? 1 : tb.aspect_edges.size() - 1;
-  std::vector<std::vector<double>> residual_by_bin(relation.is_sphere() ? 0 : (tb.size_edges.size() - 1) * m);
+      window_pass ? relation.table().window : static_cast<const localizer::BoxRelation::Grid&>(relation.table());
+  std::vector<std::vector<double>> residual_by_bin(fitting ? (tb.size_edges.size() - 1) * (tb.aspect_edges.size() - 1)
+                                                           : 0);
   for (Sample& s : samples) {
     const auto es = range_error(s, sphere);
     const auto er = range_error(s, relation);
@@ -397,7 +397,7 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     if (!csv) throw std::runtime_error(rq.samples_csv + ": write failed (--samples)");
   }
 
-  if (rq.check.empty()) {
+  if (fitting) {
     localizer::BoxRelation::Table table = relation.table();
     localizer::BoxRelation::Grid& fitted = window_pass ? table.window : table;
     // The spread of the range left in each bin: its residuals' 1.4826 MAD about zero (a bin's median stays in the
