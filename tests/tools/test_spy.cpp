@@ -2,6 +2,8 @@
 // Tests of `wingman spy`: its java command line, and that lcm-spy's classpath decodes every pipeline channel.
 #include "wingman/tools/spy.hpp"
 
+#include "test_support.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
@@ -21,6 +23,7 @@ namespace {
 using ::testing::Contains;
 using ::testing::HasSubstr;
 using ::testing::Not;
+using wingman::testing::TempDir;
 using wingman::tools::spy_command;
 using wingman::tools::SpyOptions;
 
@@ -52,13 +55,6 @@ CommandResult run_command(const std::string& command, int timeout_s = 60) {
 std::string bin_dir() {
   const char* env = std::getenv("WINGMAN_BIN_DIR");
   return env != nullptr && *env != '\0' ? env : WINGMAN_DEFAULT_BIN_DIR;
-}
-
-/// A fresh directory for one test's files.
-std::string make_temp_dir() {
-  std::string pattern = ::testing::TempDir() + "wingman_test_spy_XXXXXX";
-  if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed: " + pattern);
-  return pattern;
 }
 
 std::vector<std::string> split_words(const std::string& line) {
@@ -165,7 +161,8 @@ TEST(SpyCommand, MissingTypesJarFailsTheDryRunNamingIt) {
 }
 
 TEST(SpyDecode, EveryPipelineChannelDecodesWithTheClasspathOfWingmanSpy) {
-  const std::string dir = make_temp_dir();
+  const TempDir tmp;  // removed with its files at the end of the test
+  const std::string& dir = tmp.path();
   const std::string log = dir + "/samples.lcmlog";
   const CommandResult pub = run_command(std::string(WINGMAN_PUBLISH_SAMPLES_EXE) + " --log " + log + " --repeat 3", 30);
   ASSERT_EQ(pub.exit_code, 0) << pub.output;
@@ -191,7 +188,8 @@ TEST(SpyDecode, EveryPipelineChannelDecodesWithTheClasspathOfWingmanSpy) {
 }
 
 TEST(SpyDecode, DecodeCheckFailsOnAChannelNoClassOnTheClasspathDecodes) {
-  const std::string dir = make_temp_dir();
+  const TempDir tmp;  // removed with its files at the end of the test
+  const std::string& dir = tmp.path();
   const std::string log = dir + "/garbage.lcmlog";
   {
     lcm::LogFile file(log, "w");
@@ -212,7 +210,8 @@ TEST(SpyDecode, DecodeCheckFailsOnAChannelNoClassOnTheClasspathDecodes) {
 }
 
 TEST(SpyDecode, WithoutTheTypesJarNoPipelineChannelDecodes) {
-  const std::string dir = make_temp_dir();
+  const TempDir tmp;  // removed with its files at the end of the test
+  const std::string& dir = tmp.path();
   const std::string log = dir + "/samples.lcmlog";
   const CommandResult pub = run_command(std::string(WINGMAN_PUBLISH_SAMPLES_EXE) + " --log " + log, 30);
   ASSERT_EQ(pub.exit_code, 0) << pub.output;
