@@ -30,14 +30,8 @@ supp=$root/tools/sanitizers
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(dirname "$root")}
 export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
 
-stage() {  # stage NAME CMD...: runs CMD, prints its wall time, keeps its exit status
-  local name=$1 start rc=0
-  shift
-  start=$(date +%s)
-  "$@" || rc=$?
-  echo "sanitize: $name took $(($(date +%s) - start)) s (exit $rc)"
-  return $rc
-}
+# shellcheck source=tools/lib/stage.sh
+. tools/lib/stage.sh  # stage PREFIX NAME CMD...: runs CMD and prints its wall time
 
 # Line tables only (-gline-tables-only, not -g): the sanitizers' reports need functions, files and lines, not
 # variables and types; a translation unit compiles about a quarter faster (tools/src/replay.cpp under ASan: 21 -> 16 s)
@@ -53,17 +47,17 @@ fi
 
 if [[ $kind == asan ]]; then
   build=build-asan
-  stage "asan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=address,undefined \
+  stage sanitize "asan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=address,undefined \
     -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-90}" \
     -DWINGMAN_FUZZ_RUNS="${WINGMAN_FUZZ_RUNS:-100000}" --log-level=WARNING
   # shellcheck disable=SC2086  # SANITIZE_TARGETS is a list
-  stage "asan build" nice -n 5 cmake --build $build -j"$jobs" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}
+  stage sanitize "asan build" nice -n 5 cmake --build $build -j"$jobs" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}
   # Leaks fail a test (a process exits non-zero at its end); suppressions name third-party libraries only.
   export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:detect_stack_use_after_return=0:strict_init_order=1:${ASAN_OPTIONS:-}"
   export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0:${LSAN_OPTIONS:-}"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
   if [[ $# -gt 0 ]]; then
-    stage "asan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
+    stage sanitize "asan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
     exit
   fi
   # Excluded under ASan:
@@ -78,9 +72,9 @@ if [[ $kind == asan ]]; then
   #  in 10 s on a loaded machine). The normal build runs it; under ASan the same processes run in
   #  Replay.CameraDriverFileToFile..., ProcessFileIo.*, DetectorProcess.* and demo.*. TSan leaves it out too.
   rc=0
-  stage "asan suite" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -LE '^(fuzz|sim)$' \
+  stage sanitize "asan suite" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -LE '^(fuzz|sim)$' \
     -E '^lint\.|^load\.|^supervision\.KillEach|^accuracy_guard$|^box_relation_guard$|^track_guard$|^Replay\.LockstepReplayThroughLiveProcesses' || rc=$?
-  stage "asan fuzz" ctest --test-dir $build --output-on-failure -j"$jobs" -L '^fuzz$' || rc=$?
+  stage sanitize "asan fuzz" ctest --test-dir $build --output-on-failure -j"$jobs" -L '^fuzz$' || rc=$?
   exit $rc
 fi
 
@@ -94,24 +88,24 @@ TSAN_TESTS='^(Runtime|ProcessConfig|ProcessFileIo|ProcessSignals|Replay|Localize
 tsan_targets=(wingman-camera-driver wingman-detector wingman-localizer wingman-follower-ctrl wingman-recorder wingman
   test_process_runtime test_replay test_localizer_process test_detector_process test_detector_realtime
   test_follower_process test_recorder test_recorder_process test_recorder_disk_full test_common)
-stage "tsan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=thread -DWINGMAN_WITH_SIM=OFF \
+stage sanitize "tsan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=thread -DWINGMAN_WITH_SIM=OFF \
   --log-level=WARNING
 if [[ -n ${SANITIZE_TARGETS:-} ]]; then
   # shellcheck disable=SC2086  # a list
-  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target $SANITIZE_TARGETS
+  stage sanitize "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target $SANITIZE_TARGETS
 elif [[ $# -gt 0 ]]; then
-  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs"
+  stage sanitize "tsan build" nice -n 5 cmake --build $build -j"$jobs"
 else
-  stage "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target "${tsan_targets[@]}" \
+  stage sanitize "tsan build" nice -n 5 cmake --build $build -j"$jobs" --target "${tsan_targets[@]}" \
     $(grep -q 'WINGMAN_WITH_SIM:BOOL=ON' $build/CMakeCache.txt && echo wingman-sim)
 fi
 # A race fails the process (exit 66) and so its test; suppressions name third-party libraries only.
 export TSAN_OPTIONS="halt_on_error=0:exitcode=66:second_deadlock_stack=1:suppressions=$supp/tsan.supp:${TSAN_OPTIONS:-}"
 if [[ $# -gt 0 ]]; then
-  stage "tsan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
+  stage sanitize "tsan ctest $*" ctest --test-dir $build --output-on-failure -j"$jobs" "$@"
   exit
 fi
 # Left out under TSan: the lockstep replay through live processes starts the OpenCL detector ten times (each start
 # waited for up to 90 s), and under TSan the detector's start-up (model load, kernel build) is many times longer.
-stage "tsan multi-process tests" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -R "$TSAN_TESTS" \
+stage sanitize "tsan multi-process tests" ctest --test-dir $build --output-on-failure -j"$jobs" --timeout 1800 -R "$TSAN_TESTS" \
   -E '^Replay\.LockstepReplayThroughLiveProcesses'

@@ -9,17 +9,11 @@ cd "$(dirname "$0")/.."
 case "${1:-}" in  # help without building
   -h|--help) sed -n '3,/^set -euo/p' "$0" | sed '$d'; echo "Arguments (a selection) go to ctest, e.g. tools/test.sh -R Localizer."; exit 0 ;;
 esac
-stage() {  # stage NAME CMD...: runs CMD and prints its wall time (CI's log says where its time went)
-  local name=$1 start rc=0
-  shift
-  start=$(date +%s)
-  "$@" || rc=$?
-  echo "test: $name took $(($(date +%s) - start)) s (exit $rc)"
-  return $rc
-}
-stage "install and build" tools/build.sh
+# shellcheck source=tools/lib/stage.sh
+. tools/lib/stage.sh  # stage PREFIX NAME CMD...: runs CMD and prints its wall time
+stage test "install and build" tools/build.sh
 export POCL_AFFINITY=1 OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
-stage "ctest" ctest --test-dir build --output-on-failure -j2 --timeout 900 "$@"
+stage test ctest ctest --test-dir build --output-on-failure -j2 --timeout 900 "$@"
 # With ctest arguments (a selection), only that selection runs. Otherwise the sanitizer stages follow
 # (docs/reliability.md): the suite under AddressSanitizer + UndefinedBehaviorSanitizer with the libFuzzer targets
 # given WINGMAN_FUZZ_RUNS inputs each from a fixed seed (default 100000, at most WINGMAN_FUZZ_SECONDS), then the
