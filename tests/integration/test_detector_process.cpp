@@ -3,6 +3,7 @@
 // one detections_t per good frame carrying the frame's utime and seq; bad frames dropped and counted;
 // the same input gives the same detections (but for the measured latency) run after run.
 #include "test_support.hpp"
+#include "test_video.hpp"
 
 #include <gtest/gtest.h>
 #include <wingman/detections_t.hpp>

@@ -2,6 +2,7 @@
 // The common runtime as the real process binaries use it: configs, exit codes, signals, file I/O, bad messages.
 // No network: these tests use file:// and memq:// LCM URLs only.
 #include "test_support.hpp"
+#include "test_video.hpp"
 
 #include <gtest/gtest.h>
 #include <wingman/common/runtime.hpp>

@@ -3,6 +3,7 @@
 // file-to-file and through `wingman replay` in lockstep with live processes on LCM multicast.
 // Runs in a private network namespace (ctest wraps it in tools/netns_run.sh).
 #include "test_support.hpp"
+#include "test_video.hpp"
 
 #include <gtest/gtest.h>
 #include <wingman/detections_t.hpp>

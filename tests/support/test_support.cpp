@@ -4,7 +4,6 @@
 
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include <fcntl.h>
 #include <signal.h>
@@ -150,24 +149,6 @@ void write_log(const std::string& path, const std::vector<LogEvent>& events) {
     ev.datalen = static_cast<int32_t>(e.data.size());
     ev.data = const_cast<uint8_t*>(e.data.data());
     if (log.writeEvent(&ev) != 0) throw std::runtime_error(path + ": write failed");
-  }
-}
-
-void write_test_video(const std::string& path, int frames, int width, int height, double fps) {
-  cv::VideoWriter writer(path, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
-                         cv::Size(width, height));
-  if (!writer.isOpened()) throw std::runtime_error(path + ": cannot open video writer");
-  for (int i = 0; i < frames; ++i) {
-    cv::Mat img(height, width, CV_8UC3);
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        img.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uchar>((x * 3) & 0xff), static_cast<uchar>((y * 5) & 0xff), 90);
-      }
-    }
-    const int s = std::max(4, width / 10);
-    const int x0 = (i * 7) % std::max(1, width - s), y0 = (i * 3) % std::max(1, height - s);
-    cv::rectangle(img, cv::Rect(x0, y0, s, s), cv::Scalar(255, 255, 255), cv::FILLED);
-    writer.write(img);
   }
 }
 

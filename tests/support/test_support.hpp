@@ -96,10 +96,6 @@ LogEvent make_event(const std::string& channel, const Msg& msg, int64_t timestam
   return ev;
 }
 
-/// Writes an MJPG .avi of `frames` frames, `width` x `height`, with a bright square moving one
-/// step per frame over a textured background (OpenCV's built-in AVI writer, no ffmpeg needed).
-void write_test_video(const std::string& path, int frames, int width, int height, double fps);
-
 /// Payloads per channel, each channel in order, for comparing runs: LCM's event times differ
 /// between runs, and channels from different processes may interleave differently.
 std::map<std::string, std::vector<std::vector<uint8_t>>> payloads_by_channel(

@@ -65,14 +65,16 @@ TEST(SequenceEvalOptions, DefaultsAreValidOnceDataIsGivenAndBadFieldsAreNamed) {
   EXPECT_TRUE(o.validate().empty());
   o.hfov_deg = 180;
   o.frame_step = 0;
+  o.max_seconds = -1;
   o.scoring.on_target_fraction = 1;
   o.scoring.confirm_within_s = 0;
   const auto p = o.validate();
-  ASSERT_EQ(p.size(), 4u);
+  ASSERT_EQ(p.size(), 5u);
   EXPECT_NE(p[0].find("hfov_deg = 180"), std::string::npos) << p[0];
   EXPECT_NE(p[1].find("frame_step = 0"), std::string::npos) << p[1];
-  EXPECT_NE(p[2].find("scoring.on_target_fraction = 1"), std::string::npos) << p[2];
-  EXPECT_NE(p[3].find("scoring.confirm_within_s = 0"), std::string::npos) << p[3];
+  EXPECT_NE(p[2].find("max_seconds = -1: must be >= 0"), std::string::npos) << p[2];
+  EXPECT_NE(p[3].find("scoring.on_target_fraction = 1"), std::string::npos) << p[3];
+  EXPECT_NE(p[4].find("scoring.confirm_within_s = 0"), std::string::npos) << p[4];
   const std::string e = error_of([&] { run_sequence_eval(o); });
   EXPECT_EQ(e.rfind("run_sequence_eval: invalid options:", 0), 0u) << e;
 }
@@ -403,6 +405,32 @@ TEST(RunSequenceEval, GeneratedClipsGiveOneDroneTrackAndOneFalseTrack) {
   EXPECT_EQ(every4.clips[0].frames_tracked, 10);
   EXPECT_NEAR(every4.clips[0].time_to_confirm_s, 36.0 / 30.0, 1e-3);
 
+  // The first 0.5 s only (frames 0..14 of 30 fps): the detector sees 15 frames, the track is confirmed at the tenth
+  // as over the whole clip, and the clip's duration is the part tracked.
+  o = fx.options();
+  o.max_seconds = 0.5;
+  o.boxes_cache = fx.dir.file("boxes_limited");  // not written: a cache file holds a whole clip
+  int calls = 0;
+  const FrameDetector counted = [&](const cv::Mat& bgr) {
+    ++calls;
+    return bright_square(bgr);
+  };
+  const SequenceEvalResult first = run_sequence_eval(o, counted);
+  EXPECT_EQ(calls, 30);  // 15 frames of each clip
+  ASSERT_EQ(first.clips.size(), 2u);
+  for (const ClipTrackResult& c : first.clips) {
+    EXPECT_EQ(c.frames, 15) << c.clip;
+    EXPECT_EQ(c.frames_tracked, 15) << c.clip;
+    EXPECT_NEAR(c.duration_s, 0.5, 1e-3) << c.clip;
+    ASSERT_EQ(c.tracks.size(), 1u) << c.clip;
+    EXPECT_EQ(c.tracks[0].confirmed_frame, 9) << c.clip;
+    EXPECT_EQ(c.tracks[0].hits, 6) << c.clip;  // frames 9..14
+  }
+  EXPECT_NEAR(first.clips[1].time_to_confirm_s, 9.0 / 30.0, 1e-3);
+  EXPECT_NE(first.report().find("every frame of each clip's first 0.5 s"), std::string::npos) << first.report();
+  EXPECT_EQ(nlohmann::json::parse(first.json())["max_seconds"], 0.5);
+  EXPECT_TRUE(fs::is_empty(o.boxes_cache));
+
   // The same input twice gives the same JSON (deterministic).
   EXPECT_EQ(run_sequence_eval(fx.options(), bright_square).json(), r.json());
 }
@@ -529,6 +557,17 @@ TEST(RunSequenceEval, BoxesCacheGivesTheSameResultWithoutTheDetectorOrTheVideo) 
   EXPECT_EQ(b.height, 128);
   ASSERT_EQ(b.boxes.size(), 40u);
   EXPECT_FLOAT_EQ(b.boxes.at(0)[1].cx, 100.25f);
+
+  // A time limit reads the cached whole clips up to it (the detector is not called).
+  SequenceEvalOptions limited = o;
+  limited.max_seconds = 0.5;
+  const SequenceEvalResult part = run_sequence_eval(limited, counted);
+  EXPECT_EQ(calls, 80);
+  ASSERT_EQ(part.clips.size(), 2u);
+  EXPECT_EQ(part.clips[1].frames, 15);
+  EXPECT_EQ(part.clips[1].frames_tracked, 15);
+  EXPECT_EQ(part.clips[1].drone_boxes, 15);
+  EXPECT_EQ(part.clips[1].other_class_boxes, 15);
 
   // Other settings: one error naming the file and both settings.
   o.frame_step = 2;

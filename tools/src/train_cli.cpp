@@ -105,6 +105,8 @@ struct ValVerbOptions {
       "wingman-localizer's YAML; \"\" = its built-in defaults");
     v("sequences.hfov_deg", sequences.hfov_deg, "horizontal field of view of the static camera's pinhole, degrees");
     v("sequences.frame_step", sequences.frame_step, "track every n-th frame (1: every frame)");
+    v("sequences.max_seconds", sequences.max_seconds,
+      "track only each clip's first this many seconds (0: whole clips; writes no boxes_cache files)");
     v("sequences.clips", sequences.clips, "only these clips of the split; [] = all");
     v("sequences.boxes_cache", sequences.boxes_cache, "folder of each clip's detector boxes (read, or written)");
     sequences.motion.visit(v);  // motion.*: the detector's motion cue over each clip's frames
@@ -232,6 +234,9 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
   v->add_option("--hfov-deg", so.hfov_deg,
                 "--sequences: horizontal field of view of the static camera's nominal pinhole, degrees");
   v->add_option("--frame-step", so.frame_step, "--sequences: track every n-th frame (1: every frame)");
+  v->add_option("--max-seconds", so.max_seconds,
+                "--sequences: track only each clip's first this many seconds (0: whole clips; writes no --boxes-cache "
+                "files)");
   v->add_option("--clips", so.clips, "--sequences: only these clips of the split (comma-separated)")->delimiter(',');
   v->add_option("--boxes-cache", so.boxes_cache,
                 "--sequences: folder of each clip's detector boxes: a clip whose <clip>.boxes is there is tracked "
@@ -276,6 +281,7 @@ TrainingVerbs::TrainingVerbs(CLI::App& app) : s_(std::make_unique<State>()) {
           {"--localizer-config", "sequences.localizer_config", true},
           {"--hfov-deg", "sequences.hfov_deg", false},
           {"--frame-step", "sequences.frame_step", false},
+          {"--max-seconds", "sequences.max_seconds", false},
           {"--clips", "sequences.clips", true},
           {"--boxes-cache", "sequences.boxes_cache", true},
           {"--confirm-within", "sequences.confirm_within_s", false},

@@ -148,6 +148,8 @@ std::vector<std::string> SequenceEvalOptions::validate() const {
   if (std::string why; !detector::InputSize::parse(input_size, &why)) p.push_back("input_size = " + why);
   if (!(hfov_deg > 0.0 && hfov_deg < 180.0)) p.push_back(fmt::format("hfov_deg = {}: must be in (0, 180)", hfov_deg));
   if (frame_step < 1) p.push_back(fmt::format("frame_step = {}: must be >= 1", frame_step));
+  if (!(max_seconds >= 0.0) || !std::isfinite(max_seconds))
+    p.push_back(fmt::format("max_seconds = {}: must be >= 0 (0: whole clips)", max_seconds));
   for (const auto& s : detection.validate()) p.push_back(s);
   for (const auto& s : scoring.validate()) p.push_back(s);
   if (motion.enabled) {
@@ -354,8 +356,9 @@ std::string SequenceEvalResult::report() const {
       "tracker; static camera, pinhole HFOV {:.1f} deg (fx {:.1f} px); a track is on the drone when > {:.0f} % of its "
       "confirmed hits have their box centre in a labelled drone box\n",
       clips.size() - static_cast<size_t>(n_skipped), split, n_skipped,
-      frame_step == 1 ? std::string("every frame") : fmt::format("every {}th frame", frame_step), hfov_deg, focal_px,
-      100.0 * scoring.on_target_fraction);
+      (frame_step == 1 ? std::string("every frame") : fmt::format("every {}th frame", frame_step)) +
+          (max_seconds > 0 ? fmt::format(" of each clip's first {:g} s", max_seconds) : std::string()),
+      hfov_deg, focal_px, 100.0 * scoring.on_target_fraction);
   s += fmt::format("  {:<14} {:>5} {:>8} {:>6} {:>8} {:>9} {:>15} {:>12} {:>10} {:>10}\n", "clips", "n", "video h",
                    "false", "false/h", "(95% up)", "drone confirmed",
                    fmt::format("within {:g} s", scoring.confirm_within_s), "median s", "drone ids");
@@ -472,6 +475,7 @@ std::string SequenceEvalResult::json() const {
   j["hfov_deg"] = hfov_deg;
   j["focal_px"] = focal_px;
   j["frame_step"] = frame_step;
+  j["max_seconds"] = max_seconds;
   j["on_target_fraction"] = scoring.on_target_fraction;
   j["confirm_within_s"] = scoring.confirm_within_s;
   j["skipped"] = skipped();
@@ -673,7 +677,10 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
   result.split = o.split;
   result.hfov_deg = o.hfov_deg;
   result.frame_step = o.frame_step;
+  result.max_seconds = o.max_seconds;
   result.scoring = o.scoring;
+  // Frame k is tracked only while its video time k / fps is before max_seconds (when set).
+  const auto before_limit = [&o](int k, double fps) { return o.max_seconds <= 0 || k < o.max_seconds * fps; };
   for (const SplitClip& sc : clips) {
     ClipTrackResult c;
     c.clip = sc.name, c.cls = sc.cls, c.distance_bin = sc.distance_bin;
@@ -710,6 +717,8 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
             fmt::format("{}: made with frame_step {}, this run {}", cache_path, cached.frame_step, o.frame_step));
       c.fps = cached.fps;
       c.frames = cached.frames;
+      if (o.max_seconds > 0)
+        c.frames = std::min(c.frames, static_cast<int>(std::ceil(o.max_seconds * c.fps - 1e-9)));
       if (c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
       static const std::vector<detector::Box> kNoBoxes;
       for (int k = 0; k < c.frames && c.skipped.empty(); k += o.frame_step) {
@@ -738,7 +747,7 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
         // The motion cue sees this clip's frames only, at their video times.
         std::optional<detector::MotionCue> cue;
         if (o.motion.enabled) cue.emplace(o.motion);
-        for (int k = 0;; ++k) {
+        for (int k = 0; before_limit(k, c.fps); ++k) {
           if (k % o.frame_step != 0) {
             if (!cap.grab()) break;
             ++c.frames;
@@ -774,8 +783,8 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
         }
         if (c.skipped.empty() && c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
         record.frames = c.frames;
-        // Only a whole clip is cached (a skipped one is tried again next time).
-        if (!cache_path.empty() && c.skipped.empty()) write_clip_boxes(cache_path, record);
+        // Only a whole clip is cached (a skipped one is tried again next time; a time limit leaves the clip's end).
+        if (!cache_path.empty() && c.skipped.empty() && o.max_seconds <= 0) write_clip_boxes(cache_path, record);
       }
     }
     if (tracker) {

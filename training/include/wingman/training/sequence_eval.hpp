@@ -155,6 +155,10 @@ struct SequenceEvalOptions {
   /// (0, 180).
   double hfov_deg = 24.0;
   int frame_step = 1;  ///< track every frame_step-th frame (0, step, 2 step, ...); time stays frame / fps. >= 1
+  /// Track only each clip's frames before this video time, s (0: whole clips; >= 0). A clip's duration, its false
+  /// tracks per hour and its drone's time to confirm are then those of that part. A run with a limit writes no
+  /// boxes_cache files (they hold whole clips); it reads them, using the frames before the limit.
+  double max_seconds = 0;
   TrackScoringOptions scoring;
   /// A folder for the detector's boxes of every tracked frame, one `<clip>.boxes` file per clip ("" = none). A clip
   /// whose file is there is tracked from it instead of running the detector (the video is not read), so the tracker's
@@ -189,6 +193,7 @@ struct SequenceEvalResult {
   std::string split;
   double hfov_deg = 0, focal_px = 0;  ///< the nominal pinhole used (focal_px of the first clip's frame size)
   int frame_step = 1;
+  double max_seconds = 0;                ///< SequenceEvalOptions::max_seconds (0: whole clips)
   detector::MotionStats motion;          ///< the motion cue's work over every clip detected (motion.enabled)
   detector::WindowStats motion_windows;  ///< and its windows' (searched, crops, found a drone)
   TrackScoringOptions scoring;
