@@ -93,6 +93,14 @@ with tempfile.TemporaryDirectory() as d:
     ws03 = rows.get(('wingman-small, drone boxes', '0.3'))
     check(ws03 == ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.00'], f'wingman-small, 0.3 ({ws03})')
     check('- drone (2): airplane 50%, bird 50%' in r.stdout, 'the labels that found the drone at 0.1')
+    # The bird veto: CenterNet's bird box of 0.2 holds the centre of wingman-small's box on the bird; its 0.15 bird box
+    # in drone frame 20 holds no wingman-small box.
+    _, veto = table('--bird-veto', '0.2,0.7')
+    v02 = veto.get(('wingman-small, drone boxes not in a CenterNet bird box >= 0.2', '0.1'))
+    check(v02 == ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.00'],
+          f'a bird box of 0.2 takes wingman-small\'s box off the bird ({v02})')
+    v07 = veto.get(('wingman-small, drone boxes not in a CenterNet bird box >= 0.7', '0.1'))
+    check(v07 == ws01, f'no bird box reaches 0.7: the rows without the veto ({v07})')
     check('- bird (1): bird 100%' in r.stdout, 'the label that found the bird')
 
     # Bad input: one line naming the file.

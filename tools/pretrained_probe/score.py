@@ -7,8 +7,11 @@ that found nothing, per image; for a COCO detector also which COCO label its box
 CenterNet's output is its 100 best (place, class) pairs, often several labels at one place: its boxes first go through
 class-agnostic non-maximum suppression (--nms-iou, 0.4 as @vladmandic/human applies it), after the threshold.
 
+With both, --bird-veto S,... adds rows for the shipped model's boxes without those whose centre lies in a CenterNet box
+labelled bird scoring at least S (after the suppression): what COCO's bird label would take away, drones and birds.
+
 Usage: score.py --data DIR [--split train] [--coco PROBE.json] [--wingman PREDICT_DIR] [--thresholds 0.1,0.2,0.3]
-                [--nms-iou 0.4]
+                [--nms-iou 0.4] [--bird-veto 0.3,0.4]
   --coco: probe.mjs's output (boxes in image pixels, COCO class indices 0..79);
   --wingman: `wingman predict --out` (one <stem>.txt per image: class cx cy w h confidence, normalised).
 """
@@ -120,6 +123,17 @@ def suppress(boxes, nms_iou):
     return kept
 
 
+def bird_veto(wingman, coco, min_score, nms_iou):
+    """wingman's detections without the boxes centred in a CenterNet 'bird' box scoring >= min_score."""
+    out = {}
+    for image, (w, h, boxes) in wingman.items():
+        coco_boxes = suppress([b for b in coco.get(image, (0, 0, []))[2] if b[2] >= min_score], nms_iou)
+        birds = [c for c in coco_boxes if c[3] == 'bird']
+        out[image] = (w, h, [b for b in boxes
+                             if not any(c[4] <= b[0] <= c[6] and c[5] <= b[1] <= c[7] for c in birds)])
+    return out
+
+
 def score(data, split, detections, threshold, labels=None, nms_iou=None):
     """Found and total objects per column, the label of the box that found each kind, boxes on nothing per image.
     labels: only boxes with these labels count (None: all); nms_iou: suppress overlaps above it first (None: no)."""
@@ -166,6 +180,7 @@ def main(argv):
     p.add_argument('--wingman')
     p.add_argument('--thresholds', default='0.1,0.2,0.3')
     p.add_argument('--nms-iou', type=float, default=0.4)
+    p.add_argument('--bird-veto', default='')
     a = p.parse_args(argv)
     thresholds = [float(t) for t in a.thresholds.split(',')]
     image_dir = os.path.join(a.data, 'images', a.split)
@@ -179,7 +194,12 @@ def main(argv):
         sets += [('MB3-CenterNet (COCO), any label', coco, None, a.nms_iou),
                  ('MB3-CenterNet (COCO), airplane/bird/kite', coco, FLYING, a.nms_iou)]
     if a.wingman:
-        sets.append(('wingman-small, drone boxes', read_wingman(a.wingman, images), {'drone'}, None))
+        wingman = read_wingman(a.wingman, images)
+        sets.append(('wingman-small, drone boxes', wingman, {'drone'}, None))
+        if a.coco:
+            for v in (float(x) for x in a.bird_veto.split(',') if x):
+                sets.append((f'wingman-small, drone boxes not in a CenterNet bird box >= {v:g}',
+                             bird_veto(wingman, coco, v, a.nms_iou), {'drone'}, None))
     if not sets:
         raise ScoreError('nothing to score: give --coco and/or --wingman')
     rows = []
