@@ -11,7 +11,8 @@
 # With ctest args, only `ctest <args>` runs (e.g. `tools/sanitize.sh asan -R fuzz_corpus`).
 # The trainer (libtorch) is not built. asan builds the simulator (for the scenario parser's fuzz target) but runs
 # none of the tests that render (label sim, and the supervision fault test's flight): Mesa's llvmpipe is not
-# instrumented and a rendered flight takes minutes even without a sanitizer. tsan builds no simulator.
+# instrumented and a rendered flight takes minutes even without a sanitizer; nor does it build the test executables
+# that only render (WINGMAN_BUILD_RENDER_TESTS=OFF). tsan builds no simulator.
 # Environment: WINGMAN_FUZZ_RUNS, WINGMAN_FUZZ_SECONDS (inputs and the most seconds per fuzz target; RUNS=0:
 #   fuzz for the whole time, e.g. WINGMAN_FUZZ_RUNS=0 WINGMAN_FUZZ_SECONDS=600 for a longer hunt), JOBS (build and ctest parallelism, default 2),
 #   SANITIZE_TARGETS (build only these targets, space-separated; default: everything the stage needs).
@@ -48,7 +49,7 @@ fi
 if [[ $kind == asan ]]; then
   build=build-asan
   stage sanitize "asan configure" cmake -S . -B $build "${common_cmake[@]}" -DWINGMAN_SANITIZE=address,undefined \
-    -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-90}" \
+    -DWINGMAN_BUILD_RENDER_TESTS=OFF -DWINGMAN_BUILD_FUZZERS=ON -DWINGMAN_FUZZ_SECONDS="${WINGMAN_FUZZ_SECONDS:-90}" \
     -DWINGMAN_FUZZ_RUNS="${WINGMAN_FUZZ_RUNS:-100000}" --log-level=WARNING
   # shellcheck disable=SC2086  # SANITIZE_TARGETS is a list
   stage sanitize "asan build" nice -n 5 cmake --build $build -j"$jobs" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}

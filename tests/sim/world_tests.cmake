@@ -27,8 +27,10 @@ add_dependencies(test_sim_process wingman-sim wingman-localizer)
 
 # Several cameras on the camera vehicle (cameras.rig), rendered for real (llvmpipe): images, boxes, detections per
 # camera, a rig's first camera equal to the single camera, renderers sharing one GL context, bad rig files.
-wingman_add_test(test_sim_rig
-  SOURCES test_sim_rig.cpp
-  LIBS wingman::sim_world wingman::test_support opencv_core opencv_imgproc
-  LABEL sim
-  TIMEOUT 180)
+if(WINGMAN_BUILD_RENDER_TESTS)
+  wingman_add_test(test_sim_rig
+    SOURCES test_sim_rig.cpp
+    LIBS wingman::sim_world wingman::test_support opencv_core opencv_imgproc
+    LABEL sim
+    TIMEOUT 180)
+endif()

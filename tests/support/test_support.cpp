@@ -3,7 +3,6 @@
 #include "test_support.hpp"
 
 #include <lcm/lcm-cpp.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <fcntl.h>
 #include <signal.h>

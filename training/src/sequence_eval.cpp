@@ -717,8 +717,7 @@ SequenceEvalResult run_sequence_eval(const SequenceEvalOptions& o, const FrameDe
             fmt::format("{}: made with frame_step {}, this run {}", cache_path, cached.frame_step, o.frame_step));
       c.fps = cached.fps;
       c.frames = cached.frames;
-      if (o.max_seconds > 0)
-        c.frames = std::min(c.frames, static_cast<int>(std::ceil(o.max_seconds * c.fps - 1e-9)));
+      if (o.max_seconds > 0) c.frames = std::min(c.frames, static_cast<int>(std::ceil(o.max_seconds * c.fps - 1e-9)));
       if (c.frames == 0) c.skipped = fmt::format("{}: no frame could be read", video);
       static const std::vector<detector::Box> kNoBoxes;
       for (int k = 0; k < c.frames && c.skipped.empty(); k += o.frame_step) {
