@@ -73,25 +73,25 @@ with tempfile.TemporaryDirectory() as d:
 
     # Columns: drone CLOSE, MEDIUM, DISTANT, airplane, bird, helicopter, boxes on nothing per image.
     r, rows = table()
-    any01 = rows.get(('MB3-CenterNet (COCO), any label', '0.1'))
-    check(any01 == ['—', '—', '1.00 (2/2)', '—', '1.00 (1/1)', '—', '0.67'],
-          f'CenterNet, any label, 0.1: both drone frames and the bird found; the person and the bird box outside '
-          f'its bird on nothing: 2 in 3 images ({any01})')
-    any03 = rows.get(('MB3-CenterNet (COCO), any label', '0.3'))
-    check(any03 == ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.67'],
-          f'CenterNet, any label, 0.3: frame 0 only ({any03})')
-    fly03 = rows.get(('MB3-CenterNet (COCO), airplane/bird/kite', '0.3'))
-    check(fly03 == ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.33'],
-          f'CenterNet, flying labels, 0.3: the person box left out ({fly03})')
     _, raw = table('--nms-iou', '1')
-    raw01 = raw.get(('MB3-CenterNet (COCO), any label', '0.1'))
-    check(raw01 == ['—', '—', '1.00 (2/2)', '—', '1.00 (1/1)', '—', '1.00'],
-          f'without suppression the kite box on the found drone is on nothing too ({raw01})')
-    ws01 = rows.get(('wingman-small, drone boxes', '0.1'))
-    check(ws01 == ['—', '—', '0.50 (1/2)', '—', '1.00 (1/1)', '—', '0.00'],
-          f'wingman-small, 0.1: the drone in frame 0, a drone box on the bird ({ws01})')
-    ws03 = rows.get(('wingman-small, drone boxes', '0.3'))
-    check(ws03 == ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.00'], f'wingman-small, 0.3 ({ws03})')
+    CN, FLY, WS = 'MB3-CenterNet (COCO), any label', 'MB3-CenterNet (COCO), airplane/bird/kite', 'wingman-small, drone boxes'
+    expected = [  # (table, row, threshold, cells, why)
+        (rows, CN, '0.1', ['—', '—', '1.00 (2/2)', '—', '1.00 (1/1)', '—', '0.67'],
+         'CenterNet, any label: both drone frames and the bird found; the person and the bird box outside its bird on '
+         'nothing: 2 in 3 images'),
+        (rows, CN, '0.3', ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.67'], 'CenterNet, any label: frame 0 only'),
+        (rows, FLY, '0.3', ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.33'],
+         'CenterNet, flying labels: the person box left out'),
+        (raw, CN, '0.1', ['—', '—', '1.00 (2/2)', '—', '1.00 (1/1)', '—', '1.00'],
+         'without suppression the kite box on the found drone is on nothing too'),
+        (rows, WS, '0.1', ['—', '—', '0.50 (1/2)', '—', '1.00 (1/1)', '—', '0.00'],
+         'wingman-small: the drone in frame 0, a drone box on the bird'),
+        (rows, WS, '0.3', ['—', '—', '0.50 (1/2)', '—', '0.00 (0/1)', '—', '0.00'], 'wingman-small'),
+    ]
+    for got_rows, row, threshold, cells, why in expected:
+        got = got_rows.get((row, threshold))
+        check(got == cells, f'{why}, threshold {threshold} ({got})')
+    ws01 = rows.get((WS, '0.1'))
     check('- drone (2): airplane 50%, bird 50%' in r.stdout, 'the labels that found the drone at 0.1')
     # The bird veto: CenterNet's bird box of 0.2 holds the centre of wingman-small's box on the bird; its 0.15 bird box
     # in drone frame 20 holds no wingman-small box.

@@ -17,6 +17,7 @@ Usage: score.py --data DIR [--split train] [--coco PROBE.json] [--wingman PREDIC
 """
 import argparse
 import collections
+import functools
 import json
 import os
 import sys
@@ -40,6 +41,7 @@ class ScoreError(Exception):
     pass
 
 
+@functools.lru_cache(maxsize=None)  # score() runs once per set and threshold over the same files
 def read_splits(data):
     """clip -> distance bin, from splits.csv (clip,class,distance_bin,split,images)."""
     path = os.path.join(data, 'splits.csv')
@@ -52,11 +54,12 @@ def read_splits(data):
     return {r.split(',')[0]: r.split(',')[2] for r in rows[1:] if r}
 
 
+@functools.lru_cache(maxsize=None)
 def read_truths(path, width, height):
-    """[(kind, x1, y1, x2, y2)] in pixels from a YOLO label file (absent: none)."""
+    """((kind, x1, y1, x2, y2), ...) in pixels from a YOLO label file (absent: none)."""
     out = []
     if not os.path.exists(path):
-        return out
+        return ()
     for n, line in enumerate(open(path).read().splitlines(), 1):
         f = line.split()
         if not f:
@@ -65,7 +68,7 @@ def read_truths(path, width, height):
             raise ScoreError(f'{path}:{n}: expected "class cx cy w h" with class 0..3')
         cx, cy, w, h = float(f[1]) * width, float(f[2]) * height, float(f[3]) * width, float(f[4]) * height
         out.append((KINDS[int(f[0])], cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2))
-    return out
+    return tuple(out)
 
 
 def read_coco(path):
