@@ -11,6 +11,7 @@ add_library(wingman_sim_render
   src/render/drone_model.cpp
   src/render/mesh_builder.cpp
   src/render/procedural_drone.cpp
+  src/render/distractor_model.cpp
   src/render/mesh_loader.cpp
   src/render/truth_box.cpp
   src/render/render_options.cpp

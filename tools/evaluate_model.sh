@@ -4,7 +4,8 @@
 # Halmstad val clips (drone clips; airplane, bird and helicopter clips as negatives, false positives per image), on
 # the synthetic val split it was trained beside, on a synthetic 1280x720 set up to 30 m, and on the follower's view
 # of the formation flights (1280x720, 90 deg, the target on the horizon at 4-20 m, never trained on), on the held-out
-# training flight when tools/train_model.sh made them; and its speed (wingman bench detector, at the cfg's size).
+# training flight when tools/train_model.sh made them, on synthetic airplanes, birds and helicopters without a drone
+# (false positives per image); and its speed (wingman bench detector, at the cfg's size).
 # wingman val runs the detector at its default input size (model.input_size auto: the cfg's 640 columns, the rows
 # fitted to each set's aspect, 640x512 for the Halmstad frames).
 # Then the track-level metrics (wingman val --sequences, docs/training.md): every frame of the Halmstad val clips
@@ -82,6 +83,20 @@ if [ ! -f "$data/followview/data.yaml" ]; then
     --meshes "$src/../shared/meshes"
 fi
 val followview_val "$data/followview/data.yaml"
+# Synthetic distractors (config/datasets/distractors.yaml: one procedural airplane, bird or helicopter per image and no
+# drone, 640x512, 6-60 px; seed 61, never trained on): drone boxes per image, per kind (the label's class).
+if [ ! -f "$data/distractors/data.yaml" ]; then
+  rm -rf "$data/distractors"
+  "$bin/wingman" dataset synth --out "$data/distractors" --count 600 --seed 61 \
+    --config "$src/config/datasets/distractors.yaml"
+fi
+for kind in 1:AIRPLANE 2:BIRD 3:HELICOPTER; do
+  (cd "$data/distractors/labels/val" && grep -l "^${kind%%:*} " -- *.txt) |
+    sed "s|^\(.*\)\.txt\$|$data/distractors/images/val/\1.jpg|" > "$out/distractors_${kind#*:}.txt"
+  "$bin/wingman" dataset mix --out "$out/distractors_${kind#*:}.yaml" --path "$out" --val "distractors_${kind#*:}.txt" \
+    > /dev/null
+  val "distractors_${kind#*:}" "$out/distractors_${kind#*:}.yaml"
+done
 # The held-out training flight (tools/train_model.sh stage 3: flight 7 of seed 1, never trained on), when present.
 flights=false
 if [ -f "$data/flights/.complete" ]; then

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
 """tools/evaluate_model.sh's summary: OUT/summary.md from the wingman val --json files in OUT (the metrics per set,
-the negative clips' false positives, the truths not found and the track-level table); printed too.
+the negative clips' and the synthetic distractors' false positives, the truths not found and the track-level table);
+printed too.
 
 Usage: evaluate_summary.py OUT FLIGHTS SEQUENCES (FLIGHTS, SEQUENCES: true or false: whether OUT has
 flights_val.json and halmstad_sequences.json)."""
@@ -30,6 +31,13 @@ for kind in ("AIRPLANE", "BIRD", "HELICOPTER"):
     r = load("halmstad_val_" + kind)
     fp = r["centre"]["all"]["false_positives"]
     lines.append(f"| {kind.lower()} | {r['images']} | {fp} | {fp / max(1, r['images']):.3f} |")
+if os.path.exists(os.path.join(out, "distractors_AIRPLANE.json")):
+    lines += ["", "| synthetic distractors, no drone (config/datasets/distractors.yaml, seed 61) | images | "
+              "false positives at conf 0.2 | per image |", "|---|---|---|---|"]
+    for kind in ("AIRPLANE", "BIRD", "HELICOPTER"):
+        r = load("distractors_" + kind)
+        fp = r["centre"]["all"]["false_positives"]
+        lines.append(f"| {kind.lower()} | {r['images']} | {fp} | {fp / max(1, r['images']):.3f} |")
 lines += ["", "| set | criterion | truths not found at conf 0.2 | missed (no box overlaps) | loose (overlapped, not matched) | "
           "at the image's edge (of the truths there) |", "|---|---|---|---|---|---|"]
 for name, label in sets:

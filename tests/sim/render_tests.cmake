@@ -7,7 +7,8 @@ target_link_libraries(wingman-render-dump PRIVATE wingman::sim_render opencv_cor
 wingman_warnings(wingman-render-dump)
 
 wingman_add_test(test_sim_render
-  SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_drone_model.cpp ${CMAKE_CURRENT_SOURCE_DIR}/test_render_options.cpp
+  SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_drone_model.cpp ${CMAKE_CURRENT_SOURCE_DIR}/test_distractor_model.cpp
+          ${CMAKE_CURRENT_SOURCE_DIR}/test_render_options.cpp
           ${CMAKE_CURRENT_SOURCE_DIR}/test_render_truth_box.cpp ${CMAKE_CURRENT_SOURCE_DIR}/test_render.cpp
           ${CMAKE_CURRENT_SOURCE_DIR}/test_render_determinism.cpp
   LIBS wingman::sim_render wingman::localizer wingman::test_support opencv_core opencv_imgproc fmt::fmt

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 #include <wingman/common/config.hpp>
+#include <wingman/sim/distractor_model.hpp>
 #include <wingman/sim/truth_box.hpp>
+#include <wingman/tools/box_relation_fit.hpp>
 #include <wingman/tools/dataset_synth.hpp>
 #include <wingman/training/yolo_dataset.hpp>
 
@@ -181,6 +183,175 @@ TEST(DatasetSynth, HorizonTargetsFlyAtTheCamerasHeight) {
   EXPECT_NE(problems[1].find("synth.horizon_elevation_max_deg"), std::string::npos) << problems[1];
 }
 
+/// The camera an image's metadata describes.
+geometry::CameraModel camera_of(const nlohmann::json& meta, int width, int height) {
+  const nlohmann::json& c = meta.at("camera");
+  const geometry::Distortion distortion = c.at("distortion_model").get<std::string>() == "equidistant"
+                                              ? geometry::Distortion::kEquidistant
+                                              : geometry::Distortion::kRadTan;
+  return geometry::CameraModel(width, height, c.at("fx").get<double>(), c.at("fy").get<double>(),
+                               c.at("cx").get<double>(), c.at("cy").get<double>(), distortion,
+                               c.at("coefficients").get<std::vector<double>>());
+}
+
+/// Every image of a dataset: split/stem -> (labels, metadata).
+std::map<std::string, std::pair<std::vector<training::LabeledBox>, nlohmann::json>> read_images(
+    const std::string& dir) {
+  std::map<std::string, std::pair<std::vector<training::LabeledBox>, nlohmann::json>> out;
+  for (const char* split : {"train", "val"}) {
+    if (!fs::is_directory(fs::path(dir) / "images" / split) || fs::is_empty(fs::path(dir) / "images" / split)) continue;
+    for (const training::DatasetImage& image : training::load_yolo_dataset(dir + "/data.yaml", split).images) {
+      const std::string stem = fs::path(image.image_path).stem().string();
+      out[std::string(split) + "/" + stem] = {image.boxes, read_meta(dir + "/meta/" + split + "/" + stem + ".json")};
+    }
+  }
+  return out;
+}
+
+TEST(DatasetSynth, DistractorsAreLabelledAsTheirClassesOrLeftAsNegatives) {
+  wingman::testing::TempDir dir;
+  const std::string keys =
+      "  distractors_max: 3\n  negative_fraction: 0.4\n  distractor_px_min: 8\n  distractor_px_max: 40\n";
+  std::ostringstream progress;
+  const auto run = [&](const std::string& name, const std::string& extra) {
+    DatasetSynthRequest request;
+    request.out_dir = dir.file(name);
+    request.count = 10;
+    request.seed = 5;
+    request.config = write_config(dir, extra);
+    return run_dataset_synth(request, progress);
+  };
+  const DatasetSynthSummary with_classes = run("classes", keys + "  distractor_classes: true\n");
+  EXPECT_EQ(with_classes.images, 10);
+  EXPECT_GT(with_classes.negatives, 0);
+  EXPECT_LT(with_classes.negatives, 10);
+  EXPECT_GT(with_classes.distractors_labelled, 0);
+  EXPECT_LE(with_classes.distractors_labelled, with_classes.distractors);
+  EXPECT_NE(with_classes.one_line().find("images without a drone"), std::string::npos) << with_classes.one_line();
+  EXPECT_EQ(training::load_yolo_dataset(dir.file("classes") + "/data.yaml", "train").class_names,
+            (std::vector<std::string>{"drone", "airplane", "bird", "helicopter"}));
+
+  // Each image: its drone's label unless it is a negative, then one label per distractor seen well enough, which is
+  // the truth box of the distractor its metadata describes (rebuilt from the spec written there).
+  const auto classes = read_images(dir.file("classes"));
+  ASSERT_EQ(classes.size(), 10u);
+  int negatives = 0, labelled = 0, unlabelled = 0;
+  for (const auto& [image, entry] : classes) {
+    const auto& [labels, meta] = entry;
+    const bool negative = !meta.contains("target");
+    negatives += negative;
+    const int drones = static_cast<int>(
+        std::count_if(labels.begin(), labels.end(), [](const training::LabeledBox& b) { return b.cls == 0; }));
+    EXPECT_EQ(drones, negative ? 0 : 1) << image;
+    const geometry::CameraModel camera = camera_of(meta, 320, 240);
+    size_t expected_labels = negative ? 0 : 1;
+    bool any_seen = false;
+    for (const nlohmann::json& d : meta.at("distractors")) {
+      sim::DistractorSpec spec;
+      spec.kind = static_cast<sim::DistractorKind>(d.at("class_id").get<int>());
+      EXPECT_EQ(d.at("kind").get<std::string>(), sim::distractor_name(spec.kind));
+      const nlohmann::json& js = d.at("spec");
+      spec.span_m = js.at("span_m").get<double>();
+      spec.length_ratio = js.at("length_ratio").get<double>();
+      spec.wing_angle_deg = js.at("wing_angle_deg").get<double>();
+      spec.colour = js.at("colour").get<std::vector<double>>();
+      spec.accent_colour = js.at("accent_colour").get<std::vector<double>>();
+      const sim::DroneModel model = sim::distractor_model(spec);
+      EXPECT_NEAR(model.bounding_radius(), d.at("bounding_radius_m").get<double>(), 1e-6);
+      const sim::RenderedBox truth = sim::TruthBoxProjector(camera).project(
+          model, pose(meta.at("T_cam_to_world")), pose(d.at("T_body_to_world")), d.at("prop_angle_rad").get<double>());
+      const nlohmann::json& box = d.at("box");
+      const bool seen = box.at("visible").get<bool>() && box.at("visible_pixels").get<int>() >= 12;
+      any_seen = any_seen || seen;
+      EXPECT_EQ(d.at("labelled").get<bool>(), seen) << image;
+      if (!seen) {
+        ++unlabelled;
+        continue;
+      }
+      ++labelled;
+      ++expected_labels;
+      ASSERT_TRUE(truth.visible) << image;
+      const int cls = static_cast<int>(spec.kind);
+      const bool found = std::any_of(labels.begin(), labels.end(), [&](const training::LabeledBox& b) {
+        return b.cls == cls && std::abs(b.cx * 320.0 - truth.cx) < 1e-3 && std::abs(b.cy * 240.0 - truth.cy) < 1e-3 &&
+               std::abs(b.w * 320.0 - truth.w) < 1e-3 && std::abs(b.h * 240.0 - truth.h) < 1e-3;
+      });
+      EXPECT_TRUE(found) << image << ": no class " << cls << " label at the distractor's truth box";
+    }
+    EXPECT_EQ(labels.size(), expected_labels) << image;
+    if (negative) {
+      EXPECT_TRUE(any_seen) << image << ": a negative shows a distractor";
+    }
+  }
+  EXPECT_EQ(negatives, with_classes.negatives);
+  EXPECT_EQ(labelled, with_classes.distractors_labelled);
+  EXPECT_EQ(labelled + unlabelled, with_classes.distractors);
+
+  // `wingman model box-relation` passes over the negatives (nothing to measure) and counts them.
+  BoxRelationRequest relation;
+  relation.data = dir.file("classes");
+  relation.check = "sphere";
+  const BoxRelationSummary measured = run_box_relation(relation, progress);
+  int val_images = 0, val_negatives = 0;
+  for (const auto& [image, entry] : classes) {
+    if (image.rfind("val/", 0) != 0) continue;
+    ++val_images;
+    val_negatives += !entry.second.contains("target");
+  }
+  EXPECT_EQ(measured.images, val_images);
+  EXPECT_EQ(measured.no_target, val_negatives);
+  if (val_negatives > 0) {
+    EXPECT_NE(measured.markdown().find("without a drone"), std::string::npos) << measured.markdown();
+  }
+
+  // Without classes: the same images (the labelling draws nothing), one class, the distractors unlabelled.
+  const DatasetSynthSummary one_class = run("one_class", keys);
+  EXPECT_EQ(one_class.distractors, with_classes.distractors);
+  EXPECT_EQ(one_class.distractors_labelled, 0);
+  const auto plain = read_images(dir.file("one_class"));
+  ASSERT_EQ(plain.size(), classes.size());
+  for (const auto& [image, entry] : plain) {
+    const auto& [labels, meta] = entry;
+    EXPECT_EQ(labels.size(), meta.contains("target") ? 1u : 0u) << image;
+    nlohmann::json expected = classes.at(image).second;  // the same metadata, nothing labelled
+    for (nlohmann::json& d : expected.at("distractors")) d["labelled"] = false;
+    EXPECT_EQ(meta.dump(), expected.dump()) << image;
+  }
+}
+
+TEST(DatasetSynth, DistractorsLeaveEachImagesDroneCameraAndSceneAlone) {
+  // Their own random stream: with distractors (no negatives) every image keeps the drone, camera and scene of the run
+  // without them, except where a distractor hid the drone and the placement was drawn again. (The drone's box may
+  // lose visible pixels behind a distractor: "box" is left out of the comparison.)
+  wingman::testing::TempDir dir;
+  std::ostringstream progress;
+  const auto run = [&](const std::string& name, const std::string& extra) {
+    DatasetSynthRequest request;
+    request.out_dir = dir.file(name);
+    request.count = 8;
+    request.seed = 9;
+    request.config = write_config(dir, extra);
+    return run_dataset_synth(request, progress);
+  };
+  const DatasetSynthSummary none = run("none", "");
+  const DatasetSynthSummary some = run("some", "  distractors_max: 4\n  distractor_px_min: 20\n");
+  EXPECT_GT(some.distractors, 0);
+  const auto a = read_images(dir.file("none")), b = read_images(dir.file("some"));
+  ASSERT_EQ(a.size(), b.size());
+  int differing = 0;
+  for (const auto& [image, entry] : a) {
+    nlohmann::json meta_b = b.at(image).second;
+    EXPECT_TRUE(meta_b.contains("distractors")) << image;
+    EXPECT_FALSE(entry.second.contains("distractors")) << image << ": none asked for";
+    nlohmann::json meta_a = entry.second;
+    meta_b.erase("distractors");
+    meta_b.erase("box");
+    meta_a.erase("box");
+    if (meta_b.dump() != meta_a.dump()) ++differing;
+  }
+  EXPECT_LE(differing, some.redrawn - none.redrawn);
+}
+
 TEST(DatasetSynth, SameSeedSameBytesOtherSeedOtherImages) {
   wingman::testing::TempDir dir;
   const std::string config = write_config(dir, "  image_format: jpg\n");
@@ -230,6 +401,19 @@ TEST(DatasetSynth, ErrorsNameTheKeyOrTheFolder) {
     EXPECT_NE(std::string(e.what()).find("already holds a dataset"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(DatasetSynthConfig{}.validate().empty());
+
+  DatasetSynthConfig config;
+  config.distractors_max = 17;
+  config.distractor_px_min = 50.0;
+  config.distractor_px_max = 10.0;
+  EXPECT_EQ(config.validate().size(), 2u);
+  config.distractors_max = 0;
+  config.distractor_px_max = 80.0;
+  config.negative_fraction = 0.5;
+  const std::vector<std::string> problems = config.validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("synth.negative_fraction"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[0].find("synth.distractors_max"), std::string::npos) << problems[0];
 }
 
 TEST(DatasetSynth, CommandLineWritesTheDatasetAndProgressOnlyForALongJob) {

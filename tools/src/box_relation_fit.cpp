@@ -159,10 +159,11 @@ localizer::BoxRelation::Grid fit_grid(const std::vector<double>& size_edges, con
 std::string BoxRelationSummary::markdown() const {
   std::string s = fmt::format(
       "{} images: {} targets found by the detector (IoU with the outline box >= the threshold), {} not found, {} "
-      "skipped (cut by the image border){}\n\n",
+      "skipped (cut by the image border){}{}\n\n",
       images, matched, unmatched, skipped_truncated,
       not_searched > 0 ? fmt::format(", {} not searched by a window (the single pass sees them well)", not_searched)
-                       : "");
+                       : std::string(),
+      no_target > 0 ? fmt::format(", {} without a drone", no_target) : std::string());
   s += fmt::format("Range error (range / true range - 1), the airframe's true bounding radius, exact localizer:\n\n");
   s += "| boxes | n | sphere (ratio 1): median | MAD | " + relation_name + ": median | MAD | |error| p90 |\n";
   s += "|---|---|---|---|---|---|---|\n";
@@ -254,6 +255,10 @@ BoxRelationSummary run_box_relation(const BoxRelationRequest& rq, std::ostream& 
     }
     ++summary.images;
     try {
+      if (!meta.contains("target") && meta.contains("distractors")) {  // a negative: distractors only
+        ++summary.no_target;
+        continue;
+      }
       if (!meta.contains("sphere_box") || meta["sphere_box"].is_null())
         throw std::runtime_error("sphere_box: missing (render the set with this version of `wingman dataset synth`)");
       if (meta.at("box").at("truncated").get<bool>()) {

@@ -13,6 +13,7 @@
 #include <wingman/common/progress.hpp>
 #include <wingman/geometry/camera_model.hpp>
 #include <wingman/geometry/sphere_projection.hpp>
+#include <wingman/sim/distractor_model.hpp>
 #include <wingman/sim/drone_model.hpp>
 #include <wingman/sim/renderer.hpp>
 #include <wingman/sim/truth_box.hpp>
@@ -40,7 +41,12 @@ constexpr int kMaxPlacements = 50;  // attempts to place a visible target in one
 using Random = SynthRandom;
 
 // Random streams: one per purpose, so that adding a draw in one place leaves the others alone.
-enum SynthStream : uint64_t { kCameraStream = 1, kImageStream = 2 };
+enum SynthStream : uint64_t {
+  kCameraStream = 1,
+  kImageStream = 2,
+  kNegativeStream = 3,    // per image: whether it is a negative
+  kDistractorStream = 4,  // per placement attempt: the distractors
+};
 
 using Colour = std::vector<double>;
 
@@ -170,6 +176,93 @@ Eigen::Isometry3d random_camera_pose(const DatasetSynthConfig& c, Random& rng) {
   return T;
 }
 
+const std::vector<Colour> kAircraft = {{0.92, 0.92, 0.93}, {0.85, 0.86, 0.88}, {0.7, 0.72, 0.75},
+                                       {0.95, 0.95, 0.9},  {0.3, 0.32, 0.35},  {0.8, 0.12, 0.1}};
+const std::vector<Colour> kBirdColours = {{0.05, 0.05, 0.05}, {0.15, 0.13, 0.12}, {0.35, 0.28, 0.2},
+                                          {0.5, 0.5, 0.5},    {0.9, 0.9, 0.9},    {0.55, 0.45, 0.3}};
+const std::vector<Colour> kHelicopter = {{0.92, 0.92, 0.92}, {0.8, 0.1, 0.1}, {0.9, 0.8, 0.1},  {0.1, 0.25, 0.6},
+                                         {0.2, 0.25, 0.15},  {0.1, 0.1, 0.1}, {0.95, 0.5, 0.05}};
+constexpr double kDistractorMaxRangeM = 4000.0;  // the renderer clips at 5 km
+
+/// A distractor's shape: its kind's span, proportions and colours.
+sim::DistractorSpec random_distractor(Random& rng) {
+  sim::DistractorSpec s;
+  s.kind = static_cast<sim::DistractorKind>(1 + static_cast<int>(rng.index(3)));
+  switch (s.kind) {
+    case sim::DistractorKind::kAirplane:
+      s.span_m = rng.log_uniform(9.0, 60.0);
+      s.length_ratio = rng.uniform(0.75, 1.1);
+      s.wing_angle_deg = rng.uniform(0.0, 7.0);  // dihedral
+      s.colour = pick(rng, kAircraft);
+      s.accent_colour = rng.chance(0.6) ? s.colour : pick(rng, kAircraft);
+      break;
+    case sim::DistractorKind::kBird:
+      s.span_m = rng.log_uniform(0.25, 1.8);
+      s.length_ratio = rng.uniform(0.3, 0.55);
+      s.wing_angle_deg = rng.uniform(-45.0, 60.0);  // the wing beat at the exposure
+      s.colour = pick(rng, kBirdColours);
+      s.accent_colour = rng.chance(0.5) ? s.colour : pick(rng, kBirdColours);
+      break;
+    case sim::DistractorKind::kHelicopter:
+      s.span_m = rng.log_uniform(8.0, 16.0);
+      s.length_ratio = rng.uniform(0.95, 1.2);
+      s.colour = pick(rng, kHelicopter);
+      s.accent_colour = pick(rng, {{0.1, 0.1, 0.1}, {0.3, 0.3, 0.3}, {0.6, 0.6, 0.6}});
+      break;
+  }
+  return s;
+}
+
+/// One distractor of an image.
+struct Distractor {
+  sim::DistractorSpec spec;
+  std::shared_ptr<const sim::DroneModel> model;
+  sim::DroneInstance instance;
+};
+
+/// Up to `count` distractors seen by `camera` from `T_cam_to_world`, each at a random pixel with a random apparent
+/// span in pixels, above the ground, nearer than kDistractorMaxRangeM; a distractor that cannot be placed in 20 draws
+/// is left out.
+std::vector<Distractor> place_distractors(const DatasetSynthConfig& c, const geometry::CameraModel& camera,
+                                          const sim::TruthBoxProjector& fov, const Eigen::Isometry3d& T_cam_to_world,
+                                          size_t count, Random& rng) {
+  std::vector<Distractor> out;
+  for (size_t k = 0; k < count; ++k) {
+    Distractor d;
+    d.spec = random_distractor(rng);
+    d.model = std::make_shared<const sim::DroneModel>(sim::distractor_model(d.spec));
+    const double radius = d.model->bounding_radius();
+    bool placed = false;
+    for (int attempt = 0; attempt < 20 && !placed; ++attempt) {
+      const Eigen::Vector2d uv(rng.uniform(-0.5, c.width - 0.5), rng.uniform(-0.5, c.height - 0.5));
+      const double px = rng.log_uniform(c.distractor_px_min, c.distractor_px_max);
+      const double range = d.spec.span_m * camera.fx() / px;
+      const Eigen::Vector3d ray = camera.unproject(uv);
+      if (!ray.allFinite() || !fov.in_field_of_view(ray) || range + radius > kDistractorMaxRangeM) continue;
+      const Eigen::Vector3d p_in_world = T_cam_to_world * (ray.normalized() * range);
+      if (p_in_world.z() < radius + 0.3) continue;  // under the ground
+      d.instance.T_body_to_world.translation() = p_in_world;
+      placed = true;
+    }
+    if (!placed) continue;
+    // Level flight, banking and pitching a little; velocity along the body's nose (motion blur).
+    const double yaw = rng.uniform(-kSynthPi, kSynthPi);
+    const double roll = rng.uniform(-35.0, 35.0) * kSynthDeg, pitch = rng.uniform(-10.0, 10.0) * kSynthDeg;
+    d.instance.T_body_to_world.linear() =
+        (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    const double speed = d.spec.kind == sim::DistractorKind::kAirplane ? rng.uniform(40.0, 150.0)
+                         : d.spec.kind == sim::DistractorKind::kBird   ? rng.uniform(5.0, 15.0)
+                                                                       : rng.uniform(0.0, 50.0);
+    d.instance.v_body_in_world = d.instance.T_body_to_world.linear().col(0) * speed;
+    d.instance.prop_angle_rad = rng.uniform(0.0, 2.0 * kSynthPi);
+    d.instance.prop_rate_rad_s = d.spec.kind == sim::DistractorKind::kHelicopter ? rng.uniform(25.0, 45.0) : 0.0;
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 common::Json vec_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 common::Json quat_json(const Eigen::Matrix3d& R) {
@@ -286,12 +379,24 @@ std::vector<std::string> DatasetSynthConfig::validate() const {
   if (jpeg_quality < 1 || jpeg_quality > 100)
     p.push_back(problem("synth.jpeg_quality", jpeg_quality, "must be in 1..100"));
   if (min_visible_pixels < 1) p.push_back(problem("synth.min_visible_pixels", min_visible_pixels, "must be >= 1"));
+  if (distractors_max < 0 || distractors_max > 16)
+    p.push_back(problem("synth.distractors_max", distractors_max, "must be in 0..16"));
+  range("synth.distractor_px_min", distractor_px_min, "synth.distractor_px_max", distractor_px_max, 1.0, 2000.0);
+  fraction("synth.negative_fraction", negative_fraction);
+  if (negative_fraction > 0.0 && distractors_max < 1)
+    p.push_back(problem("synth.negative_fraction", negative_fraction,
+                        "needs synth.distractors_max >= 1 (a negative image shows distractors only)"));
   return p;
 }
 
 std::string DatasetSynthSummary::one_line() const {
-  return fmt::format("wrote {} images ({} train, {} val) to {} in {:.1f} s ({:.2f} images/s, {} placements redrawn)",
-                     images, train, val, out_dir, seconds, seconds > 0.0 ? images / seconds : 0.0, redrawn);
+  std::string line =
+      fmt::format("wrote {} images ({} train, {} val) to {} in {:.1f} s ({:.2f} images/s, {} placements redrawn)",
+                  images, train, val, out_dir, seconds, seconds > 0.0 ? images / seconds : 0.0, redrawn);
+  if (distractors > 0 || negatives > 0)
+    line += fmt::format(", {} distractors ({} labelled), {} images without a drone", distractors, distractors_labelled,
+                        negatives);
+  return line;
 }
 
 namespace {
@@ -355,6 +460,11 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
     Random rng(request.seed, kImageStream, static_cast<uint64_t>(i));
     const std::string split = rng.chance(config.val_fraction) ? "val" : "train";
     const std::string name = fmt::format("{:06d}", i);
+    bool negative = false;  // no drone, distractors only
+    if (config.negative_fraction > 0.0) {
+      Random negative_rng(request.seed, kNegativeStream, static_cast<uint64_t>(i));
+      negative = negative_rng.chance(config.negative_fraction);
+    }
     bool done = false;
     for (int attempt = 0; attempt < kMaxPlacements && !done; ++attempt) {
       Camera& camera = cameras[rng.index(cameras.size())];
@@ -400,14 +510,41 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
       const uint64_t frame_seed = rng.next();
       const bool placeable = ray.allFinite() && camera.field_of_view.in_field_of_view(ray) &&
                              target.T_body_to_world.translation().z() > model->bounding_radius() + 0.3;
-      if (!placeable) {
+      if (!negative && !placeable) {
+        ++summary.redrawn;
+        continue;
+      }
+      // The distractors, from a stream of their own (nothing is drawn without them).
+      std::vector<Distractor> distractors;
+      if (config.distractors_max > 0) {
+        Random distractor_rng(request.seed, kDistractorStream,
+                              static_cast<uint64_t>(i) * kMaxPlacements + static_cast<uint64_t>(attempt));
+        const auto max = static_cast<size_t>(config.distractors_max);
+        const size_t n = negative ? 1 + distractor_rng.index(max) : distractor_rng.index(max + 1);
+        distractors = place_distractors(config, camera.model, camera.field_of_view, T_cam_to_world, n, distractor_rng);
+      }
+      std::vector<sim::DroneInstance> instances;
+      if (!negative) instances.push_back(target);
+      for (size_t k = 0; k < distractors.size(); ++k) {
+        distractors[k].instance.vehicle_id = static_cast<int>(2 + k);
+        distractors[k].instance.model = distractors[k].model.get();
+        instances.push_back(distractors[k].instance);
+      }
+      if (instances.empty()) {  // a negative whose distractors found no place
         ++summary.redrawn;
         continue;
       }
       camera.renderer->set_options(scene);
-      const sim::RenderResult result = camera.renderer->render(T_cam_to_world, {target}, 0, frame_seed, motion);
-      const sim::RenderedBox& box = result.boxes[0];
-      if (!box.visible || box.visible_pixels < config.min_visible_pixels) {
+      const sim::RenderResult result = camera.renderer->render(T_cam_to_world, instances, 0, frame_seed, motion);
+      const size_t first_distractor = negative ? 0 : 1;
+      const auto seen = [&](const sim::RenderedBox& b) {
+        return b.visible && b.visible_pixels >= config.min_visible_pixels;
+      };
+      if (!negative && !seen(result.boxes[0])) {
+        ++summary.redrawn;
+        continue;
+      }
+      if (negative && std::none_of(result.boxes.begin(), result.boxes.end(), seen)) {
         ++summary.redrawn;
         continue;
       }
@@ -418,13 +555,50 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
                                           : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 3};
       if (!cv::imwrite(image_path, result.bgr, params))
         throw std::runtime_error(image_path + ": cannot write the image");
-      training::LabeledBox label;
-      label.cls = 0;
-      label.cx = static_cast<float>(box.cx / config.width);
-      label.cy = static_cast<float>(box.cy / config.height);
-      label.w = static_cast<float>(box.w / config.width);
-      label.h = static_cast<float>(box.h / config.height);
-      training::write_yolo_labels((out / "labels" / split / (name + ".txt")).string(), {label});
+      const auto label_of = [&](int cls, const sim::RenderedBox& b) {
+        training::LabeledBox label;
+        label.cls = cls;
+        label.cx = static_cast<float>(b.cx / config.width);
+        label.cy = static_cast<float>(b.cy / config.height);
+        label.w = static_cast<float>(b.w / config.width);
+        label.h = static_cast<float>(b.h / config.height);
+        return label;
+      };
+      std::vector<training::LabeledBox> labels;
+      if (!negative) labels.push_back(label_of(0, result.boxes[0]));
+      common::Json distractors_json = common::Json::array();
+      for (size_t k = 0; k < distractors.size(); ++k) {
+        const Distractor& d = distractors[k];
+        const sim::RenderedBox& b = result.boxes[first_distractor + k];
+        const bool labelled = config.distractor_classes && seen(b);
+        if (labelled) labels.push_back(label_of(static_cast<int>(d.spec.kind), b));
+        summary.distractors_labelled += labelled;
+        distractors_json.push_back({{"kind", sim::distractor_name(d.spec.kind)},
+                                    {"class_id", static_cast<int>(d.spec.kind)},
+                                    {"spec",
+                                     {{"span_m", d.spec.span_m},
+                                      {"length_ratio", d.spec.length_ratio},
+                                      {"wing_angle_deg", d.spec.wing_angle_deg},
+                                      {"colour", d.spec.colour},
+                                      {"accent_colour", d.spec.accent_colour}}},
+                                    {"bounding_radius_m", d.model->bounding_radius()},
+                                    {"T_body_to_world",
+                                     {{"p", vec_json(d.instance.T_body_to_world.translation())},
+                                      {"q_wxyz", quat_json(d.instance.T_body_to_world.linear())}}},
+                                    {"prop_angle_rad", d.instance.prop_angle_rad},
+                                    {"range_m", b.range_m},
+                                    {"box",
+                                     {{"cx", b.cx},
+                                      {"cy", b.cy},
+                                      {"w", b.w},
+                                      {"h", b.h},
+                                      {"visible", b.visible},
+                                      {"truncated", b.truncated},
+                                      {"visible_pixels", b.visible_pixels}}},
+                                    {"labelled", labelled}});
+      }
+      summary.distractors += static_cast<int>(distractors.size());
+      training::write_yolo_labels((out / "labels" / split / (name + ".txt")).string(), labels);
 
       const geometry::CameraModel& cam = camera.model;
       const Eigen::Vector3d p_target_in_cam = T_cam_to_world.inverse() * target.T_body_to_world.translation();
@@ -442,23 +616,27 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
                      {"coefficients", cam.coefficients()}};
       j["T_cam_to_world"] = {{"p", vec_json(T_cam_to_world.translation())},
                              {"q_wxyz", quat_json(T_cam_to_world.linear())}};
-      j["target"] = {{"airframe", model->name()},
-                     {"spec", spec_json(spec)},
-                     {"bounding_radius_m", model->bounding_radius()},
-                     {"frame_radius_m", model->frame_radius()},
-                     {"T_body_to_world",
-                      {{"p", vec_json(target.T_body_to_world.translation())},
-                       {"q_wxyz", quat_json(target.T_body_to_world.linear())}}},
-                     {"prop_angle_rad", target.prop_angle_rad},
-                     {"p_target_in_cam", vec_json(p_target_in_cam)},
-                     {"range_m", box.range_m}};
-      j["box"] = {{"cx", box.cx},
-                  {"cy", box.cy},
-                  {"w", box.w},
-                  {"h", box.h},
-                  {"truncated", box.truncated},
-                  {"visible_pixels", box.visible_pixels}};
-      j["sphere_box"] = sphere_box_json(cam, p_target_in_cam, model->bounding_radius());
+      if (!negative) {
+        const sim::RenderedBox& box = result.boxes[0];
+        j["target"] = {{"airframe", model->name()},
+                       {"spec", spec_json(spec)},
+                       {"bounding_radius_m", model->bounding_radius()},
+                       {"frame_radius_m", model->frame_radius()},
+                       {"T_body_to_world",
+                        {{"p", vec_json(target.T_body_to_world.translation())},
+                         {"q_wxyz", quat_json(target.T_body_to_world.linear())}}},
+                       {"prop_angle_rad", target.prop_angle_rad},
+                       {"p_target_in_cam", vec_json(p_target_in_cam)},
+                       {"range_m", box.range_m}};
+        j["box"] = {{"cx", box.cx},
+                    {"cy", box.cy},
+                    {"w", box.w},
+                    {"h", box.h},
+                    {"truncated", box.truncated},
+                    {"visible_pixels", box.visible_pixels}};
+        j["sphere_box"] = sphere_box_json(cam, p_target_in_cam, model->bounding_radius());
+      }
+      if (config.distractors_max > 0) j["distractors"] = distractors_json;
       j["render"] = {{"scene_seed", scene.seed},
                      {"exposure_gain", result.exposure_gain},
                      {"noise_std", scene.noise_std},
@@ -471,6 +649,7 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
       if (!meta) throw std::runtime_error(meta_path + ": cannot write the metadata");
       ++summary.images;
       ++(split == "val" ? summary.val : summary.train);
+      summary.negatives += negative;
       done = true;
     }
     if (!done) {
@@ -483,7 +662,9 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
   }
   images.finish();
   training::write_data_yaml(
-      (out / "data.yaml").string(), {"drone"},
+      (out / "data.yaml").string(),
+      config.distractor_classes ? std::vector<std::string>{"drone", "airplane", "bird", "helicopter"}
+                                : std::vector<std::string>{"drone"},
       {"written by wingman dataset synth", fmt::format("seed {}, {} images", request.seed, request.count)});
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

@@ -69,6 +69,8 @@ struct BoxRelationSummary {
   int64_t images = 0, matched = 0, unmatched = 0, skipped_truncated = 0;
   /// pass "window": targets the windows would not search (the single pass sees them over windows.max_net_px)
   int64_t not_searched = 0;
+  /// images without a drone (`wingman dataset synth`'s synth.negative_fraction): nothing to measure
+  int64_t no_target = 0;
   /// Relative range error with the sphere relation (ratio 1: the radius taken as is) and with the relation
   /// fitted or checked, overall, per airframe and per true-range bin ("2-5 m", ..., "40+ m").
   RangeErrorStats sphere_all, relation_all;

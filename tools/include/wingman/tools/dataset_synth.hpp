@@ -54,7 +54,24 @@ struct DatasetSynthConfig {
   /// other targets are anywhere in the image. 0 draws exactly the images of earlier versions.
   double horizon_fraction = 0.0;
   double horizon_elevation_max_deg = 3.0;  ///< elevation of those targets seen from the camera, within +-this, degrees
-  sim::RenderOptions render;               ///< base scene and sensor options (render.*)
+  /// Distractors per image (sim::distractor_model: procedural airplanes, birds and helicopters, each kind equally
+  /// likely): between 0 and this many, uniform, placed anywhere in the image in front of the sky or the ground. They
+  /// draw from a random stream of their own: the drone, camera and scene of each image stay those of a run without
+  /// them, and 0 (with negative_fraction 0) draws exactly the images of earlier versions.
+  int distractors_max = 0;
+  /// Their apparent size, wing span or rotor diameter in pixels (fx x span / range), log-uniform in
+  /// [distractor_px_min, distractor_px_max]; the range follows from the kind's span (airplanes 9-60 m, birds
+  /// 0.25-1.8 m, helicopter rotors 8-16 m) and stays under 4 km (the renderer's far plane is 5 km).
+  double distractor_px_min = 6.0;
+  double distractor_px_max = 80.0;
+  /// Label them as classes 1 (airplane), 2 (bird), 3 (helicopter), as the Halmstad import's --distractor-classes
+  /// does (data.yaml names four classes); false: left unlabelled, hard negatives for a one-class detector. A
+  /// distractor is labelled when seen at min_visible_pixels pixel centres or more.
+  bool distractor_classes = false;
+  /// Share of images without a drone: 1 to distractors_max distractors only, at least one of them seen at
+  /// min_visible_pixels (their metadata has no "target"). Needs distractors_max >= 1.
+  double negative_fraction = 0.0;
+  sim::RenderOptions render;  ///< base scene and sensor options (render.*)
 
   template <class V>
   void visit(V& v) {
@@ -90,6 +107,13 @@ struct DatasetSynthConfig {
     v("synth.horizon_fraction", horizon_fraction, "share of targets at about the camera's height (on the horizon)");
     v("synth.horizon_elevation_max_deg", horizon_elevation_max_deg,
       "those targets' elevation seen from the camera, within +-this, degrees");
+    v("synth.distractors_max", distractors_max,
+      "airplanes, birds and helicopters per image: 0 to this many (0: none, the images of earlier versions)");
+    v("synth.distractor_px_min", distractor_px_min, "distractor span in pixels, lower end (log-uniform)");
+    v("synth.distractor_px_max", distractor_px_max, "distractor span in pixels, upper end");
+    v("synth.distractor_classes", distractor_classes,
+      "label distractors as classes 1 airplane, 2 bird, 3 helicopter (false: unlabelled negatives)");
+    v("synth.negative_fraction", negative_fraction, "share of images without a drone, distractors only");
     render.visit(v);
   }
   /// Every problem, as "synth.key = value: rule" (and render.*), empty when valid.
@@ -108,26 +132,35 @@ struct DatasetSynthRequest {
 /// What a run wrote.
 struct DatasetSynthSummary {
   std::string out_dir;
-  int images = 0;   ///< images written (each with exactly one drone label)
-  int train = 0;    ///< of which in images/train
-  int val = 0;      ///< of which in images/val
-  int redrawn = 0;  ///< target placements drawn again because the drone was not visible enough
+  int images = 0;     ///< images written (each with one drone label, but the negatives)
+  int train = 0;      ///< of which in images/train
+  int val = 0;        ///< of which in images/val
+  int negatives = 0;  ///< of which without a drone (synth.negative_fraction)
+  int redrawn = 0;  ///< placements drawn again because the drone (a negative: every distractor) was not visible enough
+  int distractors = 0;           ///< distractors rendered
+  int distractors_labelled = 0;  ///< of which labelled (synth.distractor_classes, seen at min_visible_pixels)
   double seconds = 0.0;
-  /// "wrote 1000 images (900 train, 100 val) to DIR in 812.3 s (1.23 images/s, 57 placements redrawn)".
+  /// "wrote 1000 images (900 train, 100 val) to DIR in 812.3 s (1.23 images/s, 57 placements redrawn)", and with
+  /// distractors ", 1480 distractors (1020 labelled), 200 images without a drone".
   std::string one_line() const;
 };
 
 /// Renders the dataset:
 ///  - `images/{train,val}/NNNNNN.<png|jpg>`;
 ///  - `labels/{train,val}/NNNNNN.txt`: one line `0 cx cy w h` (YOLO: centre and size over the image size; the box is
-///    the drone's exact projected box, sim::RenderedBox);
+///    the drone's exact projected box, sim::RenderedBox), none in a negative image; with synth.distractor_classes,
+///    one line `k cx cy w h` per distractor seen well enough (k = sim::DistractorKind);
 ///  - `meta/{train,val}/NNNNNN.json`: camera model, camera pose, target airframe (its full DroneSpec, or mesh file)
-///    and pose, position in the camera frame, range, box in pixels, exposure, blur and noise;
-///  - `data.yaml` (path, train, val, nc: 1, names: [drone]).
-/// Every image shows one drone seen at min_visible_pixels pixel centres or more: a placement where it is hidden or
-/// too small is drawn again (counted in `redrawn`), so there are no empty labels. Image i depends only on the seed,
-/// the config, the meshes and i. Progress lines go to `progress` about once a second.
-/// Throws common::ConfigError for a bad config, std::runtime_error naming the file or folder for I/O problems.
+///    and pose, position in the camera frame, range, box in pixels, exposure, blur and noise (a negative image has no
+///    "target"); "distractors": each one's kind, class, DistractorSpec, pose, rotor angle, range, box and whether it
+///    was labelled;
+///  - `data.yaml` (path, train, val, nc: 1, names: [drone]; with synth.distractor_classes nc: 4, names: [drone,
+///    airplane, bird, helicopter]).
+/// Every image but the negatives shows one drone seen at min_visible_pixels pixel centres or more (distractors may
+/// hide part of it): a placement where it is hidden or too small is drawn again (counted in `redrawn`), so only the
+/// negatives lack a drone label; a negative is drawn again until one of its distractors is seen that well. Image i
+/// depends only on the seed, the config, the meshes and i. Progress lines go to `progress` about once a second. Throws
+/// common::ConfigError for a bad config, std::runtime_error naming the file or folder for I/O problems.
 DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, std::ostream& progress);
 /// The same with `config` (validated) in place of the file `request.config` (the CLI's layers: --config, --set).
 DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const DatasetSynthConfig& config,
