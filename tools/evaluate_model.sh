@@ -94,7 +94,7 @@ for kind in 1:AIRPLANE 2:BIRD 3:HELICOPTER; do
   (cd "$data/distractors/labels/val" && grep -l "^${kind%%:*} " -- *.txt) |
     sed "s|^\(.*\)\.txt\$|$data/distractors/images/val/\1.jpg|" > "$out/distractors_${kind#*:}.txt"
   "$bin/wingman" dataset mix --out "$out/distractors_${kind#*:}.yaml" --path "$out" --val "distractors_${kind#*:}.txt" \
-    > /dev/null
+    --names drone airplane bird helicopter > /dev/null
   val "distractors_${kind#*:}" "$out/distractors_${kind#*:}.yaml"
 done
 # The held-out training flight (tools/train_model.sh stage 3: flight 7 of seed 1, never trained on), when present.

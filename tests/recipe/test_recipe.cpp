@@ -135,6 +135,13 @@ TEST(Recipe, TheShippedRecipesLoad) {
   const Recipe d = load_recipe(source_path("config/training/wingman-small-distractors.yaml"), {}, src());
   ASSERT_EQ(d.stages.size(), 1u);
   EXPECT_EQ(d.stages[0].widen.classes, 4);
+  // The one-class fine-tune with rendered distractors: stage 8's box loss, from the shipped weights, its negatives
+  // rendered by the distractor config.
+  const Recipe n = load_recipe(source_path("config/training/wingman-small-synth-negatives.yaml"), {}, src());
+  ASSERT_EQ(n.stages.size(), 1u);
+  EXPECT_EQ(n.stages[0].iou_loss, "ciou");
+  EXPECT_THAT(n.stages[0].init, ::testing::ElementsAre(src() + "/models/wingman-small.weights"));
+  EXPECT_EQ(n.dataset("synth-negatives")->config, src() + "/config/datasets/distractors_train.yaml");
 }
 
 TEST(Recipe, SetChangesAStagesKeyOrATopLevelOne) {
