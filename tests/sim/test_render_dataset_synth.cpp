@@ -81,6 +81,17 @@ sim::DroneSpec spec_from(const nlohmann::json& node) {
   return common::load_options_from_string<DroneSection>("drone: " + node.dump(), "metadata spec").drone;
 }
 
+/// The camera an image's metadata describes.
+geometry::CameraModel camera_of(const nlohmann::json& meta, int width, int height) {
+  const nlohmann::json& c = meta.at("camera");
+  const geometry::Distortion distortion = c.at("distortion_model").get<std::string>() == "equidistant"
+                                              ? geometry::Distortion::kEquidistant
+                                              : geometry::Distortion::kRadTan;
+  return geometry::CameraModel(width, height, c.at("fx").get<double>(), c.at("fy").get<double>(),
+                               c.at("cx").get<double>(), c.at("cy").get<double>(), distortion,
+                               c.at("coefficients").get<std::vector<double>>());
+}
+
 TEST(DatasetSynth, WritesAYoloDatasetWhoseLabelsAreTheTruthBoxesOfItsMetadata) {
   wingman::testing::TempDir dir;
   DatasetSynthRequest request;
@@ -114,13 +125,7 @@ TEST(DatasetSynth, WritesAYoloDatasetWhoseLabelsAreTheTruthBoxesOfItsMetadata) {
       // The metadata: camera, poses, airframe; the label is the truth box of that scene.
       const fs::path stem = fs::path(image.image_path).stem();
       const nlohmann::json meta = read_meta(request.out_dir + "/meta/" + split + "/" + stem.string() + ".json");
-      const nlohmann::json& c = meta.at("camera");
-      const std::string model = c.at("distortion_model").get<std::string>();
-      const geometry::Distortion distortion =
-          model == "equidistant" ? geometry::Distortion::kEquidistant : geometry::Distortion::kRadTan;
-      const geometry::CameraModel camera(320, 240, c.at("fx").get<double>(), c.at("fy").get<double>(),
-                                         c.at("cx").get<double>(), c.at("cy").get<double>(), distortion,
-                                         c.at("coefficients").get<std::vector<double>>());
+      const geometry::CameraModel camera = camera_of(meta, 320, 240);
       const nlohmann::json& target = meta.at("target");
       const sim::DroneSpec spec = spec_from(target.at("spec"));
       const sim::DroneModel drone = sim::DroneModel::from_spec(spec);
@@ -181,17 +186,6 @@ TEST(DatasetSynth, HorizonTargetsFlyAtTheCamerasHeight) {
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_NE(problems[0].find("synth.horizon_fraction"), std::string::npos) << problems[0];
   EXPECT_NE(problems[1].find("synth.horizon_elevation_max_deg"), std::string::npos) << problems[1];
-}
-
-/// The camera an image's metadata describes.
-geometry::CameraModel camera_of(const nlohmann::json& meta, int width, int height) {
-  const nlohmann::json& c = meta.at("camera");
-  const geometry::Distortion distortion = c.at("distortion_model").get<std::string>() == "equidistant"
-                                              ? geometry::Distortion::kEquidistant
-                                              : geometry::Distortion::kRadTan;
-  return geometry::CameraModel(width, height, c.at("fx").get<double>(), c.at("fy").get<double>(),
-                               c.at("cx").get<double>(), c.at("cy").get<double>(), distortion,
-                               c.at("coefficients").get<std::vector<double>>());
 }
 
 /// Every image of a dataset: split/stem -> (labels, metadata).
