@@ -57,7 +57,8 @@ struct DatasetSynthConfig {
   /// Distractors per image (sim::distractor_model: procedural airplanes, birds and helicopters, each kind equally
   /// likely): between 0 and this many, uniform, placed anywhere in the image in front of the sky or the ground. They
   /// draw from a random stream of their own: the drone, camera and scene of each image stay those of a run without
-  /// them, and 0 (with negative_fraction 0) draws exactly the images of earlier versions.
+  /// them (unless one hides the drone: the placement is then drawn again), and 0 (with negative_fraction 0) draws
+  /// exactly the images of earlier versions.
   int distractors_max = 0;
   /// Their apparent size, wing span or rotor diameter in pixels (fx x span / range), log-uniform in
   /// [distractor_px_min, distractor_px_max]; the range follows from the kind's span (airplanes 9-60 m, birds
