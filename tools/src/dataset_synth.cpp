@@ -9,6 +9,7 @@
 #include "verb_layers.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/common/detection_class.hpp>
 #include <wingman/common/json.hpp>
 #include <wingman/common/progress.hpp>
 #include <wingman/geometry/camera_model.hpp>
@@ -264,6 +265,16 @@ std::vector<Distractor> place_distractors(const DatasetSynthConfig& c, const geo
 }
 
 common::Json vec_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+/// A rendered box in the metadata: centre and size in pixels, truncated, visible pixels.
+common::Json box_json(const sim::RenderedBox& b) {
+  return {{"cx", b.cx},
+          {"cy", b.cy},
+          {"w", b.w},
+          {"h", b.h},
+          {"truncated", b.truncated},
+          {"visible_pixels", b.visible_pixels}};
+}
 
 common::Json quat_json(const Eigen::Matrix3d& R) {
   const Eigen::Quaterniond q(R);
@@ -587,15 +598,9 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
                                       {"q_wxyz", quat_json(d.instance.T_body_to_world.linear())}}},
                                     {"prop_angle_rad", d.instance.prop_angle_rad},
                                     {"range_m", b.range_m},
-                                    {"box",
-                                     {{"cx", b.cx},
-                                      {"cy", b.cy},
-                                      {"w", b.w},
-                                      {"h", b.h},
-                                      {"visible", b.visible},
-                                      {"truncated", b.truncated},
-                                      {"visible_pixels", b.visible_pixels}}},
+                                    {"box", box_json(b)},
                                     {"labelled", labelled}});
+        distractors_json.back()["box"]["visible"] = b.visible;
       }
       summary.distractors += static_cast<int>(distractors.size());
       training::write_yolo_labels((out / "labels" / split / (name + ".txt")).string(), labels);
@@ -628,12 +633,7 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
                        {"prop_angle_rad", target.prop_angle_rad},
                        {"p_target_in_cam", vec_json(p_target_in_cam)},
                        {"range_m", box.range_m}};
-        j["box"] = {{"cx", box.cx},
-                    {"cy", box.cy},
-                    {"w", box.w},
-                    {"h", box.h},
-                    {"truncated", box.truncated},
-                    {"visible_pixels", box.visible_pixels}};
+        j["box"] = box_json(box);
         j["sphere_box"] = sphere_box_json(cam, p_target_in_cam, model->bounding_radius());
       }
       if (config.distractors_max > 0) j["distractors"] = distractors_json;
@@ -663,8 +663,9 @@ DatasetSynthSummary run_dataset_synth(const DatasetSynthRequest& request, const 
   images.finish();
   training::write_data_yaml(
       (out / "data.yaml").string(),
-      config.distractor_classes ? std::vector<std::string>{"drone", "airplane", "bird", "helicopter"}
-                                : std::vector<std::string>{"drone"},
+      config.distractor_classes
+          ? std::vector<std::string>(common::kDetectionClassNames.begin(), common::kDetectionClassNames.end())
+          : std::vector<std::string>{common::kDetectionClassNames[common::kDroneClassId]},
       {"written by wingman dataset synth", fmt::format("seed {}, {} images", request.seed, request.count)});
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

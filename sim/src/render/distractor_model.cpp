@@ -6,6 +6,7 @@
 #include "mesh_builder.hpp"
 
 #include <wingman/common/config.hpp>
+#include <wingman/common/detection_class.hpp>
 
 #include <fmt/format.h>
 
@@ -159,15 +160,8 @@ void build_helicopter(detail::MeshBuilder& mb, std::vector<Propeller>& propeller
 }  // namespace
 
 const char* distractor_name(DistractorKind kind) {
-  switch (kind) {
-    case DistractorKind::kAirplane:
-      return "airplane";
-    case DistractorKind::kBird:
-      return "bird";
-    case DistractorKind::kHelicopter:
-      return "helicopter";
-  }
-  return "unknown";
+  const int k = static_cast<int>(kind);
+  return k >= 1 && k <= 3 ? common::kDetectionClassNames[k] : "unknown";
 }
 
 std::vector<std::string> DistractorSpec::validate() const {

@@ -13,7 +13,7 @@ namespace wingman::sim {
 /// The kinds, numbered as the detector's classes (0 is the drone): 1 airplane, 2 bird, 3 helicopter.
 enum class DistractorKind : int { kAirplane = 1, kBird = 2, kHelicopter = 3 };
 
-/// "airplane", "bird" or "helicopter".
+/// "airplane", "bird" or "helicopter": the class name of common::kDetectionClassNames ("unknown" for another value).
 const char* distractor_name(DistractorKind kind);
 
 /// One distractor's shape. The model's body frame is FLU (x forward, y left, z up), metres, with its origin at the
