@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The Halmstad label CSV reader: every class with its id, MATLAB's half-pixel shift, and errors that name the file,
 // the line and the field.
+#include <wingman/common/detection_class.hpp>
 #include <wingman/training/halmstad_labels.hpp>
 #include <wingman/training/yolo_dataset.hpp>
 
@@ -8,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <string>
 
@@ -47,6 +50,12 @@ TEST(HalmstadLabels, EveryClassWithItsIdAndTheHalfPixelShift) {
   EXPECT_EQ(boxes.at(7)[1].cls, 3);
   EXPECT_EQ(halmstad_class_id("HELICOPTER"), 3);
   EXPECT_EQ(halmstad_class_id("drone"), -1);  // the names are the CSVs' upper-case ones
+  // The label classes are the detector's, in its order (the import names them from common::kDetectionClassNames).
+  for (size_t i = 0; i < common::kDetectionClassNames.size(); ++i) {
+    std::string upper = common::kDetectionClassNames[i];
+    std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
+    EXPECT_EQ(halmstad_class_id(upper), static_cast<int>(i)) << upper;
+  }
 }
 
 TEST(HalmstadLabels, SplitKeepsEmptyFieldsAndDropsCarriageReturns) {

@@ -7,6 +7,8 @@
 #include "wingman/training/seeded_random.hpp"
 #include "wingman/training/yolo_dataset.hpp"
 
+#include <wingman/common/detection_class.hpp>
+
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -216,9 +218,11 @@ HalmstadImportSummary import_halmstad(const HalmstadImportOptions& o,
   summary.mean_area_ratio = summary.tightened > 0 ? ratio_sum / static_cast<double>(summary.tightened) : 0.0;
   splits.close();
   if (!splits) throw DatasetError(fmt::format("{}: cannot write", (out / "splits.csv").string()));
-  const std::vector<std::string> names = o.distractor_classes
-                                             ? std::vector<std::string>{"drone", "airplane", "bird", "helicopter"}
-                                             : std::vector<std::string>{"drone"};
+  // The Halmstad label classes' order (halmstad_labels.hpp) is the detector's: common::kDetectionClassNames.
+  const std::vector<std::string> names =
+      o.distractor_classes
+          ? std::vector<std::string>(common::kDetectionClassNames.begin(), common::kDetectionClassNames.end())
+          : std::vector<std::string>{common::kDetectionClassNames[common::kDroneClassId]};
   write_data_yaml((out / "data.yaml").string(), names,
                   {"Halmstad drone detection dataset (CC0-1.0; Svanstrom et al., Data in Brief 39, 2021), imported by "
                    "wingman import-halmstad",
