@@ -142,6 +142,11 @@ TEST(Recipe, TheShippedRecipesLoad) {
   EXPECT_EQ(n.stages[0].iou_loss, "ciou");
   EXPECT_THAT(n.stages[0].init, ::testing::ElementsAre(src() + "/models/wingman-small.weights"));
   EXPECT_EQ(n.dataset("synth-negatives")->config, src() + "/config/datasets/distractors_train.yaml");
+  // The four-class run with rendered distractors labelled as their classes.
+  const Recipe c = load_recipe(source_path("config/training/wingman-small-distractors-synth.yaml"), {}, src());
+  ASSERT_EQ(c.stages.size(), 1u);
+  EXPECT_EQ(c.stages[0].widen.classes, 4);
+  EXPECT_EQ(c.dataset("synth-distractor-classes")->config, src() + "/config/datasets/distractors_train_classes.yaml");
 }
 
 TEST(Recipe, SetChangesAStagesKeyOrATopLevelOne) {
